@@ -1,0 +1,50 @@
+# The two set-up commands of the README (`make demo`, `make test`) and friends.
+# Every target installs missing Debian packages first (scripts/install-deps.sh
+# is idempotent and quick when everything is present).
+JOBS      ?= 2
+BUILD     ?= build
+ASAN      ?= build-asan
+CMAKEFLAGS ?=
+ifeq ($(CI),true)
+  CMAKEFLAGS += -DPIEZO_WERROR=ON
+endif
+
+.PHONY: all deps configure build demo test test-asan bench validate clean fixtures
+
+all: build
+
+deps:
+	@bash scripts/install-deps.sh
+
+$(BUILD)/CMakeCache.txt: | deps
+	cmake -S . -B $(BUILD) -DCMAKE_BUILD_TYPE=Release -DPIEZO_WERROR=ON $(CMAKEFLAGS)
+
+configure: deps $(BUILD)/CMakeCache.txt
+
+build: configure
+	cmake --build $(BUILD) -j$(JOBS)
+
+demo: build
+	./$(BUILD)/ui/piezobench demo
+
+test: build
+	cd $(BUILD) && ctest --output-on-failure -j$(JOBS) -LE validate
+
+test-asan: deps
+	cmake -S . -B $(ASAN) -DCMAKE_BUILD_TYPE=RelWithDebInfo -DPIEZO_SANITIZE=ON \
+	      -DPIEZO_BUILD_BENCH=OFF -DPIEZO_WERROR=ON $(CMAKEFLAGS)
+	cmake --build $(ASAN) -j$(JOBS)
+	cd $(ASAN) && ASAN_OPTIONS=detect_leaks=1 UBSAN_OPTIONS=print_stacktrace=1 \
+	      ctest --output-on-failure -j$(JOBS) -LE validate
+
+bench: build
+	bash scripts/run-benchmarks.sh $(BUILD)
+
+validate: build
+	cd $(BUILD) && ctest --output-on-failure -L validate
+
+fixtures: deps
+	/usr/bin/python3 fixtures/make_fixtures.py fixtures
+
+clean:
+	rm -rf $(BUILD) $(ASAN)

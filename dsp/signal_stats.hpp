@@ -1,0 +1,33 @@
+#pragma once
+// Per-channel summary statistics of a sampled signal and clipping detection,
+// used by `capture info`, the acquisition runner and the estimators.
+#include <cstddef>
+#include <optional>
+#include <span>
+
+namespace piezo::dsp {
+
+struct SignalStats {
+  double min = 0.0;
+  double max = 0.0;
+  double rms = 0.0;
+  double mean = 0.0;
+  bool clipped = false;
+  std::size_t samples_at_limit = 0;  // samples sitting at the detected limit
+};
+
+struct ClipDetection {
+  // Known DAQ full-scale (volts, symmetric ±range). When set, a sample with
+  // |x| >= range·(1 - rel_margin) counts as at the limit.
+  std::optional<double> range_v;
+  double rel_margin = 1e-6;
+  // Without a known range: the signal is clipped when it holds a run of at
+  // least `min_flat_run` consecutive samples equal to its own extreme value
+  // (a converter pinned at full scale). ADC quantization of a smooth peak
+  // gives runs of a few samples at most, see tests/dsp/test_signal_stats.cpp.
+  std::size_t min_flat_run = 8;
+};
+
+SignalStats compute_stats(std::span<const double> x, const ClipDetection& clip = {});
+
+}  // namespace piezo::dsp

@@ -1,0 +1,73 @@
+#include "ui/cli/cli_common.hpp"
+
+#include <unistd.h>
+
+#include <cstdio>
+#include <iostream>
+
+#include "acquisition/capture.hpp"
+
+namespace piezo::cli {
+
+namespace {
+void report(Context& ctx, const char* kind, const std::string& msg, const nlohmann::json& extra) {
+  std::cerr << "piezobench: " << kind << ": " << msg << "\n";
+  if (ctx.json) {
+    nlohmann::json j = {{"error", {{"kind", kind}, {"message", msg}}}};
+    for (auto& [k, v] : extra.items()) j["error"][k] = v;
+    print_json(j);
+  }
+}
+}  // namespace
+
+int run_command(Context& ctx, const std::function<void()>& body) {
+  try {
+    body();
+    return ctx.exit_code;
+  } catch (const acq::CaptureError& e) {
+    report(ctx, "bad capture", e.what(),
+           {{"file", e.file()}, {"path", e.h5path()}, {"problem", e.problem()}});
+    return kBadInput;
+  } catch (const InputError& e) {
+    report(ctx, "bad input", e.what(), nlohmann::json::object());
+    return kBadInput;
+  } catch (const std::invalid_argument& e) {
+    report(ctx, "bad input", e.what(), nlohmann::json::object());
+    return kBadInput;
+  } catch (const std::exception& e) {
+    report(ctx, "internal error", e.what(), nlohmann::json::object());
+    return kInternal;
+  }
+}
+
+void print_json(const nlohmann::json& j) { std::cout << j.dump(2) << std::endl; }
+
+void add_json_flag(CLI::App* cmd, Context& ctx) {
+  cmd->add_flag("--json", ctx.json, "Machine-readable JSON output on stdout");
+}
+
+ProgressBar::ProgressBar(std::string label, bool enabled)
+    : label_(std::move(label)), enabled_(enabled && ::isatty(STDERR_FILENO)) {}
+
+ProgressBar::~ProgressBar() { finish(); }
+
+void ProgressBar::update(double fraction, const std::string& detail) {
+  if (!enabled_ || finished_) return;
+  fraction = std::clamp(fraction, 0.0, 1.0);
+  int permille = static_cast<int>(fraction * 1000);
+  if (permille == last_permille_) return;
+  last_permille_ = permille;
+  constexpr int kWidth = 30;
+  int fill = static_cast<int>(fraction * kWidth);
+  std::fprintf(stderr, "\r%-12s [%s%s] %5.1f%% %s", label_.c_str(), std::string(fill, '#').c_str(),
+               std::string(kWidth - fill, '.').c_str(), fraction * 100.0, detail.c_str());
+  std::fflush(stderr);
+}
+
+void ProgressBar::finish() {
+  if (!enabled_ || finished_) return;
+  finished_ = true;
+  if (last_permille_ >= 0) std::fprintf(stderr, "\n");
+}
+
+}  // namespace piezo::cli

@@ -1,0 +1,51 @@
+#pragma once
+// Shared conventions of the `piezobench` commands: exit codes, --json output,
+// error reporting. Every command registers itself through a register_* function.
+#include <CLI/CLI.hpp>
+#include <functional>
+#include <iosfwd>
+#include <nlohmann/json.hpp>
+#include <string>
+
+namespace piezo::cli {
+
+enum ExitCode : int { kOk = 0, kInternal = 1, kBadInput = 2 };
+
+// Error whose cause is the user's input (bad file, bad option value): exit 2.
+struct InputError : std::runtime_error {
+  using std::runtime_error::runtime_error;
+};
+
+struct Context {
+  bool json = false;  // --json: machine-readable output on stdout
+  int exit_code = kOk;
+};
+
+// Runs `body`, mapping exceptions to exit codes and messages (stderr, and a
+// {"error": ...} object on stdout when --json is set).
+int run_command(Context& ctx, const std::function<void()>& body);
+
+void print_json(const nlohmann::json& j);
+
+// Every command takes --json (also accepted before the command name).
+void add_json_flag(CLI::App* cmd, Context& ctx);
+
+// Text progress bar on stderr (only when stderr is a terminal or forced).
+class ProgressBar {
+ public:
+  explicit ProgressBar(std::string label, bool enabled = true);
+  ~ProgressBar();
+  void update(double fraction, const std::string& detail = {});
+  void finish();
+
+ private:
+  std::string label_;
+  bool enabled_;
+  bool finished_ = false;
+  int last_permille_ = -1;
+};
+
+void register_capture_commands(CLI::App& app, Context& ctx);
+void register_demo_command(CLI::App& app, Context& ctx);
+
+}  // namespace piezo::cli

@@ -1,0 +1,27 @@
+// piezobench — command-line front end. Each command lives in its own cmd_*.cpp.
+// Exit codes: 0 success, 2 bad input, 1 internal failure.
+#include <iostream>
+
+#include "ui/cli/cli_common.hpp"
+#include "ui/version.hpp"
+
+int main(int argc, char** argv) {
+  using namespace piezo::cli;
+  CLI::App app{"piezobench — impedance measurement and FE model updating of piezoelectric tubes",
+               "piezobench"};
+  app.set_version_flag("--version", std::string("piezobench ") + piezo::kVersion);
+  app.require_subcommand(1);
+  Context ctx;
+  app.add_flag("--json", ctx.json, "Machine-readable JSON output on stdout")->trigger_on_parse();
+  register_capture_commands(app, ctx);
+  register_demo_command(app, ctx);
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::Success& e) {
+    return app.exit(e);
+  } catch (const CLI::ParseError& e) {
+    app.exit(e);
+    return kBadInput;
+  }
+  return ctx.exit_code;
+}
