@@ -1,0 +1,103 @@
+// `piezobench capture info`, --version, exit codes: each malformed capture is
+// a clear error naming file and path, with exit code 2.
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <nlohmann/json.hpp>
+
+#include "acquisition/capture_file.hpp"
+#include "tests/support/capture_mutations.hpp"
+#include "tests/support/run_cli.hpp"
+
+namespace fs = std::filesystem;
+using namespace piezo;
+
+namespace {
+fs::path tmp_dir() {
+  auto d = fs::temp_directory_path() / ("piezobench-cli-" + std::to_string(::getpid()));
+  fs::create_directories(d);
+  return d;
+}
+}  // namespace
+
+TEST(Cli, Version) {
+  auto r = test::run_cli("--version");
+  EXPECT_EQ(r.exit_code, 0);
+  EXPECT_NE(r.out.find("piezobench "), std::string::npos);
+}
+
+TEST(Cli, UnknownCommandOrOptionIsBadInput) {
+  EXPECT_EQ(test::run_cli("frobnicate").exit_code, 2);
+  EXPECT_EQ(test::run_cli("capture info --no-such-option x.h5").exit_code, 2);
+  EXPECT_EQ(test::run_cli("capture info").exit_code, 2);  // FILE missing
+}
+
+TEST(Cli, CaptureInfoJsonOnAnH5pyFixture) {
+  auto r = test::run_cli("capture info --json " + std::string(PIEZO_SOURCE_DIR) +
+                         "/fixtures/h5py-sine-cal.h5");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  auto j = nlohmann::json::parse(r.out);
+  EXPECT_EQ(j["setup"]["divider_r1_ohm"], 3140.0);
+  ASSERT_EQ(j["shots"].size(), 4u);
+  EXPECT_EQ(j["shots"][0]["samples"], 2000);
+  EXPECT_EQ(j["shots"][0]["excitation"], "sine");
+  EXPECT_EQ(j["shots"][1]["role"], "open");
+  EXPECT_NEAR(j["shots"][0]["v1"]["rms_v"].get<double>(), 1 / std::sqrt(2.0), 1e-3);
+  EXPECT_NEAR(j["shots"][0]["v1"]["max_v"].get<double>(), 1.0, 1e-6);
+  EXPECT_EQ(j["shots"][0]["clipped"], false);
+}
+
+TEST(Cli, CaptureInfoTextAlsoWorksWithJsonBeforeTheCommand) {
+  auto f = std::string(PIEZO_SOURCE_DIR) + "/fixtures/h5py-exp-decay.h5";
+  auto text = test::run_cli("capture info " + f);
+  EXPECT_EQ(text.exit_code, 0);
+  EXPECT_NE(text.out.find("exp_decay"), std::string::npos);
+  auto js = test::run_cli("--json capture info " + f);
+  EXPECT_EQ(js.exit_code, 0);
+  EXPECT_NO_THROW(nlohmann::json::parse(js.out));
+}
+
+class CliDefects : public ::testing::TestWithParam<test::DefectCase> {};
+
+TEST_P(CliDefects, ExitCode2AndAMessageNamingFileAndPath) {
+  const auto& c = GetParam();
+  auto file = tmp_dir() / (std::string(c.name) + ".h5");
+  test::make_capture_with_defect(file, c.defect);
+  auto r = test::run_cli("capture info '" + file.string() + "'");
+  EXPECT_EQ(r.exit_code, 2) << r.err;
+  EXPECT_NE(r.err.find(file.string()), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find(c.h5path), std::string::npos) << r.err;
+  auto rj = test::run_cli("capture info --json '" + file.string() + "'");
+  EXPECT_EQ(rj.exit_code, 2);
+  auto j = nlohmann::json::parse(rj.out);
+  EXPECT_EQ(j["error"]["path"], c.h5path);
+  EXPECT_EQ(j["error"]["file"], file.string());
+  fs::remove_all(file);
+}
+
+INSTANTIATE_TEST_SUITE_P(All, CliDefects, ::testing::ValuesIn(test::all_defects()),
+                         [](const auto& info) { return std::string(info.param.name); });
+
+TEST(Cli, ClippedShotIsFlagged) {
+  auto cap = test::small_valid_capture(400);
+  for (auto& v : cap.shots[1].v2) v = std::clamp(v * 8.0, -1.0, 1.0);
+  for (std::size_t i = 0; i < 40; ++i) cap.shots[1].v2[100 + i] = 1.0;  // pinned at full scale
+  auto file = tmp_dir() / "clipped.h5";
+  acq::WriterOptions o;
+  o.overwrite = true;
+  acq::write_capture(file, cap, o);
+  auto r = test::run_cli("capture info --json " + file.string());
+  ASSERT_EQ(r.exit_code, 0);
+  auto j = nlohmann::json::parse(r.out);
+  EXPECT_EQ(j["shots"][0]["clipped"], false);
+  EXPECT_EQ(j["shots"][1]["clipped"], true);
+  EXPECT_EQ(j["shots"][1]["v2"]["clipped"], true);
+}
+
+TEST(Cli, DemoRuns) {
+  auto dir = tmp_dir() / "demo";
+  auto r = test::run_cli("demo --json --out " + dir.string());
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  auto j = nlohmann::json::parse(r.out);
+  EXPECT_TRUE(fs::exists(j["capture"].get<std::string>()));
+}
