@@ -10,7 +10,7 @@
 #include <cmath>
 #include <cstdio>
 #include <ctime>
-#include <regex>
+#include <algorithm>
 #include <system_error>
 
 #include "acquisition/h5_handle.hpp"
@@ -206,8 +206,7 @@ herr_t collect_names(hid_t, const char* name, const H5L_info_t*, void* data) {
 }
 
 bool is_shot_name(const std::string& n) {
-  static const std::regex re("^[0-9]{6}$");
-  return std::regex_match(n, re);
+  return n.size() == 6 && std::all_of(n.begin(), n.end(), [](char c) { return c >= '0' && c <= '9'; });
 }
 
 // ---------------------------------------------------------------- writing
