@@ -459,6 +459,27 @@ std::string CaptureWriter::append(const Shot& shot) {
   return name;
 }
 
+void CaptureWriter::write_truth(const std::vector<std::pair<std::string, double>>& numbers,
+                                const std::vector<std::pair<std::string, std::string>>& strings) {
+  if (impl_->closed) throw std::logic_error("CaptureWriter::write_truth: writer is closed");
+  std::lock_guard lock(h5::h5_mutex());
+  hid_t f = impl_->file.get();
+  h5::Id g = h5::group(H5Lexists(f, "truth", H5P_DEFAULT) > 0
+                           ? H5Gopen2(f, "truth", H5P_DEFAULT)
+                           : H5Gcreate2(f, "truth", H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT));
+  if (!g) throw std::runtime_error("HDF5: cannot create /truth: " + h5::last_error());
+  for (const auto& [k, v] : numbers) {
+    if (H5Aexists(g.get(), k.c_str()) > 0) H5Adelete(g.get(), k.c_str());
+    write_double_attr(g.get(), k.c_str(), v);
+  }
+  for (const auto& [k, v] : strings) {
+    if (H5Aexists(g.get(), k.c_str()) > 0) H5Adelete(g.get(), k.c_str());
+    write_string_attr(g.get(), k.c_str(), v);
+  }
+  g.reset();
+  impl_->flush_to_disk();
+}
+
 void CaptureWriter::close() {
   if (impl_->closed) return;
   impl_->closed = true;

@@ -5,6 +5,8 @@
 #include <filesystem>
 #include <memory>
 #include <string>
+#include <utility>
+#include <vector>
 
 #include "acquisition/capture.hpp"
 
@@ -44,6 +46,11 @@ class CaptureWriter {
   // Validates, writes and flushes one shot; returns its name ("000007").
   std::string append(const Shot& shot);
   void close();
+
+  // Simulated captures only: ground truth under /truth, as attributes. No
+  // estimator, updater or diagnosis reads it (the reader ignores the group).
+  void write_truth(const std::vector<std::pair<std::string, double>>& numbers,
+                   const std::vector<std::pair<std::string, std::string>>& strings = {});
 
   std::size_t shots_written() const;
   const std::filesystem::path& final_path() const;

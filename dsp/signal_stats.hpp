@@ -18,9 +18,11 @@ struct SignalStats {
 
 struct ClipDetection {
   // Known DAQ full-scale (volts, symmetric ±range). When set, a sample with
-  // |x| >= range·(1 - rel_margin) counts as at the limit.
+  // |x| >= range·(1 - rel_margin) counts as at the limit. The margin covers
+  // converters whose largest code sits a few LSB below the nominal range
+  // (two's-complement codes are asymmetric): 1/256 of full scale.
   std::optional<double> range_v;
-  double rel_margin = 1e-6;
+  double rel_margin = 1.0 / 256.0;
   // Without a known range: the signal is clipped when it holds a run of at
   // least `min_flat_run` consecutive samples equal to its own extreme value
   // (a converter pinned at full scale). ADC quantization of a smooth peak

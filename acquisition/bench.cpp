@@ -1,0 +1,60 @@
+#include "acquisition/bench.hpp"
+
+#include "drivers/infiniium/driver.hpp"
+#include "drivers/instrument_uri.hpp"
+#include "drivers/keysight33500/driver.hpp"
+#include "drivers/sim/loopback_transport.hpp"
+#include "drivers/sim/sim_awg.hpp"
+#include "drivers/sim/sim_daq.hpp"
+#include "drivers/tcp_transport.hpp"
+
+namespace piezo::acq {
+
+using namespace piezo::drivers;
+
+std::unique_ptr<Transport> open_transport(const std::string& address) {
+  auto uri = parse_instrument_uri(address);
+  switch (uri.kind) {
+    case InstrumentUri::Kind::Tcp:
+      return std::make_unique<TcpTransport>(uri.host, uri.port);
+    case InstrumentUri::Kind::UsbTmc:
+      throw std::invalid_argument("instrument address '" + address +
+                                  "': USBTMC transport is not available in this build yet");
+    case InstrumentUri::Kind::Sim:
+      break;
+  }
+  throw std::invalid_argument("open_transport: 'sim' has no transport of its own");
+}
+
+Bench open_bench(const BenchAddress& addr, std::shared_ptr<sim::SimBench> sim_bench) {
+  Bench b;
+  auto awg_uri = parse_instrument_uri(addr.awg);
+  if (awg_uri.kind == InstrumentUri::Kind::Sim) {
+    if (!sim_bench) throw std::invalid_argument("open_bench: the simulated bench needs its physics");
+    auto awg_dev = std::make_shared<sim::SimAwg>(sim_bench);
+    auto daq_dev = std::make_shared<sim::SimDaq>(sim_bench);
+    b.awg = std::make_unique<keysight33500::Driver>(
+        std::make_unique<sim::LoopbackTransport>(awg_dev, "sim://awg"));
+    b.daq = std::make_unique<infiniium::Driver>(
+        std::make_unique<sim::LoopbackTransport>(daq_dev, "sim://daq"));
+    b.sim = sim_bench;
+    b.description = "embedded simulated bench (" + sim_bench->physics().description() + ")";
+    return b;
+  }
+  std::string daq_addr;
+  if (addr.daq) {
+    daq_addr = *addr.daq;
+  } else if (awg_uri.kind == InstrumentUri::Kind::Tcp) {
+    daq_addr = "tcp://" + awg_uri.host + ":" + std::to_string(awg_uri.port + 1);
+  } else {
+    throw std::invalid_argument("instrument address '" + addr.awg +
+                                "': a USBTMC bench needs the DAQ's address too (--daq)");
+  }
+  b.awg = std::make_unique<keysight33500::Driver>(open_transport(addr.awg));
+  b.daq = std::make_unique<infiniium::Driver>(open_transport(daq_addr));
+  b.description = "AWG " + addr.awg + " [" + b.awg->identity() + "], DAQ " + daq_addr + " [" +
+                  b.daq->identity() + "]";
+  return b;
+}
+
+}  // namespace piezo::acq

@@ -1,0 +1,180 @@
+#include "acquisition/plan.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <random>
+#include <stdexcept>
+#include <toml++/toml.h>
+
+namespace piezo::acq {
+
+namespace {
+void require(bool ok, const std::string& what) {
+  if (!ok) throw std::invalid_argument("measurement plan: " + what);
+}
+}  // namespace
+
+void MeasurementPlan::validate() const {
+  require(sample_rate_hz > 0 && std::isfinite(sample_rate_hz), "sample_rate_hz must be positive");
+  require(samples >= kMinSamples, "samples must be at least 16");
+  require(pretrigger_samples < samples, "pretrigger_samples must be below samples");
+  require(shots >= 1, "shots must be at least 1");
+  require(setup.divider_r1_ohm > 0, "r1_ohm must be positive");
+  const auto& e = excitation;
+  require(e.amplitude_v > 0 && e.amplitude_v <= 10, "amplitude_v must be in (0, 10] V");
+  if (e.kind == Excitation::ExpDecay) require(e.decay_per_s > 0, "decay_per_s must be positive");
+  const double nyq = 0.5 * sample_rate_hz;
+  if (e.kind == Excitation::Sine) {
+    require(e.frequency_hz > 0 && e.frequency_hz < nyq, "frequency_hz must be in (0, rate/2)");
+    if (e.f_step_hz > 0)
+      require(e.f_start_hz > 0 && e.f_stop_hz >= e.f_start_hz && e.f_stop_hz < nyq,
+              "stepped sine needs 0 < f_start_hz <= f_stop_hz < rate/2");
+  }
+  if (e.kind == Excitation::Chirp)
+    require(e.f_start_hz > 0 && e.f_stop_hz > e.f_start_hz && e.f_stop_hz < nyq,
+            "chirp needs 0 < f_start_hz < f_stop_hz < rate/2");
+  require(range_v >= 0, "range_v must be >= 0");
+}
+
+double MeasurementPlan::daq_range_v() const {
+  return range_v > 0 ? range_v : 1.25 * excitation.amplitude_v;
+}
+
+std::vector<ExcitationSpec> MeasurementPlan::steps() const {
+  const auto& e = excitation;
+  if (e.kind != Excitation::Sine || e.f_step_hz <= 0) return {e};
+  std::vector<ExcitationSpec> out;
+  for (double f = e.f_start_hz; f <= e.f_stop_hz * (1 + 1e-12); f += e.f_step_hz) {
+    ExcitationSpec s = e;
+    s.frequency_hz = f;
+    out.push_back(s);
+  }
+  return out;
+}
+
+std::vector<double> synthesize(const ExcitationSpec& e, double fs, std::size_t n) {
+  std::vector<double> w(n);
+  const double T = static_cast<double>(n) / fs;
+  switch (e.kind) {
+    case Excitation::ExpDecay:
+      for (std::size_t k = 0; k < n; ++k) w[k] = std::exp(-e.decay_per_s * k / fs);
+      break;
+    case Excitation::Sine:
+      for (std::size_t k = 0; k < n; ++k) w[k] = std::sin(2 * M_PI * e.frequency_hz * k / fs);
+      break;
+    case Excitation::Chirp: {  // linear sweep over the record
+      const double rate = (e.f_stop_hz - e.f_start_hz) / T;
+      for (std::size_t k = 0; k < n; ++k) {
+        double t = k / fs;
+        w[k] = std::sin(2 * M_PI * (e.f_start_hz * t + 0.5 * rate * t * t));
+      }
+      break;
+    }
+    case Excitation::Noise: {
+      std::mt19937_64 rng(e.noise_seed);
+      std::normal_distribution<double> g(0.0, 1.0);
+      double peak = 0;
+      for (auto& x : w) {
+        x = g(rng);
+        peak = std::max(peak, std::fabs(x));
+      }
+      for (auto& x : w) x /= peak;
+      break;
+    }
+    case Excitation::Arbitrary:
+      throw std::invalid_argument("synthesize: arbitrary excitation has no formula");
+  }
+  return w;
+}
+
+MeasurementPlan load_plan_toml(const std::filesystem::path& file) {
+  toml::table t;
+  try {
+    t = toml::parse_file(file.string());
+  } catch (const toml::parse_error& e) {
+    throw std::invalid_argument("plan " + file.string() + ": " + std::string(e.description()) +
+                                " at line " + std::to_string(e.source().begin.line));
+  }
+  MeasurementPlan p;
+  auto fail = [&](const std::string& key, const std::string& why) {
+    throw std::invalid_argument("plan " + file.string() + ": " + key + ": " + why);
+  };
+  auto num = [&](const toml::table& tb, const char* key, double& out, const std::string& where) {
+    if (auto n = tb.get(key)) {
+      if (auto v = n->value<double>()) out = *v;
+      else fail(where + key, "expected a number");
+    }
+  };
+  const std::vector<std::string> top_keys = {"excitation", "acquisition", "setup"};
+  for (auto& [k, v] : t)
+    if (std::find(top_keys.begin(), top_keys.end(), std::string(k.str())) == top_keys.end())
+      fail(std::string(k.str()), "unknown section (excitation, acquisition, setup)");
+
+  if (auto ex = t["excitation"].as_table()) {
+    for (auto& [k, v] : *ex) {
+      static const std::vector<std::string> known = {"kind", "amplitude_v", "decay_per_s", "frequency_hz",
+                                                     "f_start_hz", "f_stop_hz", "f_step_hz", "seed"};
+      if (std::find(known.begin(), known.end(), std::string(k.str())) == known.end())
+        fail("excitation." + std::string(k.str()), "unknown key");
+    }
+    if (auto kind = (*ex)["kind"].value<std::string>()) {
+      auto e = parse_excitation(*kind);
+      if (!e || *e == Excitation::Arbitrary) fail("excitation.kind", "expected exp_decay, sine, chirp or noise");
+      p.excitation.kind = *e;
+    }
+    auto& e = p.excitation;
+    num(*ex, "amplitude_v", e.amplitude_v, "excitation.");
+    num(*ex, "decay_per_s", e.decay_per_s, "excitation.");
+    num(*ex, "frequency_hz", e.frequency_hz, "excitation.");
+    num(*ex, "f_start_hz", e.f_start_hz, "excitation.");
+    num(*ex, "f_stop_hz", e.f_stop_hz, "excitation.");
+    num(*ex, "f_step_hz", e.f_step_hz, "excitation.");
+    if (auto s = (*ex)["seed"].value<std::int64_t>()) e.noise_seed = static_cast<std::uint64_t>(*s);
+  }
+  if (auto aq = t["acquisition"].as_table()) {
+    for (auto& [k, v] : *aq) {
+      static const std::vector<std::string> known = {"sample_rate_hz", "samples", "pretrigger_samples",
+                                                     "shots", "range_v"};
+      if (std::find(known.begin(), known.end(), std::string(k.str())) == known.end())
+        fail("acquisition." + std::string(k.str()), "unknown key");
+    }
+    num(*aq, "sample_rate_hz", p.sample_rate_hz, "acquisition.");
+    num(*aq, "range_v", p.range_v, "acquisition.");
+    if (auto v = (*aq)["samples"].value<std::int64_t>()) p.samples = static_cast<std::size_t>(std::max<std::int64_t>(0, *v));
+    if (auto v = (*aq)["pretrigger_samples"].value<std::int64_t>())
+      p.pretrigger_samples = static_cast<std::size_t>(std::max<std::int64_t>(0, *v));
+    if (auto v = (*aq)["shots"].value<std::int64_t>()) p.shots = static_cast<int>(*v);
+  }
+  p.setup.divider_r1_ohm = 3140.0;
+  if (auto su = t["setup"].as_table()) {
+    for (auto& [k, v] : *su) {
+      static const std::vector<std::string> known = {"r1_ohm", "transducer_id", "material", "notes",
+                                                     "inner_diameter_m", "outer_diameter_m", "length_m",
+                                                     "density_kg_m3"};
+      if (std::find(known.begin(), known.end(), std::string(k.str())) == known.end())
+        fail("setup." + std::string(k.str()), "unknown key");
+    }
+    num(*su, "r1_ohm", p.setup.divider_r1_ohm, "setup.");
+    if (auto s = (*su)["transducer_id"].value<std::string>()) p.setup.transducer_id = *s;
+    if (auto s = (*su)["material"].value<std::string>()) p.setup.material = *s;
+    if (auto s = (*su)["notes"].value<std::string>()) p.setup.notes = *s;
+    for (auto [key, dst] : {std::pair{"inner_diameter_m", &p.setup.inner_diameter_m},
+                            std::pair{"outer_diameter_m", &p.setup.outer_diameter_m},
+                            std::pair{"length_m", &p.setup.length_m},
+                            std::pair{"density_kg_m3", &p.setup.density_kg_m3}}) {
+      double v = 0;
+      if ((*su)[key]) {
+        num(*su, key, v, "setup.");
+        *dst = v;
+      }
+    }
+  }
+  try {
+    p.validate();
+  } catch (const std::invalid_argument& e) {
+    throw std::invalid_argument("plan " + file.string() + ": " + e.what());
+  }
+  return p;
+}
+
+}  // namespace piezo::acq

@@ -1,0 +1,128 @@
+#include "acquisition/runner.hpp"
+
+#include "acquisition/capture_file.hpp"
+#include "dsp/signal_stats.hpp"
+#include "drivers/scpi_client.hpp"
+
+namespace piezo::acq {
+
+namespace {
+std::string shot_label(int k, int total) {
+  return "shot " + std::to_string(k + 1) + " of " + std::to_string(total);
+}
+}  // namespace
+
+RunResult run_measurement(Bench& bench, const MeasurementPlan& plan, const std::filesystem::path& out,
+                          const RunnerOptions& opt, const std::function<void(const Progress&)>& progress,
+                          const std::atomic<bool>* cancel) {
+  plan.validate();
+  if (!bench.awg || !bench.daq) throw std::invalid_argument("run_measurement: bench has no AWG or DAQ");
+  const auto steps = plan.steps();
+  RunResult res;
+  res.capture = out;
+  res.shots_planned = static_cast<int>(steps.size()) * plan.shots;
+
+  WriterOptions wo;
+  wo.software = opt.software;
+  wo.overwrite = opt.overwrite;
+  CaptureWriter writer(out, plan.setup, wo);  // destroyed on any exit: keeps every written shot
+  if (opt.record_truth && bench.sim) {
+    auto numbers = bench.sim->physics().truth();
+    const auto& imp = bench.sim->imperfections();
+    numbers.emplace_back("channel_skew_s", imp.channel_skew_s);
+    numbers.emplace_back("channel_gain", imp.channel_gain);
+    numbers.emplace_back("noise_rel_v1", imp.noise_rel[0]);
+    numbers.emplace_back("noise_rel_v2", imp.noise_rel[1]);
+    numbers.emplace_back("seed", static_cast<double>(bench.sim->seed()));
+    writer.write_truth(numbers, {{"physics", bench.sim->physics().description()}});
+  }
+
+  drivers::DaqConfig dc;
+  dc.sample_rate_hz = plan.sample_rate_hz;
+  dc.record_length = plan.samples;
+  dc.pretrigger_samples = plan.pretrigger_samples;
+  dc.range_v[0] = dc.range_v[1] = plan.daq_range_v();
+  const std::size_t post = plan.samples - plan.pretrigger_samples;
+
+  int k = 0;
+  auto report = [&](const char* stage) {
+    if (progress) progress(Progress{k, res.shots_planned, stage});
+  };
+  try {
+    for (const auto& step : steps) {
+      drivers::ArbWaveform w;
+      w.samples = synthesize(step, plan.sample_rate_hz, post);
+      w.sample_rate_hz = plan.sample_rate_hz;
+      w.peak_v = step.amplitude_v;
+      bool loaded = false;
+      for (int rep = 0; rep < plan.shots; ++rep, ++k) {
+        if (cancel && cancel->load()) {
+          res.cancelled = true;
+          break;
+        }
+        report("configure");
+        if (!loaded) {
+          bench.awg->load(w);
+          loaded = true;
+        }
+        bench.daq->configure(dc);
+        report("acquire");
+        bench.daq->arm();
+        bench.awg->output(true);
+        bench.awg->trigger();
+        report("fetch");
+        drivers::DaqRecord r = bench.daq->fetch(opt.fetch_timeout_s);
+
+        Shot s;
+        s.sample_rate_hz = r.sample_rate_hz;
+        s.excitation = step.kind;
+        s.amplitude_v = step.amplitude_v;
+        if (step.kind == Excitation::ExpDecay) s.decay_per_s = step.decay_per_s;
+        if (step.kind == Excitation::Sine) s.frequency_hz = step.frequency_hz;
+        if (step.kind == Excitation::Chirp) {
+          s.f_start_hz = step.f_start_hz;
+          s.f_stop_hz = step.f_stop_hz;
+        }
+        s.pretrigger_samples = static_cast<std::int64_t>(r.pretrigger_samples);
+        s.daq_range_v = r.range_v[0];
+        s.v1 = std::move(r.v1);
+        s.v2 = std::move(r.v2);
+        dsp::ClipDetection clip;
+        clip.range_v = s.daq_range_v;
+        bool clipped = dsp::compute_stats(s.v1, clip).clipped || dsp::compute_stats(s.v2, clip).clipped;
+        report("write");
+        writer.append(s);
+        ++res.shots_written;
+        if (clipped) {
+          res.clipped_shots.push_back(k);
+          if (opt.stop_on_clipping) {
+            bench.awg->output(false);
+            writer.close();
+            throw RunError(shot_label(k, res.shots_planned) + " clipped: a channel reached the DAQ range of ±" +
+                               std::to_string(dc.range_v[0]) +
+                               " V. The shot is stored (flagged); raise the range or lower the amplitude. " +
+                               std::to_string(res.shots_written) + " shot(s) are in " + out.string(),
+                           res);
+          }
+        }
+      }
+      if (res.cancelled) break;
+    }
+    bench.awg->output(false);
+  } catch (const RunError&) {
+    throw;
+  } catch (const std::exception& e) {
+    try {
+      writer.close();
+    } catch (...) {
+    }
+    throw RunError(shot_label(k, res.shots_planned) + " failed: " + e.what() + ". " +
+                       std::to_string(res.shots_written) + " earlier shot(s) are safe in " +
+                       (res.shots_written > 0 ? out.string() : std::string("(none written)")),
+                   res);
+  }
+  writer.close();
+  return res;
+}
+
+}  // namespace piezo::acq

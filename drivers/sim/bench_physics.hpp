@@ -1,0 +1,32 @@
+#pragma once
+// What the simulated bench needs from physics: the voltage at the transducer
+// terminal (v2) at given instants, for a generator voltage v1 given as a
+// piecewise-linear function (knots; two knots at the same instant make a
+// jump, such as the step at t = 0 of an exp_decay burst). The circuit is at
+// rest before the first knot. The FE-based implementation lives in
+// acquisition/ (it needs model/); drivers/ stays free of the model.
+#include <span>
+#include <string>
+#include <utility>
+#include <vector>
+
+namespace piezo::drivers::sim {
+
+struct PiecewiseLinear {
+  std::vector<double> t;  // non-decreasing
+  std::vector<double> v;
+  double at(double time) const;  // right-continuous value
+};
+
+class BenchPhysics {
+ public:
+  virtual ~BenchPhysics() = default;
+  // `sample_times` ascending, all >= knots.t.front(); v1 is held at its last
+  // knot value after the last knot.
+  virtual std::vector<double> respond(const PiecewiseLinear& v1, std::span<const double> sample_times) = 0;
+  // Ground truth recorded in simulated captures (/truth), never read by estimators.
+  virtual std::vector<std::pair<std::string, double>> truth() const { return {}; }
+  virtual std::string description() const = 0;
+};
+
+}  // namespace piezo::drivers::sim
