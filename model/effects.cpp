@@ -1,0 +1,70 @@
+#include "model/effects.hpp"
+
+#include <cmath>
+#include <cstdlib>
+#include <stdexcept>
+
+namespace piezo::model {
+
+namespace {
+constexpr double kInf = std::numeric_limits<double>::infinity();
+const EffectInfo kCatalogue[] = {
+    {"series_resistance", "ohm", 0.0, 200.0, &EffectSet::series_resistance_ohm,
+     "resistance of leads and contacts in series with the transducer"},
+    {"parallel_capacitance", "F", 0.0, 2e-9, &EffectSet::parallel_capacitance_f,
+     "fixture and cable capacitance across the transducer terminals"},
+    {"daq_input_resistance", "ohm", 1e3, kInf, &EffectSet::daq_input_resistance_ohm,
+     "input resistance of the DAQ channel on the transducer node"},
+    {"dielectric_loss", "tan_delta", 0.0, 0.1, &EffectSet::dielectric_loss,
+     "dielectric loss tangent of the ceramic"},
+    {"channel_skew", "s", -1e-6, 1e-6, &EffectSet::channel_skew_s,
+     "sampling delay of channel 2 (v2) relative to channel 1 (v1)"},
+    {"channel_gain", "fraction", -0.2, 0.2, &EffectSet::channel_gain,
+     "relative gain error of channel 2"},
+    {"r1_tolerance", "fraction", -0.2, 0.2, &EffectSet::r1_tolerance,
+     "deviation of the true series resistor from its nominal value"},
+    {"mass_loading", "fraction", 0.0, 0.5, &EffectSet::mass_loading,
+     "mass added at the tube's end faces, as a fraction of the tube's mass"},
+    {"mechanical_damping", "s", 0.0, 1e-6, &EffectSet::mechanical_damping,
+     "stiffness-proportional damping beyond the fitted Rayleigh model"},
+};
+}  // namespace
+
+bool EffectSet::any() const {
+  EffectSet neutral;
+  for (const auto& e : kCatalogue)
+    if (this->*e.field != neutral.*e.field) return true;
+  return false;
+}
+
+std::span<const EffectInfo> effect_catalogue() { return kCatalogue; }
+
+const EffectInfo* find_effect(std::string_view name) {
+  for (const auto& e : kCatalogue)
+    if (e.name == name) return &e;
+  return nullptr;
+}
+
+void apply_effect_assignment(EffectSet& set, std::string_view a) {
+  auto eq = a.find('=');
+  if (eq == std::string_view::npos)
+    throw std::invalid_argument("effect '" + std::string(a) + "': expected NAME=VALUE");
+  std::string name(a.substr(0, eq)), value(a.substr(eq + 1));
+  const EffectInfo* e = find_effect(name);
+  if (!e) {
+    std::string known;
+    for (const auto& c : kCatalogue) known += (known.empty() ? "" : ", ") + std::string(c.name);
+    throw std::invalid_argument("effect '" + name + "': unknown (known: " + known + ")");
+  }
+  char* end = nullptr;
+  double v = std::strtod(value.c_str(), &end);
+  if (value.empty() || *end != '\0' || std::isnan(v))
+    throw std::invalid_argument("effect '" + name + "': '" + value + "' is not a number");
+  if (v < e->lower || v > e->upper)
+    throw std::invalid_argument("effect '" + name + "': " + value + " " + std::string(e->unit) +
+                                " is outside the physical bounds [" + std::to_string(e->lower) + ", " +
+                                std::to_string(e->upper) + "]");
+  set.*(e->field) = v;
+}
+
+}  // namespace piezo::model

@@ -1,0 +1,43 @@
+#pragma once
+// The catalogue of bench effects that the FE model of the bare tube leaves
+// out. One list serves two sides: the simulated bench injects them (physics
+// and DAQ imperfections) and the gap diagnosis fits them as model extensions.
+// Values are physical (SI); zero/neutral means "absent".
+#include <limits>
+#include <optional>
+#include <span>
+#include <string>
+#include <string_view>
+
+namespace piezo::model {
+
+struct EffectSet {
+  double series_resistance_ohm = 0.0;  // lead/contact resistance in series with the tube
+  double parallel_capacitance_f = 0.0;  // fixture and cable capacitance across the terminals
+  double daq_input_resistance_ohm = std::numeric_limits<double>::infinity();  // loads the v2 node
+  double dielectric_loss = 0.0;  // tan δ of the ceramic (εT33 → εT33·(1 − j·tanδ))
+  double channel_skew_s = 0.0;  // channel 2 samples later than channel 1
+  double channel_gain = 0.0;  // relative gain error of channel 2
+  double r1_tolerance = 0.0;  // true R1 = nominal·(1 + r1_tolerance)
+  double mass_loading = 0.0;  // added mass at the end faces, fraction of the tube mass
+  double mechanical_damping = 0.0;  // extra stiffness-proportional damping β (s) beyond the fitted Rayleigh model
+
+  bool any() const;
+};
+
+struct EffectInfo {
+  std::string_view name;  // CLI / JSON name
+  std::string_view unit;
+  double lower, upper;  // physical bounds used by the diagnosis and the CLI check
+  double EffectSet::*field;
+  std::string_view meaning;
+};
+
+std::span<const EffectInfo> effect_catalogue();
+const EffectInfo* find_effect(std::string_view name);
+
+// "NAME=VALUE" → sets the field; throws std::invalid_argument naming the
+// effect and the problem (unknown name, not a number, out of bounds).
+void apply_effect_assignment(EffectSet& set, std::string_view assignment);
+
+}  // namespace piezo::model
