@@ -1,0 +1,67 @@
+#pragma once
+// The divider bench as a linear state-space system, exact in time: the tube
+// in modal form (model::ModalPortModel), R1, and the circuit effects of the
+// catalogue (series resistance, parallel capacitance, DAQ input resistance,
+// dielectric loss as a causal Debye network). Input: the generator voltage
+// v1(t), piecewise linear; output: the terminal voltage v2 seen by the DAQ.
+//
+// Tube port (see model/port_model.hpp): Q = Ce·vt + Σ p_k x_k,
+//   x_k'' + c_k x_k' + ω_k² x_k = p_k vt,  Ce = C0 + C_res,  c_k = α + β κ_k,
+// so Q/V = Ce + Σ p_k² / (ω_k² − ω² + jω c_k) as in the harmonic analysis.
+// Integration is exact for piecewise-linear input: one matrix exponential of
+// the system augmented by the input and its slope per distinct step length.
+#include <Eigen/Dense>
+#include <complex>
+#include <map>
+#include <span>
+#include <vector>
+
+#include "drivers/sim/bench_physics.hpp"
+#include "model/effects.hpp"
+#include "model/port_model.hpp"
+
+namespace piezo::acq {
+
+struct DividerCircuit {
+  double r1_ohm = 3140.0;  // the TRUE series resistor (nominal·(1 + r1_tolerance))
+  double series_resistance_ohm = 0.0;
+  double parallel_capacitance_f = 0.0;
+  double daq_input_resistance_ohm = std::numeric_limits<double>::infinity();
+  double dielectric_loss = 0.0;  // tan δ, realised by a Debye network on Ce
+  model::RayleighDamping damping;
+  double extra_beta_s = 0.0;  // mechanical_damping effect
+};
+
+class DividerStateSpace {
+ public:
+  DividerStateSpace(const model::ModalPortModel& port, const DividerCircuit& circuit);
+
+  // v2 at the given instants for generator voltage v1 (at rest before v1's first knot).
+  std::vector<double> simulate(const drivers::sim::PiecewiseLinear& v1, std::span<const double> times);
+
+  // Frequency response v2/v1 of the same system (for tests: the time domain
+  // must agree with it), and the terminal impedance the DAQ would see.
+  std::complex<double> transfer(double omega) const;
+
+  int order() const { return static_cast<int>(a_.rows()); }
+
+ private:
+  struct Step {
+    Eigen::MatrixXd phi;
+    Eigen::VectorXd g0, g1;  // response to the input value and to its slope
+  };
+  const Step& step(double h);
+
+  Eigen::MatrixXd a_;
+  Eigen::VectorXd b_;  // input v1
+  Eigen::RowVectorXd c_;  // output v2 = c·X + d·v1
+  double d_ = 0.0;
+  std::map<long long, Step> cache_;  // key: step length in femtoseconds
+};
+
+// The Debye network (series R–C branches) whose conductance approximates
+// ω·C·tanδ over [f_lo, f_hi]: returns (C_i, τ_i) pairs.
+std::vector<std::pair<double, double>> debye_network_for_loss(double c, double tan_delta,
+                                                              double f_lo = 100.0, double f_hi = 1e6);
+
+}  // namespace piezo::acq

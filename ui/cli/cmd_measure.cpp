@@ -1,0 +1,212 @@
+// `piezobench measure`: runs a measurement plan on a bench (embedded simulator,
+// SCPI over TCP, or USBTMC) and writes the capture shot by shot.
+// `piezobench sim-instrument`: serves the simulated AWG and DAQ over TCP
+// (AWG on PORT, DAQ on PORT+1), speaking the same SCPI dialects as the real ones.
+#include <csignal>
+#include <iostream>
+#include <thread>
+
+#include "acquisition/runner.hpp"
+#include "acquisition/sim_setup.hpp"
+#include "drivers/sim/sim_awg.hpp"
+#include "drivers/sim/sim_daq.hpp"
+#include "drivers/sim/tcp_server.hpp"
+#include "ui/cli/cli_common.hpp"
+
+namespace piezo::cli {
+
+namespace {
+
+struct SimOptions {
+  std::vector<std::string> effects;
+  std::string material = "apc850";
+  bool isotropic = false;
+  std::string set;
+  double noise = 0.0;
+  double beta = 1e-7;
+  std::uint64_t seed = 1;
+  int adc_bits = 14;
+};
+
+void add_sim_options(CLI::App* cmd, SimOptions& o) {
+  cmd->add_option("--effect", o.effects, "Simulated bench effect NAME=VALUE (repeatable)");
+  cmd->add_option("--sim-material", o.material, "Simulated transducer's material preset")->capture_default_str();
+  cmd->add_flag("--sim-isotropic", o.isotropic, "Simulated transducer in the seed's isotropic class");
+  cmd->add_option("--sim-set", o.set, "Simulated material overrides, e.g. YE11=6.66e10,d31=-210e-12");
+  cmd->add_option("--noise", o.noise, "White noise per channel, std(noise)/std(signal)")->capture_default_str();
+  cmd->add_option("--rayleigh-beta", o.beta, "Simulated Rayleigh beta (s)")->capture_default_str();
+  cmd->add_option("--seed", o.seed, "Noise seed")->capture_default_str();
+  cmd->add_option("--adc-bits", o.adc_bits, "Simulated DAQ resolution")->capture_default_str();
+}
+
+acq::SimSpec sim_spec(const SimOptions& o, const model::TubeGeometry& g) {
+  acq::SimSpec s;
+  s.material = o.material;
+  s.isotropic = o.isotropic;
+  s.set = o.set;
+  s.geometry = g;
+  s.damping.beta = o.beta;
+  s.noise_rel = o.noise;
+  s.seed = o.seed;
+  s.adc_bits = o.adc_bits;
+  for (const auto& e : o.effects) model::apply_effect_assignment(s.effects, e);
+  return s;
+}
+
+std::atomic<bool> g_cancel{false};
+void on_sigint(int) { g_cancel = true; }
+
+}  // namespace
+
+void register_measure_commands(CLI::App& app, Context& ctx) {
+  // ---------------------------------------------------------------- measure
+  auto* m = app.add_subcommand("measure", "Acquire a capture on the bench");
+  struct MeasureArgs {
+    std::string instrument = "sim";
+    std::string daq;
+    std::string plan_file;
+    std::string excitation = "exp_decay";
+    double amplitude = 1.0, decay = 3000.0, frequency = 50e3, f_start = 1e3, f_stop = 120e3, f_step = 0;
+    std::size_t samples = 20000, pretrigger = 200;
+    double rate = 1e7, range = 0, r1 = 3140;
+    int shots = 1;
+    std::string out;
+    bool overwrite = false, allow_clipping = false;
+    SimOptions sim;
+  };
+  auto a = std::make_shared<MeasureArgs>();
+  m->add_option("--instrument", a->instrument, "sim | tcp://HOST:PORT | usbtmc://VID:PID[/SERIAL] (the AWG)")
+      ->capture_default_str();
+  m->add_option("--daq", a->daq, "DAQ address (default: tcp PORT+1 on the same host)");
+  auto* plan_opt = m->add_option("--plan", a->plan_file, "TOML measurement plan");
+  m->add_option("--excitation", a->excitation, "exp_decay | sine | chirp | noise")->capture_default_str();
+  m->add_option("--amplitude", a->amplitude, "Peak drive (V)")->capture_default_str();
+  m->add_option("--decay", a->decay, "exp_decay rate (1/s)")->capture_default_str();
+  m->add_option("--frequency", a->frequency, "sine frequency (Hz)")->capture_default_str();
+  m->add_option("--f-start", a->f_start, "chirp / stepped-sine start (Hz)");
+  m->add_option("--f-stop", a->f_stop, "chirp / stepped-sine stop (Hz)");
+  m->add_option("--f-step", a->f_step, "stepped-sine step (Hz); > 0 makes one shot per frequency");
+  m->add_option("--samples", a->samples, "Record length")->capture_default_str();
+  m->add_option("--pretrigger", a->pretrigger, "Samples before the trigger")->capture_default_str();
+  m->add_option("--rate", a->rate, "Sample rate (S/s)")->capture_default_str();
+  m->add_option("--range", a->range, "DAQ ±range (V); 0 = 1.25 × amplitude")->capture_default_str();
+  m->add_option("--r1", a->r1, "Series resistor R1 (ohm)")->capture_default_str();
+  m->add_option("--shots", a->shots, "Shots per excitation step")->capture_default_str();
+  m->add_option("--out", a->out, "Capture file to write (.h5)")->required();
+  m->add_flag("--overwrite", a->overwrite, "Replace an existing capture");
+  m->add_flag("--allow-clipping", a->allow_clipping, "Keep going after a clipped shot");
+  add_sim_options(m, a->sim);
+  add_json_flag(m, ctx);
+  m->callback([&ctx, a, plan_opt] {
+    ctx.exit_code = run_command(ctx, [&] {
+      acq::MeasurementPlan plan;
+      if (*plan_opt) {
+        plan = acq::load_plan_toml(a->plan_file);
+      } else {
+        auto e = acq::parse_excitation(a->excitation);
+        if (!e || *e == acq::Excitation::Arbitrary)
+          throw InputError("--excitation: expected exp_decay, sine, chirp or noise");
+        plan.excitation.kind = *e;
+        plan.excitation.amplitude_v = a->amplitude;
+        plan.excitation.decay_per_s = a->decay;
+        plan.excitation.frequency_hz = a->frequency;
+        plan.excitation.f_start_hz = a->f_start;
+        plan.excitation.f_stop_hz = a->f_stop;
+        plan.excitation.f_step_hz = a->f_step;
+        plan.samples = a->samples;
+        plan.pretrigger_samples = a->pretrigger;
+        plan.sample_rate_hz = a->rate;
+        plan.range_v = a->range;
+        plan.shots = a->shots;
+        plan.setup.divider_r1_ohm = a->r1;
+      }
+      plan.validate();
+      acq::BenchAddress addr{a->instrument, a->daq.empty() ? std::nullopt : std::optional(a->daq)};
+      std::shared_ptr<drivers::sim::SimBench> sim;
+      if (a->instrument == "sim") {
+        sim = acq::make_sim_bench(sim_spec(a->sim, plan.setup.geometry()), plan.setup.divider_r1_ohm);
+        if (!plan.setup.material) plan.setup.material = a->sim.material;
+      } else if (!a->sim.effects.empty()) {
+        throw InputError("--effect applies to the simulated bench only (--instrument sim)");
+      }
+      acq::Bench bench = acq::open_bench(addr, sim);
+      acq::RunnerOptions ro;
+      ro.overwrite = a->overwrite;
+      ro.stop_on_clipping = !a->allow_clipping;
+      ro.software = "piezobench measure";
+      std::signal(SIGINT, on_sigint);
+      ProgressBar bar("measure");
+      acq::RunResult res;
+      try {
+        res = acq::run_measurement(bench, plan, a->out, ro,
+                                   [&](const acq::Progress& p) {
+                                     bar.update(static_cast<double>(p.shot) / p.total,
+                                                "shot " + std::to_string(p.shot + 1) + "/" +
+                                                    std::to_string(p.total) + " " + p.stage);
+                                   },
+                                   &g_cancel);
+      } catch (const acq::RunError& e) {
+        bar.finish();
+        throw InputError(e.what());
+      }
+      bar.update(1.0);
+      bar.finish();
+      nlohmann::json j = {{"capture", res.capture.string()},
+                          {"shots_written", res.shots_written},
+                          {"shots_planned", res.shots_planned},
+                          {"cancelled", res.cancelled},
+                          {"clipped_shots", res.clipped_shots},
+                          {"bench", bench.description}};
+      if (ctx.json) print_json(j);
+      else
+        std::cout << "wrote " << res.shots_written << "/" << res.shots_planned << " shots to "
+                  << res.capture.string() << " (" << bench.description << ")\n";
+      if (res.cancelled) ctx.exit_code = kInternal;
+    });
+  });
+
+  // --------------------------------------------------------- sim-instrument
+  auto* s = app.add_subcommand("sim-instrument",
+                               "Serve the simulated AWG (PORT) and DAQ (PORT+1) over TCP (SCPI)");
+  struct SimArgs {
+    std::string host = "127.0.0.1";
+    int port = 5025;
+    double r1 = 3140;
+    double seconds = 0;  // 0 = until interrupted
+    SimOptions sim;
+  };
+  auto sa = std::make_shared<SimArgs>();
+  s->add_option("--host", sa->host, "IPv4 address to listen on")->capture_default_str();
+  s->add_option("--port", sa->port, "AWG port; the DAQ listens on PORT+1")->capture_default_str();
+  s->add_option("--r1", sa->r1, "Nominal series resistor of the simulated bench (ohm)")->capture_default_str();
+  s->add_option("--seconds", sa->seconds, "Stop after this long (0: until Ctrl-C)")->capture_default_str();
+  add_sim_options(s, sa->sim);
+  add_json_flag(s, ctx);
+  s->callback([&ctx, sa] {
+    ctx.exit_code = run_command(ctx, [&] {
+      if (sa->port < 1 || sa->port > 65534) throw InputError("--port must be 1..65534");
+      auto bench = acq::make_sim_bench(sim_spec(sa->sim, model::TubeGeometry{}), sa->r1);
+      drivers::sim::TcpServer awg(std::make_shared<drivers::sim::SimAwg>(bench), sa->host,
+                                  static_cast<std::uint16_t>(sa->port));
+      drivers::sim::TcpServer daq(std::make_shared<drivers::sim::SimDaq>(bench), sa->host,
+                                  static_cast<std::uint16_t>(sa->port + 1));
+      awg.start();
+      daq.start();
+      std::signal(SIGINT, on_sigint);
+      std::signal(SIGTERM, on_sigint);
+      if (ctx.json) print_json({{"awg_port", awg.port()}, {"daq_port", daq.port()}, {"host", sa->host}});
+      else
+        std::cout << "simulated bench: AWG (Keysight 33522B dialect) on " << sa->host << ":" << awg.port()
+                  << ", DAQ (Infiniium dialect) on " << sa->host << ":" << daq.port() << std::endl;
+      auto t0 = std::chrono::steady_clock::now();
+      while (!g_cancel) {
+        std::this_thread::sleep_for(std::chrono::milliseconds(50));
+        if (sa->seconds > 0 &&
+            std::chrono::steady_clock::now() - t0 > std::chrono::duration<double>(sa->seconds))
+          break;
+      }
+    });
+  });
+}
+
+}  // namespace piezo::cli

@@ -1,0 +1,72 @@
+// Plan panel: R1, excitation, shots, rate, record length; transducer and
+// nominal material; the "Measure and update" button with progress and Cancel.
+#include <cstring>
+
+#include "ui/gui/windows.hpp"
+
+namespace piezo::gui {
+
+namespace {
+const char* const kKinds[] = {"exp_decay", "sine", "chirp", "noise"};
+}  // namespace
+
+void render_plan_window(AppState& s) {
+  ImGui::Begin("Plan");
+  auto& p = s.request.plan;
+  const bool busy = s.job.running();
+  ImGui::BeginDisabled(busy);
+  ImGui::InputDouble("R1 [ohm]", &p.setup.divider_r1_ohm, 10, 100, "%.1f");
+  int kind = static_cast<int>(p.excitation.kind);
+  if (kind > 3) kind = 0;
+  if (ImGui::Combo("Excitation", &kind, kKinds, 4)) p.excitation.kind = static_cast<acq::Excitation>(kind);
+  ImGui::InputDouble("Amplitude [V]", &p.excitation.amplitude_v, 0.1, 1, "%.3f");
+  if (p.excitation.kind == acq::Excitation::ExpDecay)
+    ImGui::InputDouble("Decay [1/s]", &p.excitation.decay_per_s, 100, 1000, "%.0f");
+  if (p.excitation.kind == acq::Excitation::Sine)
+    ImGui::InputDouble("Frequency [Hz]", &p.excitation.frequency_hz, 100, 1000, "%.1f");
+  if (p.excitation.kind == acq::Excitation::Chirp) {
+    ImGui::InputDouble("f start [Hz]", &p.excitation.f_start_hz, 100, 1000, "%.0f");
+    ImGui::InputDouble("f stop [Hz]", &p.excitation.f_stop_hz, 100, 1000, "%.0f");
+  }
+  ImGui::InputInt("Shots", &p.shots);
+  ImGui::InputDouble("Sample rate [S/s]", &p.sample_rate_hz, 1e5, 1e6, "%.3g");
+  int n = static_cast<int>(p.samples);
+  if (ImGui::InputInt("Record length", &n, 1000, 10000)) p.samples = static_cast<std::size_t>(std::max(16, n));
+  ImGui::Separator();
+  ImGui::Text("Transducer and nominal model");
+  auto g = p.setup.geometry();
+  double di = g.inner_diameter_m * 1e3, dout = g.outer_diameter_m * 1e3, len = g.length_m * 1e3;
+  if (ImGui::InputDouble("Inner diameter [mm]", &di, 0.1, 1, "%.3f")) p.setup.inner_diameter_m = di * 1e-3;
+  if (ImGui::InputDouble("Outer diameter [mm]", &dout, 0.1, 1, "%.3f")) p.setup.outer_diameter_m = dout * 1e-3;
+  if (ImGui::InputDouble("Length [mm]", &len, 0.1, 1, "%.3f")) p.setup.length_m = len * 1e-3;
+  ImGui::Checkbox("Isotropic model class (seed §6.4.3)", &s.request.isotropic);
+  ImGui::InputText("Capture file", s.capture_out, sizeof s.capture_out);
+  ImGui::InputText("Replay capture (optional)", s.replay_path, sizeof s.replay_path);
+  ImGui::EndDisabled();
+  ImGui::Separator();
+
+  if (!busy) {
+    if (tracked_button(s, "Measure and update", ImVec2(-1, 48))) {
+      ui::PipelineRequest req = s.request;  // committed copy: edits during the run do not leak in
+      req.instrument = s.instrument.awg;
+      req.daq = s.instrument.daq;
+      req.capture_out = s.capture_out;
+      req.replay_capture = s.replay_path;
+      s.error.clear();
+      s.frame_ms_during_job.clear();
+      s.job.start(req);
+      s.log.push_back(req.replay_capture.empty() ? "measure and update started" : "replay started");
+    }
+  } else {
+    ImGui::ProgressBar(s.job.progress(), ImVec2(-1, 24), s.job.stage().c_str());
+    if (tracked_button(s, "Cancel", ImVec2(-1, 0))) s.job.cancel();
+  }
+  if (!s.error.empty()) {
+    ImGui::PushStyleColor(ImGuiCol_Text, ImVec4(1, 0.45f, 0.45f, 1));
+    ImGui::TextWrapped("%s", s.error.c_str());
+    ImGui::PopStyleColor();
+  }
+  ImGui::End();
+}
+
+}  // namespace piezo::gui

@@ -1,0 +1,195 @@
+#include "ui/gui/plot_widget.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+
+namespace piezo::gui {
+
+namespace {
+double fwd(double v, bool log) { return log ? std::log10(std::max(v, 1e-300)) : v; }
+double inv(double v, bool log) { return log ? std::pow(10.0, v) : v; }
+
+// "Nice" tick positions in transformed units.
+std::vector<double> ticks(double a, double b, bool log) {
+  std::vector<double> t;
+  if (!(b > a)) return t;
+  if (log) {
+    for (double d = std::floor(a); d <= b; d += 1.0)
+      for (int m = 1; m < 10; ++m) {
+        double v = d + std::log10(static_cast<double>(m));
+        if (v >= a && v <= b && (m == 1 || b - a < 2.5)) t.push_back(v);
+      }
+    return t;
+  }
+  double span = b - a, step = std::pow(10.0, std::floor(std::log10(span / 5)));
+  if (span / step > 10) step *= 2;
+  if (span / step > 10) step *= 2.5;
+  for (double v = std::ceil(a / step) * step; v <= b; v += step) t.push_back(v);
+  return t;
+}
+
+std::string fmt(double v) {
+  char buf[32];
+  double a = std::fabs(v);
+  if (a != 0 && (a >= 1e5 || a < 1e-2)) std::snprintf(buf, sizeof buf, "%.3g", v);
+  else std::snprintf(buf, sizeof buf, "%.4g", v);
+  return buf;
+}
+}  // namespace
+
+void fit_view(const PlotSpec& spec, PlotView& view) {
+  double xmin = INFINITY, xmax = -INFINITY, ymin = INFINITY, ymax = -INFINITY;
+  for (const auto& s : spec.series)
+    for (std::size_t i = 0; i < s.x.size() && i < s.y.size(); ++i) {
+      if ((view.log_x && s.x[i] <= 0) || (view.log_y && s.y[i] <= 0)) continue;
+      if (!std::isfinite(s.x[i]) || !std::isfinite(s.y[i])) continue;
+      xmin = std::min(xmin, s.x[i]);
+      xmax = std::max(xmax, s.x[i]);
+      ymin = std::min(ymin, s.y[i]);
+      ymax = std::max(ymax, s.y[i]);
+    }
+  if (!(xmax > xmin)) {
+    xmin = view.log_x ? 1 : 0;
+    xmax = 10;
+  }
+  if (!(ymax > ymin)) {
+    ymin = view.log_y ? ymin * 0.5 : ymin - 1;
+    ymax = view.log_y ? std::max(ymax, ymin) * 2 : ymax + 1;
+    if (!std::isfinite(ymin) || !std::isfinite(ymax)) {
+      ymin = view.log_y ? 1 : 0;
+      ymax = 10;
+    }
+  }
+  double ly0 = fwd(ymin, view.log_y), ly1 = fwd(ymax, view.log_y), pad = 0.05 * (ly1 - ly0);
+  view.x0 = xmin;
+  view.x1 = xmax;
+  view.y0 = inv(ly0 - pad, view.log_y);
+  view.y1 = inv(ly1 + pad, view.log_y);
+  view.fitted = true;
+}
+
+bool plot(const char* id, const PlotSpec& spec, PlotView& view, ImVec2 size) {
+  if (!view.fitted) fit_view(spec, view);
+  ImGui::PushID(id);
+  ImGui::BeginChild("plot", size, true, ImGuiWindowFlags_NoScrollbar | ImGuiWindowFlags_NoScrollWithMouse);
+  ImDrawList* dl = ImGui::GetWindowDrawList();
+  const ImVec2 p0 = ImGui::GetCursorScreenPos();
+  const ImVec2 avail = ImGui::GetContentRegionAvail();
+  const float left = 64, bottom = 36, top = 22, right = 10;
+  const ImVec2 a(p0.x + left, p0.y + top), b(p0.x + avail.x - right, p0.y + avail.y - bottom);
+  ImGui::InvisibleButton("canvas", avail);
+  const bool hovered = ImGui::IsItemHovered();
+  const ImGuiIO& io = ImGui::GetIO();
+
+  double X0 = fwd(view.x0, view.log_x), X1 = fwd(view.x1, view.log_x);
+  double Y0 = fwd(view.y0, view.log_y), Y1 = fwd(view.y1, view.log_y);
+  auto sx = [&](double x) { return a.x + static_cast<float>((fwd(x, view.log_x) - X0) / (X1 - X0)) * (b.x - a.x); };
+  auto sy = [&](double y) { return b.y - static_cast<float>((fwd(y, view.log_y) - Y0) / (Y1 - Y0)) * (b.y - a.y); };
+
+  // Interaction: wheel zooms about the cursor, drag pans, double-click fits.
+  if (hovered && io.MouseWheel != 0) {
+    double f = std::pow(0.85, io.MouseWheel);
+    double cx = X0 + (io.MousePos.x - a.x) / (b.x - a.x) * (X1 - X0);
+    double cy = Y0 + (b.y - io.MousePos.y) / (b.y - a.y) * (Y1 - Y0);
+    bool only_x = io.KeyShift, only_y = io.KeyCtrl;
+    if (!only_y) {
+      X0 = cx + (X0 - cx) * f;
+      X1 = cx + (X1 - cx) * f;
+    }
+    if (!only_x) {
+      Y0 = cy + (Y0 - cy) * f;
+      Y1 = cy + (Y1 - cy) * f;
+    }
+  }
+  if (ImGui::IsItemActive() && ImGui::IsMouseDragging(ImGuiMouseButton_Left)) {
+    double dx = -io.MouseDelta.x / (b.x - a.x) * (X1 - X0);
+    double dy = io.MouseDelta.y / (b.y - a.y) * (Y1 - Y0);
+    X0 += dx;
+    X1 += dx;
+    Y0 += dy;
+    Y1 += dy;
+  }
+  if (hovered && ImGui::IsMouseDoubleClicked(ImGuiMouseButton_Left)) {
+    fit_view(spec, view);
+    X0 = fwd(view.x0, view.log_x);
+    X1 = fwd(view.x1, view.log_x);
+    Y0 = fwd(view.y0, view.log_y);
+    Y1 = fwd(view.y1, view.log_y);
+  }
+  view.x0 = inv(X0, view.log_x);
+  view.x1 = inv(X1, view.log_x);
+  view.y0 = inv(Y0, view.log_y);
+  view.y1 = inv(Y1, view.log_y);
+
+  // Frame, grid, ticks.
+  dl->AddRectFilled(a, b, IM_COL32(20, 22, 28, 255));
+  const ImU32 grid = IM_COL32(70, 75, 90, 255), text = IM_COL32(200, 200, 210, 255);
+  for (double t : ticks(X0, X1, view.log_x)) {
+    float x = a.x + static_cast<float>((t - X0) / (X1 - X0)) * (b.x - a.x);
+    dl->AddLine(ImVec2(x, a.y), ImVec2(x, b.y), grid);
+    dl->AddText(ImVec2(x - 14, b.y + 4), text, fmt(inv(t, view.log_x)).c_str());
+  }
+  for (double t : ticks(Y0, Y1, view.log_y)) {
+    float y = b.y - static_cast<float>((t - Y0) / (Y1 - Y0)) * (b.y - a.y);
+    dl->AddLine(ImVec2(a.x, y), ImVec2(b.x, y), grid);
+    dl->AddText(ImVec2(p0.x + 2, y - 7), text, fmt(inv(t, view.log_y)).c_str());
+  }
+  dl->AddText(ImVec2(a.x, p0.y + 2), text, spec.title.c_str());
+  dl->AddText(ImVec2(b.x - ImGui::CalcTextSize(spec.x_label.c_str()).x, b.y + 18), text, spec.x_label.c_str());
+  dl->AddText(ImVec2(p0.x + 2, p0.y + 2), text, spec.y_label.c_str());
+
+  dl->PushClipRect(a, b, true);
+  for (const auto& band : spec.bands) {
+    float xa = sx(band.x0), xb = sx(band.x1);
+    dl->AddRectFilled(ImVec2(xa, a.y), ImVec2(xb, b.y), band.color);
+    if (!band.label.empty()) dl->AddText(ImVec2(xa + 2, a.y + 2), text, band.label.c_str());
+  }
+  for (const auto& m : spec.markers) {
+    float x = sx(m.x);
+    dl->AddLine(ImVec2(x, a.y), ImVec2(x, b.y), m.color, 1.0f);
+  }
+  std::vector<ImVec2> pts;
+  for (const auto& s : spec.series) {
+    pts.clear();
+    for (std::size_t i = 0; i < s.x.size() && i < s.y.size(); ++i) {
+      if ((view.log_x && s.x[i] <= 0) || (view.log_y && s.y[i] <= 0) || !std::isfinite(s.y[i])) continue;
+      pts.emplace_back(sx(s.x[i]), sy(s.y[i]));
+    }
+    if (s.points) {
+      for (const auto& p : pts) dl->AddCircleFilled(p, 2.5f, s.color);
+    } else if (pts.size() > 1) {
+      dl->AddPolyline(pts.data(), static_cast<int>(pts.size()), s.color, 0, s.thickness);
+    }
+  }
+  dl->PopClipRect();
+
+  // Legend.
+  float ly = a.y + 4;
+  for (const auto& s : spec.series) {
+    float w = ImGui::CalcTextSize(s.label.c_str()).x;
+    dl->AddRectFilled(ImVec2(b.x - w - 28, ly + 3), ImVec2(b.x - w - 14, ly + 11), s.color);
+    dl->AddText(ImVec2(b.x - w - 8, ly), text, s.label.c_str());
+    ly += 16;
+  }
+
+  // Hover read-out: cursor position and the nearest point of each series.
+  if (hovered && io.MousePos.x >= a.x && io.MousePos.x <= b.x && io.MousePos.y >= a.y && io.MousePos.y <= b.y) {
+    double cx = inv(X0 + (io.MousePos.x - a.x) / (b.x - a.x) * (X1 - X0), view.log_x);
+    dl->AddLine(ImVec2(io.MousePos.x, a.y), ImVec2(io.MousePos.x, b.y), IM_COL32(255, 255, 255, 60));
+    ImGui::BeginTooltip();
+    ImGui::Text("%s = %s", spec.x_label.c_str(), fmt(cx).c_str());
+    for (const auto& s : spec.series) {
+      if (s.x.empty()) continue;
+      auto it = std::lower_bound(s.x.begin(), s.x.end(), cx);
+      std::size_t i = std::min<std::size_t>(static_cast<std::size_t>(it - s.x.begin()), s.x.size() - 1);
+      ImGui::TextColored(ImGui::ColorConvertU32ToFloat4(s.color), "%s: %s", s.label.c_str(), fmt(s.y[i]).c_str());
+    }
+    ImGui::EndTooltip();
+  }
+  ImGui::EndChild();
+  ImGui::PopID();
+  return hovered;
+}
+
+}  // namespace piezo::gui

@@ -1,0 +1,72 @@
+#pragma once
+// "Measure and update", end to end: acquire (or replay a capture) → estimate
+// Z(ω) → update the FE model → diagnose the remaining gap. One implementation
+// serves the GUI's button, `piezobench demo` and headless replay. Stages that
+// have not landed yet are reported as skipped, never faked.
+#include <atomic>
+#include <complex>
+#include <functional>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "acquisition/plan.hpp"
+#include "acquisition/sim_setup.hpp"
+
+namespace piezo::ui {
+
+struct PipelineRequest {
+  // Acquire with `plan` on `instrument` (sim | tcp://… | usbtmc://…), or replay `replay_capture`.
+  std::string instrument = "sim";
+  std::string daq;  // optional DAQ address
+  acq::MeasurementPlan plan;
+  acq::SimSpec sim;  // used when instrument == "sim"
+  std::string capture_out = "capture.h5";
+  std::string replay_capture;  // non-empty: skip acquisition
+  std::string material = "apc850";  // nominal model to update
+  bool isotropic = true;
+};
+
+struct Curve {
+  std::string label;
+  std::vector<double> f_hz;
+  std::vector<std::complex<double>> z_ohm;
+};
+
+struct ParamRow {
+  std::string name, unit;
+  double original = 0, updated = 0;
+  std::optional<double> truth;  // only when the bench is simulated (shown for the demo)
+};
+
+struct StageReport {
+  std::string name;
+  bool ran = false;
+  std::string note;  // what happened, or why it was skipped
+};
+
+struct PipelineResult {
+  std::string capture_path;
+  int shots = 0;
+  std::vector<Curve> curves;  // measured (Prony), FFT, cross-spectra, original model, updated model
+  std::vector<double> resonances_hz, antiresonances_hz;
+  std::vector<double> singular_values;  // normalised, for the order plot
+  int order = 0;
+  std::vector<ParamRow> params;
+  std::string verdict;
+  std::vector<StageReport> stages;
+  std::vector<std::string> warnings;
+};
+
+struct PipelineProgress {
+  double fraction = 0;  // 0..1 over all stages
+  std::string stage;
+};
+
+// Throws on failure with a message that says what to do; checks `cancel`
+// between and inside stages (a cancelled run returns what it has).
+PipelineResult run_pipeline(const PipelineRequest& req,
+                            const std::function<void(const PipelineProgress&)>& progress,
+                            const std::atomic<bool>& cancel);
+
+}  // namespace piezo::ui
