@@ -1,0 +1,32 @@
+#include "drivers/usbtmc/usbtmc_quirks.hpp"
+
+#include <array>
+
+namespace piezo::drivers::usbtmc {
+
+namespace {
+// Sources:
+//  [linux]  drivers/usb/class/usbtmc.c (v3.x - 4.19), usbtmc_id_quirk[]: Rigol
+//           devices that send a whole response per request (commit 50c9ba31,
+//           "usbtmc: Add support for Rigol devices").
+//  [pyusbtmc] python-ivi/python-usbtmc, RIGOL_QUIRK_PIDS = [0x04ce, 0x0588].
+//  [sigrok] libsigrok src/scpi/scpi_usbtmc_libusb.c: the Agilent DSO1000 series
+//           (0957:0588) is a rebadged Rigol DS1000.
+constexpr std::array kQuirks{
+    UsbTmcQuirk{0x1ab1, 0x0588, "Rigol DS1000 series", true, "[linux] [pyusbtmc]"},
+    UsbTmcQuirk{0x1ab1, 0x04b0, "Rigol DS2000 series", true, "[linux]"},
+    UsbTmcQuirk{0x1ab1, 0x04ce, "Rigol DS1000Z series", true, "[pyusbtmc]"},
+    UsbTmcQuirk{0x0957, 0x0588, "Agilent DSO1000 (rebadged Rigol DS1000)", true,
+                "[sigrok] rebadge note + [linux] entry for 1ab1:0588"},
+};
+}  // namespace
+
+std::span<const UsbTmcQuirk> quirk_table() { return kQuirks; }
+
+const UsbTmcQuirk* find_quirk(std::uint16_t vid, std::uint16_t pid) {
+  for (const UsbTmcQuirk& q : kQuirks)
+    if (q.vid == vid && q.pid == pid) return &q;
+  return nullptr;
+}
+
+}  // namespace piezo::drivers::usbtmc
