@@ -272,6 +272,22 @@ TEST(UsbTmcTransport, ZeroLengthPacketAfterFullPacketsIsConsumed) {
   EXPECT_EQ(b.read_message(), "second\n");
 }
 
+TEST(UsbTmcTransport, ZeroLengthPacketInItsOwnReadIsConsumedBeforeTheNextRequest) {
+  UsbTmcOptions o = Bench::fast();
+  o.max_in_read = 64;  // one packet per read: the ZLP cannot ride along with the data
+  Bench b({}, o);
+  const std::string r1 = pattern(115) + "\n";  // 12 + 116 = 128 = two full packets, then a ZLP
+  b.dev.replies["A?\n"] = r1;
+  b.dev.replies["B?\n"] = "second\n";
+  for (int i = 0; i < 3; ++i) {
+    b.t->send(std::string("A?\n"));
+    EXPECT_EQ(b.read_message(), r1);
+    b.t->send(std::string("B?\n"));
+    EXPECT_EQ(b.read_message(), "second\n");
+  }
+  for (std::size_t n : b.dev.in_read_sizes) EXPECT_EQ(n, 64u);
+}
+
 TEST(UsbTmcTransport, TinyPacketsSplitTheHeader) {
   FakeUsbTmcDevice::Config cfg;
   cfg.max_packet = 8;  // full-speed minimum: the 12-byte header spans two packets
