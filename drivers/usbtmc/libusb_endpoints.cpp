@@ -22,8 +22,8 @@ unsigned int ms(std::chrono::milliseconds t) {
 
 UsbIoError usb_error(int rc, const char* what) {
   using C = UsbIoError::Code;
-  const C c = rc == LIBUSB_ERROR_TIMEOUT ? C::Timeout
-              : rc == LIBUSB_ERROR_PIPE  ? C::Stall
+  const C c = rc == LIBUSB_ERROR_TIMEOUT     ? C::Timeout
+              : rc == LIBUSB_ERROR_PIPE      ? C::Stall
               : rc == LIBUSB_ERROR_NO_DEVICE ? C::NoDevice
                                              : C::Io;
   return UsbIoError(c, std::string(what) + ": " + libusb_error_name(rc));
@@ -133,8 +133,8 @@ std::unique_ptr<LibusbEndpoints> LibusbEndpoints::open(std::uint16_t vid, std::u
   libusb_device* dev = libusb_get_device(impl->handle);
   ConfigDescriptor cfg;
   if (int rc = libusb_get_active_config_descriptor(dev, &cfg.desc); rc != 0)
-    throw fail(K::Io, std::string("cannot read the configuration descriptor: ") +
-                          libusb_error_name(rc));
+    throw fail(K::Io,
+               std::string("cannot read the configuration descriptor: ") + libusb_error_name(rc));
   bool found = false;
   for (int i = 0; i < cfg.desc->bNumInterfaces && !found; ++i) {
     const libusb_interface& itf = cfg.desc->interface[i];
@@ -156,20 +156,20 @@ std::unique_ptr<LibusbEndpoints> LibusbEndpoints::open(std::uint16_t vid, std::u
     found = impl->ep_in && impl->ep_out && impl->max_packet;
   }
   if (!found)
-    throw fail(K::Io, "USB device " + vidpid(vid, pid) +
-                          " has no USBTMC interface (class 0xFE subclass 0x03) with bulk endpoints");
+    throw fail(K::Io,
+               "USB device " + vidpid(vid, pid) +
+                   " has no USBTMC interface (class 0xFE subclass 0x03) with bulk endpoints");
 
   if (libusb_kernel_driver_active(impl->handle, impl->interface) == 1) {
     if (int rc = libusb_detach_kernel_driver(impl->handle, impl->interface); rc != 0)
-      throw fail(K::Io, std::string("cannot detach the kernel driver (usbtmc): ") +
-                            libusb_error_name(rc));
+      throw fail(K::Io,
+                 std::string("cannot detach the kernel driver (usbtmc): ") + libusb_error_name(rc));
     impl->reattach = true;
   }
   if (int rc = libusb_claim_interface(impl->handle, impl->interface); rc != 0)
-    throw fail(K::Io,
-               std::string("cannot claim the USBTMC interface") +
-                   (rc == LIBUSB_ERROR_BUSY ? " (in use by another program)" : "") + ": " +
-                   libusb_error_name(rc));
+    throw fail(K::Io, std::string("cannot claim the USBTMC interface") +
+                          (rc == LIBUSB_ERROR_BUSY ? " (in use by another program)" : "") + ": " +
+                          libusb_error_name(rc));
   impl->claimed = true;
   return std::unique_ptr<LibusbEndpoints>(new LibusbEndpoints(std::move(impl)));
 }
@@ -183,9 +183,9 @@ void LibusbEndpoints::bulk_out(std::span<const std::uint8_t> bytes,
                                std::chrono::milliseconds timeout) {
   int done = 0;
   // libusb takes a non-const buffer for both directions; OUT does not write it.
-  const int rc = libusb_bulk_transfer(impl_->handle, impl_->ep_out,
-                                      const_cast<unsigned char*>(bytes.data()),
-                                      static_cast<int>(bytes.size()), &done, ms(timeout));
+  const int rc =
+      libusb_bulk_transfer(impl_->handle, impl_->ep_out, const_cast<unsigned char*>(bytes.data()),
+                           static_cast<int>(bytes.size()), &done, ms(timeout));
   if (rc != 0) throw usb_error(rc, "bulk-OUT");
   if (static_cast<std::size_t>(done) != bytes.size())
     throw UsbIoError(UsbIoError::Code::Io, "bulk-OUT: short write");
@@ -202,8 +202,8 @@ std::size_t LibusbEndpoints::bulk_in(std::uint8_t* buf, std::size_t max,
 
 std::size_t LibusbEndpoints::control_in(const ControlSetup& s, std::uint8_t* buf,
                                         std::chrono::milliseconds timeout) {
-  const int rc = libusb_control_transfer(impl_->handle, s.request_type, s.request, s.value,
-                                         s.index, buf, s.length, ms(timeout));
+  const int rc = libusb_control_transfer(impl_->handle, s.request_type, s.request, s.value, s.index,
+                                         buf, s.length, ms(timeout));
   if (rc < 0) throw usb_error(rc, "control request");
   return static_cast<std::size_t>(rc);
 }

@@ -30,7 +30,8 @@ class LibusbEndpoints final : public UsbTmcEndpoints {
   std::size_t max_packet_size() const override;
 
   void bulk_out(std::span<const std::uint8_t> bytes, std::chrono::milliseconds timeout) override;
-  std::size_t bulk_in(std::uint8_t* buf, std::size_t max, std::chrono::milliseconds timeout) override;
+  std::size_t bulk_in(std::uint8_t* buf, std::size_t max,
+                      std::chrono::milliseconds timeout) override;
   std::size_t control_in(const ControlSetup& setup, std::uint8_t* buf,
                          std::chrono::milliseconds timeout) override;
   void clear_halt(std::uint8_t endpoint) override;

@@ -110,12 +110,18 @@ std::vector<std::size_t> packet_sizes(std::size_t transfer_bytes, std::size_t ma
 
 std::string to_string(Status s) {
   switch (s) {
-    case Status::Success: return "STATUS_SUCCESS";
-    case Status::Pending: return "STATUS_PENDING";
-    case Status::Failed: return "STATUS_FAILED";
-    case Status::TransferNotInProgress: return "STATUS_TRANSFER_NOT_IN_PROGRESS";
-    case Status::SplitNotInProgress: return "STATUS_SPLIT_NOT_IN_PROGRESS";
-    case Status::SplitInProgress: return "STATUS_SPLIT_IN_PROGRESS";
+    case Status::Success:
+      return "STATUS_SUCCESS";
+    case Status::Pending:
+      return "STATUS_PENDING";
+    case Status::Failed:
+      return "STATUS_FAILED";
+    case Status::TransferNotInProgress:
+      return "STATUS_TRANSFER_NOT_IN_PROGRESS";
+    case Status::SplitNotInProgress:
+      return "STATUS_SPLIT_NOT_IN_PROGRESS";
+    case Status::SplitInProgress:
+      return "STATUS_SPLIT_IN_PROGRESS";
   }
   char buf[24];
   std::snprintf(buf, sizeof buf, "status 0x%02x", static_cast<unsigned>(s));
@@ -124,13 +130,20 @@ std::string to_string(Status s) {
 
 std::string to_string(Request r) {
   switch (r) {
-    case Request::InitiateAbortBulkOut: return "INITIATE_ABORT_BULK_OUT";
-    case Request::CheckAbortBulkOutStatus: return "CHECK_ABORT_BULK_OUT_STATUS";
-    case Request::InitiateAbortBulkIn: return "INITIATE_ABORT_BULK_IN";
-    case Request::CheckAbortBulkInStatus: return "CHECK_ABORT_BULK_IN_STATUS";
-    case Request::InitiateClear: return "INITIATE_CLEAR";
-    case Request::CheckClearStatus: return "CHECK_CLEAR_STATUS";
-    case Request::GetCapabilities: return "GET_CAPABILITIES";
+    case Request::InitiateAbortBulkOut:
+      return "INITIATE_ABORT_BULK_OUT";
+    case Request::CheckAbortBulkOutStatus:
+      return "CHECK_ABORT_BULK_OUT_STATUS";
+    case Request::InitiateAbortBulkIn:
+      return "INITIATE_ABORT_BULK_IN";
+    case Request::CheckAbortBulkInStatus:
+      return "CHECK_ABORT_BULK_IN_STATUS";
+    case Request::InitiateClear:
+      return "INITIATE_CLEAR";
+    case Request::CheckClearStatus:
+      return "CHECK_CLEAR_STATUS";
+    case Request::GetCapabilities:
+      return "GET_CAPABILITIES";
   }
   return "request " + std::to_string(static_cast<unsigned>(r));
 }

@@ -17,17 +17,17 @@
 namespace piezo::drivers::usbtmc {
 
 inline constexpr std::size_t kHeaderSize = 12;
-inline constexpr std::uint8_t kInterfaceClass = 0xFE;  // application specific
+inline constexpr std::uint8_t kInterfaceClass = 0xFE;     // application specific
 inline constexpr std::uint8_t kInterfaceSubClass = 0x03;  // USBTMC
 
 enum class MsgId : std::uint8_t {
-  DevDepMsgOut = 1,         // host -> device, carries a message
-  RequestDevDepMsgIn = 2,   // host -> device, asks for a response transfer
-  DevDepMsgIn = 2,          // device -> host, the response transfer
+  DevDepMsgOut = 1,        // host -> device, carries a message
+  RequestDevDepMsgIn = 2,  // host -> device, asks for a response transfer
+  DevDepMsgIn = 2,         // device -> host, the response transfer
 };
 
 // bmTransferAttributes bits.
-inline constexpr std::uint8_t kAttrEom = 0x01;          // DEV_DEP_MSG_OUT / _IN
+inline constexpr std::uint8_t kAttrEom = 0x01;              // DEV_DEP_MSG_OUT / _IN
 inline constexpr std::uint8_t kAttrTermCharEnabled = 0x02;  // REQUEST_DEV_DEP_MSG_IN
 inline constexpr std::uint8_t kAttrTermCharMatched = 0x02;  // DEV_DEP_MSG_IN
 
@@ -136,8 +136,9 @@ ControlSetup check_clear_status(std::uint8_t interface);
 // than the spec's wLength for that request.
 struct ClassReply {
   Status status = Status::Failed;
-  bool in_fifo_has_data = false;  // CHECK_CLEAR_STATUS bmClear.D0 / CHECK_ABORT_BULK_IN bmAbortBulkIn.D0
-  std::uint32_t nbytes = 0;       // CHECK_ABORT_*_STATUS NBYTES_RXD / NBYTES_TXD
+  bool in_fifo_has_data =
+      false;                 // CHECK_CLEAR_STATUS bmClear.D0 / CHECK_ABORT_BULK_IN bmAbortBulkIn.D0
+  std::uint32_t nbytes = 0;  // CHECK_ABORT_*_STATUS NBYTES_RXD / NBYTES_TXD
 };
 ClassReply parse_class_reply(Request r, std::span<const std::uint8_t> reply);
 

@@ -21,9 +21,9 @@ ClassReply class_request(UsbTmcEndpoints& ep, const ControlSetup& s, const Seque
 }
 
 [[noreturn]] void still_pending(Request r, int polls) {
-  throw TransportError(TransportError::Kind::Timeout, "USBTMC " + to_string(r) +
-                                                          " still PENDING after " +
-                                                          std::to_string(polls) + " polls");
+  throw TransportError(
+      TransportError::Kind::Timeout,
+      "USBTMC " + to_string(r) + " still PENDING after " + std::to_string(polls) + " polls");
 }
 
 void pause(const SequencePolicy& p) {

@@ -119,8 +119,8 @@ void UsbTmcTransport::start_transfer() {
     } catch (const std::exception& e2) {
       outcome = std::string("abort failed: ") + e2.what();
     }
-    fail(TransportError::Kind::Timeout, "receive: REQUEST_DEV_DEP_MSG_IN not accepted (" +
-                                            outcome + ")");
+    fail(TransportError::Kind::Timeout,
+         "receive: REQUEST_DEV_DEP_MSG_IN not accepted (" + outcome + ")");
   }
   open_ = true;
 }
@@ -241,7 +241,8 @@ void UsbTmcTransport::clear() {
 
 std::unique_ptr<UsbTmcTransport> open_usbtmc(const InstrumentUri& uri, UsbTmcOptions opts) {
   if (uri.kind != InstrumentUri::Kind::UsbTmc)
-    throw std::invalid_argument("open_usbtmc: '" + uri.to_string() + "' is not a usbtmc:// address");
+    throw std::invalid_argument("open_usbtmc: '" + uri.to_string() +
+                                "' is not a usbtmc:// address");
   auto ep = usbtmc::LibusbEndpoints::open(uri.vid, uri.pid, uri.serial, uri.to_string());
   return std::make_unique<UsbTmcTransport>(std::move(ep), uri.to_string(),
                                            with_quirks(std::move(opts), uri.vid, uri.pid));

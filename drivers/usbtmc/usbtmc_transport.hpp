@@ -74,17 +74,17 @@ class UsbTmcTransport final : public Transport {
   usbtmc::TagCounter tags_;
 
   // Input state: one DEV_DEP_MSG_IN transfer at a time.
-  std::vector<std::uint8_t> rx_;      // last bulk-IN read
+  std::vector<std::uint8_t> rx_;             // last bulk-IN read
   std::size_t win_begin_ = 0, win_end_ = 0;  // its payload bytes not yet returned
-  bool open_ = false;                 // transfer not yet ended by a short packet
+  bool open_ = false;                        // transfer not yet ended by a short packet
   std::uint8_t request_tag_ = 0;
   std::uint32_t requested_ = 0;
   usbtmc::Header header_{};
-  std::size_t header_bytes_ = 0;      // of header_ received so far
+  std::size_t header_bytes_ = 0;  // of header_ received so far
   usbtmc::BulkInHeader in_{};
-  std::size_t wire_got_ = 0;          // bytes of this transfer read, header included
+  std::size_t wire_got_ = 0;  // bytes of this transfer read, header included
   std::size_t payload_got_ = 0;
-  bool zero_length_eom_ = false;      // a TransferSize 0 transfer with EOM, to report
+  bool zero_length_eom_ = false;  // a TransferSize 0 transfer with EOM, to report
 };
 
 // Opens usbtmc://VID:PID[/SERIAL] through libusb and applies the quirk

@@ -79,8 +79,10 @@ void FakeUsbTmcDevice::on_request(const ut::Header& h) {
   s_.last_request_tag = h[1];
   if (s_.silent || s_.reply.empty()) return;  // the host will time out
   std::size_t n = std::min<std::size_t>(s_.reply.size(), s_.cfg.max_reply_transfer);
-  if (!s_.cfg.ignore_requested_size) n = std::min<std::size_t>(n, le32(&h[4]));
-  else n = s_.reply.size();
+  if (!s_.cfg.ignore_requested_size)
+    n = std::min<std::size_t>(n, le32(&h[4]));
+  else
+    n = s_.reply.size();
   const std::string part = s_.reply.substr(0, n);
   s_.reply.erase(0, n);
   const std::uint8_t tag = s_.wrong_tag ? static_cast<std::uint8_t>(h[1] + 1) : h[1];
@@ -97,7 +99,7 @@ std::size_t FakeUsbTmcDevice::bulk_in(std::uint8_t* buf, std::size_t max,
   while (!s_.fifo.empty()) {
     const std::vector<std::uint8_t>& p = s_.fifo.front();
     if (p.size() > max - got) throw UsbIoError(UsbIoError::Code::Io, "fake: overflow");
-    std::memcpy(buf + got, p.data(), p.size());
+    if (!p.empty()) std::memcpy(buf + got, p.data(), p.size());  // a ZLP has no data()
     got += p.size();
     const bool short_packet = p.size() < s_.cfg.max_packet;
     s_.fifo.pop_front();
@@ -114,12 +116,12 @@ std::size_t FakeUsbTmcDevice::control_in(const ut::ControlSetup& c, std::uint8_t
   s_.controls.push_back(c);
   const auto req = static_cast<Request>(c.request);
   s_.log.push_back("ctrl " + ut::to_string(req));
-  const bool to_endpoint = req == Request::InitiateAbortBulkOut ||
-                           req == Request::CheckAbortBulkOutStatus ||
-                           req == Request::InitiateAbortBulkIn ||
-                           req == Request::CheckAbortBulkInStatus;
+  const bool to_endpoint =
+      req == Request::InitiateAbortBulkOut || req == Request::CheckAbortBulkOutStatus ||
+      req == Request::InitiateAbortBulkIn || req == Request::CheckAbortBulkInStatus;
   const std::uint8_t want_type = to_endpoint ? ut::kToHostClassEndpoint : ut::kToHostClassInterface;
-  const bool out_ep = req == Request::InitiateAbortBulkOut || req == Request::CheckAbortBulkOutStatus;
+  const bool out_ep =
+      req == Request::InitiateAbortBulkOut || req == Request::CheckAbortBulkOutStatus;
   const std::uint16_t want_index =
       to_endpoint ? (out_ep ? s_.cfg.ep_out : s_.cfg.ep_in) : s_.cfg.interface;
   if (c.request_type != want_type || c.index != want_index) {

@@ -38,12 +38,12 @@ class FakeUsbTmcDevice final : public ut::UsbTmcEndpoints {
     Config cfg;
     std::map<std::string, std::string> replies;  // message -> reply
     // Misbehaviour switches.
-    bool silent = false;          // accept requests, never answer
-    bool wrong_tag = false;       // answer with bTag + 1
+    bool silent = false;     // accept requests, never answer
+    bool wrong_tag = false;  // answer with bTag + 1
     bool stall_bulk_in = false;
     bool stall_bulk_out = false;
     bool bulk_out_times_out = false;
-    bool keep_in_fifo_on_clear = false;  // stale data survive INITIATE_CLEAR
+    bool keep_in_fifo_on_clear = false;             // stale data survive INITIATE_CLEAR
     std::deque<ut::Status> check_clear_script;      // then SUCCESS (or PENDING while data)
     std::deque<ut::Status> check_abort_in_script;   // then SUCCESS
     std::deque<ut::Status> check_abort_out_script;  // then SUCCESS
@@ -75,7 +75,8 @@ class FakeUsbTmcDevice final : public ut::UsbTmcEndpoints {
   std::size_t max_packet_size() const override { return s_.cfg.max_packet; }
 
   void bulk_out(std::span<const std::uint8_t> bytes, std::chrono::milliseconds timeout) override;
-  std::size_t bulk_in(std::uint8_t* buf, std::size_t max, std::chrono::milliseconds timeout) override;
+  std::size_t bulk_in(std::uint8_t* buf, std::size_t max,
+                      std::chrono::milliseconds timeout) override;
   std::size_t control_in(const ut::ControlSetup& setup, std::uint8_t* buf,
                          std::chrono::milliseconds timeout) override;
   void clear_halt(std::uint8_t endpoint) override;

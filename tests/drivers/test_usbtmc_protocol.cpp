@@ -345,7 +345,8 @@ TEST(UsbTmcTransport, TimeoutRunsAbortBulkInThenThrowsTimeout) {
   });
   EXPECT_EQ(init->value, b.dev.requests.back()[1]) << "abort names the request's bTag";
   EXPECT_EQ(init->index, 0x81);
-  EXPECT_EQ(b.count_controls(ut::Request::CheckAbortBulkInStatus), 3u);  // PENDING, PENDING, SUCCESS
+  EXPECT_EQ(b.count_controls(ut::Request::CheckAbortBulkInStatus),
+            3u);  // PENDING, PENDING, SUCCESS
   EXPECT_TRUE(b.dev.fifo.empty()) << "the aborted transfer's short packet was read";
 
   b.dev.silent = false;  // the transport is usable afterwards
@@ -381,7 +382,7 @@ TEST(UsbTmcTransport, ClearPollsWhilePendingThenClearsBulkOutHalt) {
   b.t->clear();
   EXPECT_EQ(b.count_controls(ut::Request::InitiateClear), 1u);
   EXPECT_EQ(b.count_controls(ut::Request::CheckClearStatus), 4u);
-  const std::vector<std::string> want{"ctrl INITIATE_CLEAR", "ctrl CHECK_CLEAR_STATUS",
+  const std::vector<std::string> want{"ctrl INITIATE_CLEAR",     "ctrl CHECK_CLEAR_STATUS",
                                       "ctrl CHECK_CLEAR_STATUS", "ctrl CHECK_CLEAR_STATUS",
                                       "ctrl CHECK_CLEAR_STATUS", "clear_halt 2"};
   EXPECT_EQ(b.dev.log, want);
