@@ -7,6 +7,7 @@
 #include "drivers/sim/sim_awg.hpp"
 #include "drivers/sim/sim_daq.hpp"
 #include "drivers/tcp_transport.hpp"
+#include "drivers/usbtmc/usbtmc_transport.hpp"
 
 namespace piezo::acq {
 
@@ -18,8 +19,7 @@ std::unique_ptr<Transport> open_transport(const std::string& address) {
     case InstrumentUri::Kind::Tcp:
       return std::make_unique<TcpTransport>(uri.host, uri.port);
     case InstrumentUri::Kind::UsbTmc:
-      throw std::invalid_argument("instrument address '" + address +
-                                  "': USBTMC transport is not available in this build yet");
+      return open_usbtmc(uri);
     case InstrumentUri::Kind::Sim:
       break;
   }
