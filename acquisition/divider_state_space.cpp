@@ -52,7 +52,7 @@ std::vector<std::pair<double, double>> debye_network_for_loss(double c, double t
   return out;
 }
 
-DividerStateSpace::DividerStateSpace(const model::ModalPortModel& port, const DividerCircuit& k) {
+DividerStateSpace::DividerStateSpace(const model::ModalPortModel& port, const BenchCircuit& k) {
   if (!(k.r1_ohm > 0)) throw std::invalid_argument("DividerStateSpace: R1 must be positive");
   if (k.series_resistance_ohm < 0 || k.parallel_capacitance_f < 0 || !(k.daq_input_resistance_ohm > 0))
     throw std::invalid_argument("DividerStateSpace: circuit values out of range");
@@ -117,6 +117,19 @@ DividerStateSpace::DividerStateSpace(const model::ModalPortModel& port, const Di
   }
   a_.row(i_vt) = row / c_node;
   b_(i_vt) = row_b / c_node;
+
+  // Balance to energy coordinates (√C·v for capacitor voltages, ω·x and x' for
+  // the modes): the raw matrix mixes ω² ~ 1e11 with p/C, and the matrix
+  // exponential's accuracy is relative to the norm. x_s = T x.
+  Eigen::VectorXd tdiag = Eigen::VectorXd::Ones(n);
+  tdiag(i_vt) = std::sqrt(ce);
+  if (v2_state) tdiag(i_v2) = std::sqrt(k.parallel_capacitance_f);
+  for (int j = 0; j < nd; ++j) tdiag(i_d0 + j) = std::sqrt(debye[j].first);
+  for (int m = 0; m < nm; ++m) tdiag(i_m0 + 2 * m) = modes[m]->omega;
+  for (int r = 0; r < n; ++r)
+    for (int q = 0; q < n; ++q) a_(r, q) *= tdiag(r) / tdiag(q);
+  b_ = b_.cwiseProduct(tdiag);
+  c_ = c_.cwiseQuotient(tdiag.transpose());
 }
 
 const DividerStateSpace::Step& DividerStateSpace::step(double h) {

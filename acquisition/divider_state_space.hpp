@@ -22,7 +22,7 @@
 
 namespace piezo::acq {
 
-struct DividerCircuit {
+struct BenchCircuit {
   double r1_ohm = 3140.0;  // the TRUE series resistor (nominal·(1 + r1_tolerance))
   double series_resistance_ohm = 0.0;
   double parallel_capacitance_f = 0.0;
@@ -34,7 +34,7 @@ struct DividerCircuit {
 
 class DividerStateSpace {
  public:
-  DividerStateSpace(const model::ModalPortModel& port, const DividerCircuit& circuit);
+  DividerStateSpace(const model::ModalPortModel& port, const BenchCircuit& circuit);
 
   // v2 at the given instants for generator voltage v1 (at rest before v1's first knot).
   std::vector<double> simulate(const drivers::sim::PiecewiseLinear& v1, std::span<const double> times);

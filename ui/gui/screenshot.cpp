@@ -4,6 +4,7 @@
 #include <GL/gl.h>
 #include <stb_image_write.h>
 
+#include <algorithm>
 #include <stdexcept>
 #include <vector>
 

@@ -1,0 +1,90 @@
+#include "acquisition/sim_setup.hpp"
+
+#include <stdexcept>
+
+#include "acquisition/divider_state_space.hpp"
+#include "model/material_spec.hpp"
+#include "model/modal.hpp"
+#include "model/tube_model.hpp"
+
+namespace piezo::acq {
+
+namespace {
+
+// The FE tube reduced to its port, in the divider with the circuit effects.
+class FePhysics : public drivers::sim::BenchPhysics {
+ public:
+  FePhysics(const model::ModalPortModel& port, const BenchCircuit& circuit,
+            std::vector<std::pair<std::string, double>> truth, std::string description)
+      : ss_(port, circuit), truth_(std::move(truth)), description_(std::move(description)) {}
+
+  std::vector<double> respond(const drivers::sim::PiecewiseLinear& v1,
+                              std::span<const double> times) override {
+    return ss_.simulate(v1, times);
+  }
+  std::vector<std::pair<std::string, double>> truth() const override { return truth_; }
+  std::string description() const override { return description_; }
+
+ private:
+  DividerStateSpace ss_;
+  std::vector<std::pair<std::string, double>> truth_;
+  std::string description_;
+};
+
+}  // namespace
+
+std::shared_ptr<drivers::sim::SimBench> make_sim_bench(const SimSpec& spec, double nominal_r1_ohm) {
+  if (!(nominal_r1_ohm > 0)) throw std::invalid_argument("make_sim_bench: R1 must be positive");
+  const auto& fx = spec.effects;
+  if (fx.mass_loading != 0.0)
+    throw std::invalid_argument(
+        "effect 'mass_loading': the simulated bench does not model end-face masses yet");
+  auto mat = model::resolve_material({spec.material, spec.isotropic, spec.set});
+  model::TubeGeometry g = spec.geometry;
+  g.density_kg_m3 = mat.density_kg_m3;
+  g.validate();
+  model::TubeModel tube(g);
+  model::ModalSolver solver(tube);
+  model::ModalOptions mo;
+  mo.n_modes = spec.modes;
+  const auto e = model::to_e_form(mat.d);
+  model::ModalPortModel port = solver.port_model(e, mo);
+
+  BenchCircuit c;
+  c.r1_ohm = nominal_r1_ohm * (1.0 + fx.r1_tolerance);
+  c.series_resistance_ohm = fx.series_resistance_ohm;
+  c.parallel_capacitance_f = fx.parallel_capacitance_f;
+  c.daq_input_resistance_ohm = fx.daq_input_resistance_ohm;
+  c.dielectric_loss = fx.dielectric_loss;
+  c.damping = spec.damping;
+  c.extra_beta_s = fx.mechanical_damping;
+
+  const auto iso = model::isotropic_params(mat.d);
+  std::vector<std::pair<std::string, double>> truth = {
+      {"YE11", iso.y_e11},
+      {"nu12", iso.nu12},
+      {"d31", iso.d31},
+      {"epsT33_rel", iso.eps_t33 / model::kEps0},
+      {"sE11", mat.d.s_e11},
+      {"sE12", mat.d.s_e12},
+      {"rayleigh_alpha", spec.damping.alpha},
+      {"rayleigh_beta", spec.damping.beta},
+      {"r1_true_ohm", c.r1_ohm},
+      {"static_capacitance_f", port.c_static}};
+  for (const auto& info : model::effect_catalogue())
+    truth.emplace_back("effect_" + std::string(info.name), fx.*(info.field));
+
+  drivers::sim::DaqImperfections imp;
+  imp.channel_skew_s = fx.channel_skew_s;
+  imp.channel_gain = fx.channel_gain;
+  imp.noise_rel[0] = imp.noise_rel[1] = spec.noise_rel;
+  imp.noise_v[0] = imp.noise_v[1] = spec.noise_v;
+  imp.adc_bits = spec.adc_bits;
+  auto physics = std::make_unique<FePhysics>(port, c, std::move(truth),
+                                             "FE tube " + mat.description + ", " +
+                                                 std::to_string(static_cast<int>(port.modes.size())) +
+                                                 " modes");
+  return std::make_shared<drivers::sim::SimBench>(std::move(physics), imp, spec.seed, spec.faults);
+}
+
+}  // namespace piezo::acq

@@ -1,0 +1,115 @@
+// `piezobench measure` on the embedded simulated bench and through
+// `piezobench sim-instrument` over TCP: same SCPI drivers, same simulated
+// instruments, so the two captures must be equal sample for sample.
+#include <gtest/gtest.h>
+#include <netinet/in.h>
+#include <signal.h>
+#include <spawn.h>
+#include <sys/socket.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <chrono>
+#include <filesystem>
+#include <nlohmann/json.hpp>
+#include <thread>
+
+#include "acquisition/capture_file.hpp"
+#include "tests/support/run_cli.hpp"
+
+extern char** environ;
+namespace fs = std::filesystem;
+using namespace piezo;
+
+namespace {
+fs::path tmp_dir() {
+  auto d = fs::temp_directory_path() / ("piezobench-measure-" + std::to_string(::getpid()));
+  fs::create_directories(d);
+  return d;
+}
+
+int free_port_pair() {  // two consecutive free ports (AWG, DAQ)
+  for (int attempt = 0; attempt < 50; ++attempt) {
+    int fd = ::socket(AF_INET, SOCK_STREAM, 0);
+    sockaddr_in a{};
+    a.sin_family = AF_INET;
+    a.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+    ::bind(fd, reinterpret_cast<sockaddr*>(&a), sizeof a);
+    socklen_t len = sizeof a;
+    ::getsockname(fd, reinterpret_cast<sockaddr*>(&a), &len);
+    int port = ntohs(a.sin_port);
+    ::close(fd);
+    int fd2 = ::socket(AF_INET, SOCK_STREAM, 0);
+    a.sin_port = htons(static_cast<uint16_t>(port + 1));
+    bool ok = port < 65000 && ::bind(fd2, reinterpret_cast<sockaddr*>(&a), sizeof a) == 0;
+    ::close(fd2);
+    if (ok) return port;
+  }
+  return 0;
+}
+}  // namespace
+
+TEST(CliMeasure, SeedLabMeasurementOnTheEmbeddedBench) {
+  auto out = tmp_dir() / "lab.h5";
+  auto r = test::run_cli("measure --instrument sim --excitation exp_decay --amplitude 1 --decay 3000 "
+                         "--samples 20000 --rate 1e7 --shots 2 --noise 0.03 --seed 9 --overwrite --json --out " +
+                         out.string());
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  auto j = nlohmann::json::parse(r.out);
+  EXPECT_EQ(j["shots_written"], 2);
+  auto cap = acq::read_capture(out);
+  ASSERT_EQ(cap.shots.size(), 2u);
+  EXPECT_EQ(cap.shots[0].samples(), 20000u);
+  EXPECT_EQ(cap.setup.divider_r1_ohm, 3140.0);
+}
+
+TEST(CliMeasure, BadEffectIsBadInput) {
+  auto out = tmp_dir() / "bad.h5";
+  auto r = test::run_cli("measure --effect no_such_effect=1 --out " + out.string());
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_NE(r.err.find("no_such_effect"), std::string::npos);
+  r = test::run_cli("measure --effect series_resistance=-5 --out " + out.string());
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_NE(r.err.find("bounds"), std::string::npos);
+}
+
+TEST(CliMeasure, SimInstrumentOverTcpEqualsInProcess) {
+  const int port = free_port_pair();
+  ASSERT_GT(port, 0);
+  std::string exe = PIEZO_CLI, p = std::to_string(port);
+  const char* argv[] = {exe.c_str(), "sim-instrument", "--host", "127.0.0.1", "--port", p.c_str(),
+                        "--seconds", "60", "--noise", "0.05", "--seed", "17",
+                        "--effect", "parallel_capacitance=100e-12", nullptr};
+  pid_t pid = 0;
+  ASSERT_EQ(posix_spawn(&pid, exe.c_str(), nullptr, nullptr, const_cast<char**>(argv), environ), 0);
+  // Wait until both ports accept connections.
+  for (int i = 0; i < 200; ++i) {
+    int fd = ::socket(AF_INET, SOCK_STREAM, 0);
+    sockaddr_in a{};
+    a.sin_family = AF_INET;
+    a.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+    a.sin_port = htons(static_cast<uint16_t>(port + 1));
+    bool up = ::connect(fd, reinterpret_cast<sockaddr*>(&a), sizeof a) == 0;
+    ::close(fd);
+    if (up) break;
+    std::this_thread::sleep_for(std::chrono::milliseconds(25));
+  }
+  auto dir = tmp_dir();
+  const std::string plan = " --samples 5000 --shots 2 --overwrite --out ";
+  auto tcp = test::run_cli("measure --instrument tcp://127.0.0.1:" + p + plan + (dir / "tcp.h5").string());
+  ::kill(pid, SIGTERM);
+  int status = 0;
+  ::waitpid(pid, &status, 0);
+  ASSERT_EQ(tcp.exit_code, 0) << tcp.err;
+  auto local = test::run_cli("measure --instrument sim --noise 0.05 --seed 17 --effect parallel_capacitance=100e-12" +
+                             plan + (dir / "local.h5").string());
+  ASSERT_EQ(local.exit_code, 0) << local.err;
+  auto a = acq::read_capture(dir / "tcp.h5");
+  auto b = acq::read_capture(dir / "local.h5");
+  ASSERT_EQ(a.shots.size(), 2u);
+  ASSERT_EQ(b.shots.size(), 2u);
+  for (int k = 0; k < 2; ++k) {
+    EXPECT_EQ(a.shots[k].v1, b.shots[k].v1) << "shot " << k;
+    EXPECT_EQ(a.shots[k].v2, b.shots[k].v2) << "shot " << k;
+  }
+}
