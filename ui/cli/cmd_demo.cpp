@@ -1,93 +1,84 @@
-// `piezobench demo`: runs every stage that has landed, end to end, on the
-// embedded simulated bench. Stages so far: capture files.
-// TODO(issue 5): replace the analytic RC stand-in by the simulated bench.
-#include <cmath>
+// `piezobench demo`: the main job end to end on the embedded simulated bench —
+// the seed's lab measurement (R1 = 3140 Ω, 1 V exp_decay at 3000 1/s, 20000
+// samples at 10 MS/s) of a simulated tube, then every later stage that has
+// landed (the same pipeline as the GUI's "Measure and update").
 #include <filesystem>
 #include <iostream>
 
-#include "acquisition/capture_file.hpp"
-#include "dsp/signal_stats.hpp"
 #include "ui/cli/cli_common.hpp"
+#include "ui/pipeline.hpp"
 
 namespace piezo::cli {
 
-namespace {
-
-constexpr double kEps0 = 8.854187817e-12;
-
-// Exact response of the divider with a lossless capacitor as the load to the
-// seed's exp_decay drive v1 = A·exp(−a·t): v2 = A/(1 − a·τ)·(e^{−a t} − e^{−t/τ}), τ = R1·C.
-acq::Shot rc_exp_decay_shot(double r1, double c, double amplitude, double decay, double rate,
-                            std::size_t n, std::size_t pretrigger) {
-  acq::Shot s;
-  s.sample_rate_hz = rate;
-  s.excitation = acq::Excitation::ExpDecay;
-  s.amplitude_v = amplitude;
-  s.decay_per_s = decay;
-  s.pretrigger_samples = static_cast<std::int64_t>(pretrigger);
-  s.v1.assign(n, 0.0);
-  s.v2.assign(n, 0.0);
-  const double tau = r1 * c;
-  for (std::size_t i = pretrigger; i < n; ++i) {
-    double t = (i - pretrigger) / rate;
-    s.v1[i] = amplitude * std::exp(-decay * t);
-    s.v2[i] = amplitude / (1.0 - decay * tau) * (std::exp(-decay * t) - std::exp(-t / tau));
-  }
-  return s;
-}
-
-}  // namespace
-
 void register_demo_command(CLI::App& app, Context& ctx) {
   auto* demo = app.add_subcommand("demo", "Run the main job on the embedded simulated bench");
-  auto out_dir = std::make_shared<std::string>("demo-out");
-  demo->add_option("--out", *out_dir, "Folder for the demo's files")->capture_default_str();
+  struct Args {
+    std::string out_dir = "demo-out";
+    double noise = 0.01;
+    std::uint64_t seed = 2016;
+  };
+  auto a = std::make_shared<Args>();
+  demo->add_option("--out", a->out_dir, "Folder for the demo's files")->capture_default_str();
+  demo->add_option("--noise", a->noise, "White noise per channel, std(noise)/std(signal)")->capture_default_str();
+  demo->add_option("--seed", a->seed, "Noise seed")->capture_default_str();
   add_json_flag(demo, ctx);
-  demo->callback([&ctx, out_dir] {
+  demo->callback([&ctx, a] {
     ctx.exit_code = run_command(ctx, [&] {
       namespace fs = std::filesystem;
-      fs::create_directories(*out_dir);
-      const fs::path cap_path = fs::path(*out_dir) / "demo-capture.h5";
-
-      // Stage 1 — acquire (stand-in: the tube as its static capacitance).
-      acq::Setup setup;
-      setup.divider_r1_ohm = 3140.0;  // seed §5.2 lab circuit
-      setup.transducer_id = "demo-tube";
-      setup.material = "apc850";
-      auto g = setup.geometry();
-      const double c0 = 2 * M_PI * 1594 * kEps0 * g.length_m /
-                        std::log(g.outer_diameter_m / g.inner_diameter_m);
-      acq::WriterOptions wo;
-      wo.software = "piezobench demo";
-      wo.overwrite = true;
-      {
-        ProgressBar bar("acquire");
-        acq::CaptureWriter w(cap_path, setup, wo);
-        const int kShots = 3;
-        for (int k = 0; k < kShots; ++k) {
-          w.append(rc_exp_decay_shot(setup.divider_r1_ohm, c0, 1.0, 3000.0, 1e7, 20000, 200));
-          bar.update((k + 1.0) / kShots);
-        }
-        w.close();
-      }
-
-      // Stage 2 — read back and summarise.
-      auto cap = acq::read_capture(cap_path);
+      fs::create_directories(a->out_dir);
+      ui::PipelineRequest req;
+      req.instrument = "sim";
+      req.plan.setup.divider_r1_ohm = 3140.0;
+      req.plan.setup.transducer_id = "demo-tube";
+      req.plan.setup.material = "apc850";
+      req.plan.samples = 20000;
+      req.plan.pretrigger_samples = 200;
+      req.plan.shots = 3;
+      // The simulated "real" tube: the seed's Table 4/5 target material in the isotropic class.
+      req.sim.material = "apc850";
+      req.sim.isotropic = true;
+      req.sim.set = "YE11=6.66e10,nu12=0.3333,d31=-210e-12,epsT33_rel=2294";
+      req.sim.noise_rel = a->noise;
+      req.sim.seed = a->seed;
+      req.capture_out = (fs::path(a->out_dir) / "demo-capture.h5").string();
+      req.material = "apc850";
+      req.isotropic = true;
+      std::atomic<bool> cancel{false};
+      ProgressBar bar("demo");
+      auto res = ui::run_pipeline(req, [&](const ui::PipelineProgress& p) { bar.update(p.fraction, p.stage); }, cancel);
+      bar.finish();
       nlohmann::json j;
-      j["capture"] = cap_path.string();
-      j["shots"] = cap.shots.size();
-      j["stages"] = {"acquire", "capture-file"};
-      j["tube_capacitance_f"] = c0;
-      auto st = dsp::compute_stats(cap.shots[0].v2);
-      j["v2_rms_v"] = st.rms;
+      j["capture"] = res.capture_path;
+      j["shots"] = res.shots;
+      j["stages"] = nlohmann::json::array();
+      for (const auto& s : res.stages) j["stages"].push_back({{"name", s.name}, {"ran", s.ran}, {"note", s.note}});
+      j["resonances_hz"] = res.resonances_hz;
+      j["antiresonances_hz"] = res.antiresonances_hz;
+      j["parameters"] = nlohmann::json::array();
+      for (const auto& p : res.params) {
+        nlohmann::json r = {{"name", p.name}, {"unit", p.unit}, {"original", p.original}, {"updated", p.updated}};
+        if (p.truth) r["true"] = *p.truth;
+        j["parameters"].push_back(r);
+      }
+      j["verdict"] = res.verdict;
+      j["warnings"] = res.warnings;
       if (ctx.json) {
         print_json(j);
-      } else {
-        std::cout << "piezobench demo\n"
-                  << "  wrote " << cap_path.string() << " (" << cap.shots.size() << " shots)\n"
-                  << "  stages run: acquire -> capture file\n"
-                  << "  inspect it with: piezobench capture info " << cap_path.string() << "\n";
+        return;
       }
+      std::cout << "piezobench demo — the main job on the embedded simulated bench\n";
+      for (const auto& s : res.stages)
+        std::cout << "  " << (s.ran ? "[ran]     " : "[skipped] ") << s.name << ": " << s.note << "\n";
+      if (!res.params.empty()) {
+        std::printf("\n  %-12s %14s %14s %14s\n", "parameter", "original", "updated", "true");
+        for (const auto& p : res.params)
+          std::printf("  %-12s %14.6g %14.6g %14s\n", p.name.c_str(), p.original, p.updated,
+                      p.truth ? std::to_string(*p.truth).c_str() : "-");
+      }
+      if (!res.verdict.empty()) std::cout << "\n  gap verdict: " << res.verdict << "\n";
+      for (const auto& w : res.warnings) std::cout << "  warning: " << w << "\n";
+      std::cout << "\n  capture: " << res.capture_path << " (inspect: piezobench capture info " << res.capture_path
+                << ")\n";
     });
   });
 }

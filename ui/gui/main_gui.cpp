@@ -73,8 +73,8 @@ int main(int argc, char** argv) {
   state.request.plan.pretrigger_samples = 200;
   if (!replay.empty()) std::snprintf(state.replay_path, sizeof state.replay_path, "%s", replay.c_str());
 
-  enum class Script { Idle, Clicking, Releasing, Waiting, Settling, Done } script =
-      click.empty() ? Script::Idle : Script::Clicking;
+  enum class Script { Idle, Hovering, Pressing, Releasing, Waiting, Settling, Done } script =
+      click.empty() ? Script::Idle : Script::Hovering;
   int settle_frames = 0, rc = 0;
   bool job_seen = false;
   const auto t_start = std::chrono::steady_clock::now();
@@ -83,19 +83,19 @@ int main(int argc, char** argv) {
     const auto t_frame = std::chrono::steady_clock::now();
     glfwPollEvents();
     ImGuiIO& io = ImGui::GetIO();
-    // Scripted input goes through ImGui's IO exactly like the GLFW backend's.
-    if (script == Script::Clicking && state.button_rects.count(click)) {
-      ImVec4 r = state.button_rects[click];
-      io.MousePos = ImVec2(0.5f * (r.x + r.z), 0.5f * (r.y + r.w));
-      io.MouseDown[0] = true;
-      script = Script::Releasing;
-    } else if (script == Script::Releasing) {
-      io.MouseDown[0] = false;
-      script = Script::Waiting;
-    }
     ImGui_ImplOpenGL3_NewFrame();
     ImGui_ImplGlfw_NewFrame();
-    if (script == Script::Releasing) io.MouseDown[0] = true;  // the backend overwrote it
+    // Scripted input goes through ImGui's IO like the GLFW backend's, after the
+    // backend wrote the real mouse state: hover, press, release (a click).
+    if (script != Script::Idle && script != Script::Waiting && script != Script::Settling &&
+        script != Script::Done && state.button_rects.count(click)) {
+      ImVec4 r = state.button_rects[click];
+      io.MousePos = ImVec2(0.5f * (r.x + r.z), 0.5f * (r.y + r.w));
+      io.MouseDown[0] = script == Script::Pressing;
+      script = script == Script::Hovering ? Script::Pressing
+               : script == Script::Pressing ? Script::Releasing
+                                            : Script::Waiting;
+    }
     ImGui::NewFrame();
 
     int w = 0, h = 0;
