@@ -38,6 +38,12 @@ ResolvedMaterial resolve_material(const MaterialSpec& spec) {
   r.density_kg_m3 = p.density_kg_m3;
   r.description = p.name + (spec.isotropic ? " (isotropic class)" : "");
   auto overrides = parse_assignments(spec.set);
+  std::erase_if(overrides, [&](const auto& kv) {
+    if (kv.first != "rho") return false;
+    if (!(kv.second > 0)) throw std::invalid_argument("material override 'rho': must be positive");
+    r.density_kg_m3 = kv.second;
+    return true;
+  });
   if (spec.isotropic) {
     IsotropicPiezoParams ip = isotropic_params(p.material);
     for (const auto& [k, v] : overrides) {
@@ -45,9 +51,11 @@ ResolvedMaterial resolve_material(const MaterialSpec& spec) {
       else if (k == "nu12") ip.nu12 = v;
       else if (k == "d31") ip.d31 = v;
       else if (k == "epsT33_rel") ip.eps_t33 = v * kEps0;
+      else if (k == "epsT33") ip.eps_t33 = v;
       else
         throw std::invalid_argument("material override '" + k +
-                                    "': the isotropic class takes YE11, nu12, d31, epsT33_rel");
+                                    "' is not a parameter of the isotropic class (YE11, nu12, d31, "
+                                    "epsT33_rel, rho)");
     }
     if (!(ip.y_e11 > 0) || !(ip.nu12 > -1 && ip.nu12 < 0.5) || !(ip.eps_t33 > 0))
       throw std::invalid_argument("material overrides: need YE11 > 0, -1 < nu12 < 0.5, epsT33 > 0");
@@ -65,6 +73,8 @@ ResolvedMaterial resolve_material(const MaterialSpec& spec) {
       else if (k == "d15") d.d15 = v;
       else if (k == "epsT11_rel") d.eps_t11 = v * kEps0;
       else if (k == "epsT33_rel") d.eps_t33 = v * kEps0;
+      else if (k == "epsT11") d.eps_t11 = v;
+      else if (k == "epsT33") d.eps_t33 = v;
       else if (k == "YE11" || k == "nu12") {
         // in-plane engineering constants: sE11 = 1/YE11, sE12 = −nu12/YE11
         double y = 1.0 / d.s_e11, nu = -d.s_e12 / d.s_e11;
@@ -72,7 +82,9 @@ ResolvedMaterial resolve_material(const MaterialSpec& spec) {
         d.s_e11 = 1.0 / y;
         d.s_e12 = -nu / y;
       } else {
-        throw std::invalid_argument("material override '" + k + "': unknown key");
+        throw std::invalid_argument("material override '" + k +
+                                    "': unknown d-form parameter (sE11 sE12 sE13 sE33 sE44 d31 d33 d15 "
+                                    "epsT11[_rel] epsT33[_rel] YE11 nu12 rho)");
       }
     }
     r.d = d;

@@ -1,8 +1,8 @@
 #pragma once
 // A material as the CLI, plan files and the simulated bench name it: a preset,
 // optionally reduced to the seed's isotropic class (§6.4.3), with overrides
-// "KEY=VALUE,KEY=VALUE". Keys: YE11, nu12, d31, epsT33_rel (both classes);
-// sE11, sE12, sE13, sE33, sE44, d33, d15, epsT11_rel (full class only).
+// "KEY=VALUE,KEY=VALUE". Keys: YE11, nu12, d31, epsT33[_rel], rho (both
+// classes); sE11, sE12, sE13, sE33, sE44, d33, d15, epsT11[_rel] (full class).
 #include <string>
 
 #include "model/material.hpp"
