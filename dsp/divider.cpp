@@ -52,13 +52,9 @@ DividerSignals prepare_divider(const DividerRecord& rec, const char* who, const 
   return s;
 }
 
-double estimate_noise_std(const Eigen::Ref<const Eigen::VectorXd>& x) {
-  if (x.size() < 8) throw std::invalid_argument("estimate_noise_std: need at least 8 samples");
-  std::vector<double> d(static_cast<std::size_t>(x.size() - 2));
-  for (Eigen::Index k = 0; k + 2 < x.size(); ++k)
-    d[static_cast<std::size_t>(k)] = std::abs(x[k + 2] - 2.0 * x[k + 1] + x[k]);
-  std::nth_element(d.begin(), d.begin() + d.size() / 2, d.end());
-  return 1.482602218505602 * d[d.size() / 2] / std::sqrt(6.0);
+void difference_in_place(DividerSignals& s) {
+  for (Eigen::VectorXd* v : {&s.v1, &s.v2, &s.i})
+    for (Eigen::Index k = v->size() - 1; k > 0; --k) (*v)[k] -= (*v)[k - 1];
 }
 
 }  // namespace piezo::dsp

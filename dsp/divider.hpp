@@ -25,9 +25,9 @@ struct DividerPrep {
 // Throws std::invalid_argument naming `who` for any violated precondition.
 DividerSignals prepare_divider(const DividerRecord& rec, const char* who, const DividerPrep& prep = {});
 
-// Robust white-noise std of a smooth (oversampled) signal: MAD of the second
-// differences (σ·√6 for white noise), insensitive to steps and to content well
-// below Nyquist.
-double estimate_noise_std(const Eigen::Ref<const Eigen::VectorXd>& x);
+
+
+// v[k] ← v[k] − v[k−1] (v[−1] = 0: the record starts at rest at t = 0) on v1, v2, i.
+void difference_in_place(DividerSignals& s);
 
 }  // namespace piezo::dsp

@@ -84,25 +84,28 @@ Eigen::MatrixXd decimate(const Eigen::MatrixXd& y, std::size_t d) {
 
 }  // namespace
 
-std::size_t select_order(const Eigen::VectorXd& s, std::size_t max_order, double noise_threshold,
-                         std::size_t tail) {
-  const auto n = static_cast<std::size_t>(s.size());
-  if (n < 2) throw std::invalid_argument("select_order: need at least 2 singular values");
-  if (!(s[0] > 0.0)) throw std::invalid_argument("select_order: the Hankel matrix is zero");
-  const std::size_t pmax = std::min(max_order, n - 1);
-  // Noise floor: median of the singular values just beyond max_order (or of the
-  // last quarter when fewer were computed).
-  std::size_t b = std::min(pmax, n - 1), e = std::min(n, pmax + std::max<std::size_t>(tail, 1));
-  if (e - b < 4) {
-    b = n - std::max<std::size_t>(n / 4, 1);
-    e = n;
-  }
-  std::vector<double> t(s.data() + b, s.data() + e);
-  std::nth_element(t.begin(), t.begin() + t.size() / 2, t.end());
-  const double floor = std::max(t[t.size() / 2], 1e-12 * s[0]);
+std::size_t select_order(const Eigen::VectorXd& s, double s_noise, std::size_t max_order,
+                         double noise_threshold) {
+  if (s.size() < 1 || !(s[0] > 0.0)) throw std::invalid_argument("select_order: the Hankel matrix is zero");
+  const double floor = std::max(noise_threshold * s_noise, 1e-12 * s[0]);
+  const std::size_t pmax = std::min<std::size_t>(max_order, static_cast<std::size_t>(s.size()));
   std::size_t p = 0;
-  while (p < pmax && s[static_cast<Eigen::Index>(p)] > noise_threshold * floor) ++p;
+  while (p < pmax && s[static_cast<Eigen::Index>(p)] > floor) ++p;
   return std::max<std::size_t>(p, 1);
+}
+
+double estimate_noise_std(const Eigen::Ref<const Eigen::VectorXd>& x) {
+  constexpr int kOrder = 6;
+  constexpr double kBinom[kOrder + 1] = {1, -6, 15, -20, 15, -6, 1};  // Σ c² = C(12,6) = 924
+  if (x.size() < 4 * kOrder) throw std::invalid_argument("estimate_noise_std: need at least 24 samples");
+  std::vector<double> d(static_cast<std::size_t>(x.size() - kOrder));
+  for (Eigen::Index k = 0; k + kOrder < x.size(); ++k) {
+    double acc = 0;
+    for (int l = 0; l <= kOrder; ++l) acc += kBinom[l] * x[k + l];
+    d[static_cast<std::size_t>(k)] = std::abs(acc);
+  }
+  std::nth_element(d.begin(), d.begin() + d.size() / 2, d.end());
+  return 1.482602218505602 * d[d.size() / 2] / std::sqrt(924.0);
 }
 
 PronyFit prony_ss(const Eigen::Ref<const Eigen::MatrixXd>& y, double sample_rate_hz,
@@ -121,6 +124,7 @@ PronyFit prony_ss(const Eigen::Ref<const Eigen::MatrixXd>& y, double sample_rate
 
   // Per-signal scaling (to unit RMS) so that volts and amperes weigh alike.
   Eigen::MatrixXd ys = y.bottomRows(k_used);
+  Eigen::VectorXd scale = Eigen::VectorXd::Ones(m);
   for (Eigen::Index j = 0; j < m; ++j) {
     const auto col = y.col(j).tail(k_used);
     const double span = col.maxCoeff() - col.minCoeff();
@@ -128,16 +132,34 @@ PronyFit prony_ss(const Eigen::Ref<const Eigen::MatrixXd>& y, double sample_rate
     if (!(span > 1e-12 * mag))
       fail("signal " + std::to_string(j) + " is constant over the " + std::to_string(k_used) +
            " samples: it holds no exponential components to decompose");
-    if (opt.normalize_signals) ys.col(j) /= std::sqrt(col.squaredNorm() / double(k_used));
+    if (opt.normalize_signals) scale[j] = 1.0 / std::sqrt(col.squaredNorm() / double(k_used));
+    ys.col(j) *= scale[j];
   }
+  if (opt.noise_mixing.size() && opt.noise_mixing.rows() != m)
+    fail("noise_mixing must have one row per signal");
 
   std::size_t dec = opt.decimation;
   if (dec == 0)
     dec = opt.band_hz > 0.0 ? std::max<std::size_t>(1, static_cast<std::size_t>(
                                                            sample_rate_hz / (5.0 * opt.band_hz)))
                             : 1;
+  const bool automatic = !opt.order.has_value();
+  Eigen::MatrixXd noise;  // simulated noise, scaled like the data (automatic order only)
+  if (automatic) {
+    Eigen::MatrixXd mix = opt.noise_mixing;
+    if (!mix.size()) {
+      mix = Eigen::MatrixXd::Zero(m, m);
+      for (Eigen::Index j = 0; j < m; ++j) mix(j, j) = estimate_noise_std(y.col(j).tail(k_used));
+    }
+    std::mt19937_64 rng(opt.seed ^ 0x9e3779b97f4a7c15ULL);
+    std::normal_distribution<double> nd;
+    Eigen::MatrixXd w(k_used, mix.cols());
+    for (Eigen::Index i = 0; i < w.size(); ++i) w.data()[i] = nd(rng);
+    noise = w * mix.transpose() * scale.asDiagonal();
+  }
   if (dec > 1) {
     ys = decimate(ys, dec);
+    if (automatic) noise = decimate(noise, dec);
     if (ys.rows() < 8)
       fail("too short for decimation by " + std::to_string(dec) + ": " + std::to_string(k_used) +
            " samples leave " + std::to_string(ys.rows()) + " (need 8); lower band_hz/decimation");
@@ -178,10 +200,17 @@ PronyFit prony_ss(const Eigen::Ref<const Eigen::MatrixXd>& y, double sample_rate
   fit.decimation = dec;
   fit.singular_values = svd.s;
   if (!(svd.s[0] > 0.0)) fail("the Hankel matrix is zero");
-  fit.order_automatic = !opt.order.has_value();
-  fit.order = opt.order ? *opt.order
-                        : select_order(svd.s, std::min<std::size_t>(opt.max_order, rank_cap),
-                                       opt.noise_threshold, opt.oversampling);
+  fit.order_automatic = automatic;
+  if (automatic) {
+    BlockHankel hn(noise, xi, eta);
+    fit.noise_singular_value =
+        randomized_svd(hn, std::min<Eigen::Index>(8, std::min(hn.rows(), hn.cols())), 4, opt.seed).s[0];
+    fit.order = select_order(svd.s, fit.noise_singular_value,
+                             std::min<std::size_t>(opt.max_order, static_cast<std::size_t>(rank_cap)),
+                             opt.noise_threshold);
+  } else {
+    fit.order = *opt.order;
+  }
   const auto p = static_cast<Eigen::Index>(fit.order);
   if (p > svd.s.size()) fail("order exceeds the singular values computed");
   if (!(svd.s[p - 1] > 1e-14 * svd.s[0]))

@@ -30,11 +30,15 @@ struct PronyOptions {
   std::size_t cols = 0;  // η; 0: samples − ξ (the most H(1) allows)
   std::optional<std::size_t> order;  // manual model order p; empty: automatic
   std::size_t max_order = 60;        // automatic order never exceeds this
-  // Automatic order: p = number of singular values above threshold × noise floor,
-  // the floor being the median of the singular values just beyond max_order
-  // (numerical floor 1e-12·s1 for noise-free data): the "significant gap"
-  // between system and noise components of eq. 163.
-  double noise_threshold = 3.0;
+  // Automatic order (noise rejection, eqs 162-163): the gap between system and
+  // noise components is placed where the singular values of the data meet the
+  // largest singular value of the same Hankel matrix built from simulated white
+  // noise at the data's noise level: p = #{s_k > noise_threshold·s_noise}
+  // (and s_k > 1e-12·s_1, the numerical floor of noise-free data).
+  double noise_threshold = 1.25;
+  // Noise model: signal noise = noise_mixing · w, w iid N(0, 1) (m × q). Empty:
+  // independent noise per signal with the std from estimate_noise_std().
+  Eigen::MatrixXd noise_mixing;
   SvdMethod svd = SvdMethod::Auto;
   std::size_t oversampling = 20;     // randomized SVD: extra sketch columns
   std::size_t power_iterations = 2;  // randomized SVD: subspace iterations
@@ -59,6 +63,7 @@ struct PronyFit {
   std::size_t order = 0;
   bool order_automatic = true;
   Eigen::VectorXd singular_values;  // of H(0) (signals as stacked), descending, as computed
+  double noise_singular_value = 0;  // largest singular value of the simulated-noise H(0)
   Eigen::VectorXcd z;               // eigenvalues of A (eq. 143)
   Eigen::VectorXcd lambda;          // λ_n = ln(z_n)/Δt (eq. 164), 1/s
   Eigen::MatrixXcd residues;        // order × signals: γ_{n,j} (eq. 155), referred to t = 0
@@ -73,10 +78,14 @@ struct PronyFit {
 PronyFit prony_ss(const Eigen::Ref<const Eigen::MatrixXd>& y, double sample_rate_hz,
                   const PronyOptions& opt = {});
 
-// The automatic order rule of PronyOptions::noise_threshold on descending
-// singular values s (at least 2).
-std::size_t select_order(const Eigen::VectorXd& s, std::size_t max_order, double noise_threshold,
-                         std::size_t tail = 20);
+// The automatic order rule on descending singular values s given the noise
+// Hankel's largest singular value.
+std::size_t select_order(const Eigen::VectorXd& s, double s_noise, std::size_t max_order,
+                         double noise_threshold);
+
+// Robust white-noise std of an oversampled signal: MAD of the 6th differences
+// (C(12,6)·σ² for white noise), blind to steps and to content well below Nyquist.
+double estimate_noise_std(const Eigen::Ref<const Eigen::VectorXd>& x);
 
 // Y_j(s) = Σ_n γ_{n,j}/(s − λ_n) (eq. 114).
 std::complex<double> laplace(const PronyFit& fit, Eigen::Index signal, std::complex<double> s);
