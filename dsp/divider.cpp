@@ -29,12 +29,6 @@ DividerSignals prepare_divider(const DividerRecord& rec, const char* who, const 
          std::to_string(prep.min_samples));
   for (std::size_t k = 0; k < n; ++k)
     if (!std::isfinite(rec.v1[k]) || !std::isfinite(rec.v2[k])) fail("signals contain NaN or Inf");
-  if (prep.refuse_clipped) {
-    ClipDetection clip;
-    clip.range_v = rec.daq_range_v;
-    if (compute_stats(rec.v1, clip).clipped) fail("v1 is clipped (samples at the converter limit)");
-    if (compute_stats(rec.v2, clip).clipped) fail("v2 is clipped (samples at the converter limit)");
-  }
   DividerSignals s;
   s.sample_rate_hz = rec.sample_rate_hz;
   s.r1_ohm = rec.r1_ohm;
@@ -47,6 +41,19 @@ DividerSignals prepare_divider(const DividerRecord& rec, const char* who, const 
   if (prep.remove_pretrigger_offset && p0 >= 16) {
     s.v1.array() -= m1.head(p0).mean();
     s.v2.array() -= m2.head(p0).mean();
+  }
+  // A constant channel holds no response: say so before the clip heuristic
+  // (which would read a constant as a converter pinned at full scale).
+  for (const auto* v : {&s.v1, &s.v2})
+    if (!(v->maxCoeff() - v->minCoeff() > 1e-12 * v->cwiseAbs().maxCoeff()))
+      fail(std::string(v == &s.v1 ? "v1" : "v2") + " is constant after t = 0: no response to analyse");
+  if (prep.refuse_clipped) {  // over the analysed span: the pretrigger may sit flat at an offset
+    ClipDetection clip;
+    clip.range_v = rec.daq_range_v;
+    if (compute_stats(rec.v1.subspan(rec.pretrigger_samples, use), clip).clipped)
+      fail("v1 is clipped (samples at the converter limit)");
+    if (compute_stats(rec.v2.subspan(rec.pretrigger_samples, use), clip).clipped)
+      fail("v2 is clipped (samples at the converter limit)");
   }
   s.i = (s.v1 - s.v2) / rec.r1_ohm;
   return s;
