@@ -19,7 +19,7 @@ struct FeatureOptions {
   double min_prominence_db = 0.3;
   double search_rel = 0.15;
   // Grid refinement: weighted quadratic fit of 20·log10|Z| over ±fit_points.
-  int fit_points = 2;
+  int fit_points = 1;
   // Capacitance band; 0: auto = [first grid point > 0, cap_rel_hi × lowest resonance]
   // (or × fmax without resonance). Fit: Im(1/Z) = ω·(C + D·ω²).
   double cap_f_lo_hz = 0.0, cap_f_hi_hz = 0.0;
