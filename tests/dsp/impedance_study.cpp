@@ -42,9 +42,12 @@ void score(const StudyInput& in, const dsp::ImpedanceResult& r, StudyRow& row) {
       for (double t : *v) near = near || std::abs(f - t) <= in.peak_exclusion_rel * t;
     if (near) continue;
     err.push_back(std::abs(20.0 * std::log10(std::abs(r.z_ohm[k]) / std::abs(in.z_true(f)))));
+    if (err.back() > row.max_db_err) {
+      row.max_db_err = err.back();
+      row.f_max_db_err = f;
+    }
   }
   if (err.empty()) return;
-  row.max_db_err = *std::max_element(err.begin(), err.end());
   std::nth_element(err.begin(), err.begin() + err.size() / 2, err.end());
   row.median_db_err = err[err.size() / 2];
 }
@@ -108,9 +111,9 @@ StudyRow study_xspec(const StudyInput& in, std::size_t segment, bool difference)
 std::string format_table(const std::vector<StudyRow>& rows) {
   std::string s;
   char buf[512];
-  std::snprintf(buf, sizeof buf, "| %-16s | %8s | %5s | %-44s | %-44s | %9s | %9s |\n", "method",
-                "samples", "order", "resonance err % (3 modes)", "anti-resonance err % (3 modes)",
-                "max dB", "median dB");
+  std::snprintf(buf, sizeof buf, "| %-20s | %8s | %5s | %-27s | %-27s | %18s | %9s |\n", "method",
+                "samples", "order", "resonance err %", "anti-resonance err %",
+                "max dB (at kHz)", "median dB");
   s += buf;
   auto errs = [](const std::vector<double>& v) {
     std::string o;
@@ -123,9 +126,9 @@ std::string format_table(const std::vector<StudyRow>& rows) {
     return o;
   };
   for (const auto& r : rows) {
-    std::snprintf(buf, sizeof buf, "| %-16s | %8zu | %5zu | %-44s | %-44s | %9.3f | %9.3f |\n",
+    std::snprintf(buf, sizeof buf, "| %-20s | %8zu | %5zu | %-27s | %-27s | %7.3f (%7.1f) | %9.3f |\n",
                   r.method.c_str(), r.samples, r.order, errs(r.res_err_rel).c_str(),
-                  errs(r.anti_err_rel).c_str(), r.max_db_err, r.median_db_err);
+                  errs(r.anti_err_rel).c_str(), r.max_db_err, r.f_max_db_err / 1e3, r.median_db_err);
     s += buf;
   }
   return s;

@@ -28,6 +28,7 @@ struct StudyRow {
   std::vector<double> res_err_rel, anti_err_rel;  // per true feature; NaN = not found
   double max_feature_err_rel = 0;               // worst over features (inf if one is missing)
   double max_db_err = 0, median_db_err = 0;     // |Z| away from the peaks, f_lo..f_hi
+  double f_max_db_err = 0;                      // where the largest |Z| error sits
   std::size_t order = 0;                        // Prony only
   double elapsed_ms = 0;
 };
