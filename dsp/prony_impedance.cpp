@@ -96,6 +96,8 @@ ImpedanceResult impedance_prony(const DividerRecord& rec, const Eigen::VectorXd&
     o2.prony.order = model.fit.order;
     std::vector<std::vector<double>> res(r.features.resonances.size()),
         anti(r.features.antiresonances.size()), cap(1);
+    Eigen::VectorXd zvar = Eigen::VectorXd::Zero(f_hz.size());
+    std::size_t good = 0;
     for (std::size_t b = 0; b < opt.bootstrap; ++b) {
       Eigen::MatrixXd y(s.size(), 3);
       for (Eigen::Index k = 0; k < s.size(); ++k) {
@@ -110,6 +112,8 @@ ImpedanceResult impedance_prony(const DividerRecord& rec, const Eigen::VectorXd&
       } catch (const std::invalid_argument&) {
         continue;  // a degenerate replicate carries no information
       }
+      for (Eigen::Index k = 0; k < f_hz.size(); ++k) zvar[k] += std::norm(m2.z(f_hz[k]) - r.z_ohm[k]);
+      ++good;
       const auto f2 = features_of(m2);
       accumulate(r.features.resonances, f2.resonances, res);
       accumulate(r.features.antiresonances, f2.antiresonances, anti);
@@ -118,6 +122,7 @@ ImpedanceResult impedance_prony(const DividerRecord& rec, const Eigen::VectorXd&
     for (std::size_t k = 0; k < res.size(); ++k) r.features.resonances[k].sigma_hz = stddev(res[k]);
     for (std::size_t k = 0; k < anti.size(); ++k) r.features.antiresonances[k].sigma_hz = stddev(anti[k]);
     r.features.capacitance_sigma_f = stddev(cap[0]);
+    if (good >= 2) r.z_sigma_ohm = (zvar / double(good)).cwiseSqrt();
   }
   return r;
 }

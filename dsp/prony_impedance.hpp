@@ -22,8 +22,9 @@ struct PronyImpedanceOptions {
   DividerPrep prep;  // prep.max_samples: the samples from t = 0 decomposed (0: all)
   FeatureOptions features;
   double feature_step_hz = 0.0;  // search grid of the features; 0: grid step / 4
-  // Parametric bootstrap for the feature uncertainties: refits with white noise
-  // of the residual RMS added to the model, at the chosen order. 0: no σ.
+  // Parametric bootstrap for the uncertainties of the features and of Z per point
+  // (z_sigma_ohm): refits with white noise of the fit's residual RMS added to the
+  // model on v1 and v2, at the chosen order. 0: no σ.
   std::size_t bootstrap = 0;
   std::uint64_t bootstrap_seed = 7;
 };

@@ -78,6 +78,7 @@ TEST_F(CmdImpedance, PronyJsonCarriesFeaturesOrderAndSingularValues) {
   EXPECT_NEAR(j["capacitance_f"].get<double>() / truth_.capacitance_f, 1.0, 1e-2);
   EXPECT_TRUE(j.contains("rayleigh"));
   EXPECT_EQ(j["f_hz"].size(), j["re_ohm"].size());
+  EXPECT_EQ(j["sigma_ohm"].size(), j["f_hz"].size());  // bootstrap σ per point
 }
 
 TEST_F(CmdImpedance, CsvAndTouchstone) {

@@ -71,7 +71,7 @@ nlohmann::json features_json(const dsp::ImpedanceFeatures& f) {
 }
 
 nlohmann::json result_json(const dsp::ImpedanceResult& r, const std::string& file,
-                           const std::vector<std::string>& shots) {
+                           const std::vector<std::string>& shots, double fmax) {
   nlohmann::json j;
   j["file"] = file;
   j["shots"] = shots;
@@ -89,10 +89,10 @@ nlohmann::json result_json(const dsp::ImpedanceResult& r, const std::string& fil
     for (const auto& p : r.prony->poles) {
       poles.push_back({{"freq_hz", p.freq_hz}, {"damping_ratio", p.damping_ratio},
                        {"re_per_s", p.lambda.real()}, {"im_rad_per_s", p.lambda.imag()}});
-      if (p.freq_hz > 0 && p.damping_ratio > 0) modes.push_back(p);
+      if (p.freq_hz > 0 && p.freq_hz <= fmax && p.damping_ratio > 0) modes.push_back(p);
     }
     j["poles"] = poles;
-    if (modes.size() >= 2) {
+    if (modes.size() >= 2) {  // eqs 167-169, least squares over the modes in the band
       const auto d = dsp::rayleigh_fit(modes);
       j["rayleigh"] = {{"alpha_per_s", d.alpha}, {"beta_s", d.beta}};
     }
@@ -142,6 +142,7 @@ void run(const ImpedanceArgs& a, Context& ctx) {
   if (!win) throw InputError("unknown window '" + a.window + "'");
   std::vector<std::string> names;
   dsp::ImpedanceResult r;
+  double band = a.fmax;
   if (a.method == "sine") {
     std::vector<dsp::SineShot> shots;
     for (const auto* s : dut_shots(cap, true)) {
@@ -158,6 +159,7 @@ void run(const ImpedanceArgs& a, Context& ctx) {
     const acq::Shot& shot = pick_shot(cap, a);
     const double fs = shot.sample_rate_hz;
     const double fmax = a.fmax > 0 ? a.fmax : fs / 4;
+    band = fmax;
     if (!(fmax <= fs / 2)) throw InputError("--fmax above the Nyquist frequency");
     const double step = a.step > 0 ? a.step : fmax / 2000;
     const double fmin = a.fmin > 0 ? a.fmin : step;
@@ -206,7 +208,7 @@ void run(const ImpedanceArgs& a, Context& ctx) {
   if (a.csv) dsp::write_impedance_csv(*os, r);
   else if (a.s1p) dsp::write_touchstone_s1p(*os, r);
   else {
-    const auto j = result_json(r, a.file, names);
+    const auto j = result_json(r, a.file, names, band > 0 ? band : 1e300);
     if (ctx.json) *os << j.dump(2) << std::endl;
     else print_text(j);
   }
