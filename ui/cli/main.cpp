@@ -17,6 +17,7 @@ int main(int argc, char** argv) {
   register_demo_command(app, ctx);
   register_measure_commands(app, ctx);
   register_model_commands(app, ctx);
+  register_impedance_command(app, ctx);
   try {
     app.parse(argc, argv);
   } catch (const CLI::Success& e) {

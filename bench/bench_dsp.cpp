@@ -1,0 +1,104 @@
+// Impedance estimators on divider-like signals (10 MS/s, three damped modes near
+// 51/54/95 kHz, an RC step component, exp_decay drive, 1 % white noise):
+//   Prony-SS on 1000 / 3000 / 20000 samples — decimated (band 120 kHz, the
+//   default path of the CLI) and at the full rate, each with the full SVD and
+//   the randomized SVD; the direct FFT ratio and the cross spectra on 1e6 samples.
+// Target: the 3000-sample Prony estimate under 20 ms.
+#include <benchmark/benchmark.h>
+
+#include <cmath>
+#include <numbers>
+#include <random>
+#include <vector>
+
+#include "dsp/cross_spectra.hpp"
+#include "dsp/fft_ratio.hpp"
+#include "dsp/prony_impedance.hpp"
+
+namespace {
+using namespace piezo;
+constexpr double kFs = 1e7;
+
+struct Signals {
+  std::vector<double> v1, v2;
+};
+
+Signals make(std::size_t n, std::uint64_t seed) {
+  Signals s;
+  std::mt19937_64 rng(seed);
+  std::normal_distribution<double> nd(0.0, 1.0);
+  const double tw = 2.0 * std::numbers::pi;
+  for (std::size_t k = 0; k < n; ++k) {
+    const double t = double(k) / kFs;
+    const double v1 = std::exp(-3000.0 * t);
+    const double v2 = v1 - 0.9 * std::exp(-85e3 * t) +
+                      0.02 * std::exp(-1.6e3 * t) * std::sin(tw * 51.08e3 * t) +
+                      0.008 * std::exp(-1.8e3 * t) * std::sin(tw * 53.96e3 * t + 0.4) +
+                      0.03 * std::exp(-2.0e4 * t) * std::sin(tw * 94.6e3 * t + 1.0);
+    s.v1.push_back(v1 + 0.01 * 0.3 * nd(rng));
+    s.v2.push_back(v2 + 0.01 * 0.3 * nd(rng));
+  }
+  return s;
+}
+
+void BM_Prony(benchmark::State& st) {
+  const auto n = static_cast<std::size_t>(st.range(0));
+  const bool decimated = st.range(1) != 0;
+  const auto svd = st.range(2) ? dsp::SvdMethod::Randomized : dsp::SvdMethod::Full;
+  const Signals s = make(n, 1);
+  dsp::PronyImpedanceOptions o;
+  o.prony.svd = svd;
+  if (decimated) o.prony.band_hz = 120e3;
+  else o.prony.decimation = 1;
+  const Eigen::VectorXd grid = dsp::make_grid(1e3, 120e3, 200);
+  std::size_t order = 0;
+  for (auto _ : st) {
+    const auto r = dsp::impedance_prony({s.v1, s.v2, kFs, 3140.0, 0, {}}, grid, o);
+    order = r.prony->order;
+    benchmark::DoNotOptimize(r.z_ohm.data());
+  }
+  st.counters["order"] = double(order);
+}
+// args: samples, decimated (band 120 kHz → D = 16), randomized SVD
+BENCHMARK(BM_Prony)->Args({1000, 1, 0})->Args({1000, 1, 1})->Args({3000, 1, 0})->Args({3000, 1, 1})
+    ->Args({20000, 1, 0})->Args({20000, 1, 1})->Unit(benchmark::kMillisecond);
+// Full rate: the balanced 3·ξ × η Hankel of N samples; the full SVD is O(N³)
+// (3000: a 4500 × 1500 BDCSVD, seconds; 20000: 30000 × 10000, not attempted).
+BENCHMARK(BM_Prony)->Args({1000, 0, 0})->Args({1000, 0, 1})->Args({3000, 0, 1})->Args({20000, 0, 1})
+    ->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_Prony)->Args({3000, 0, 0})->Iterations(1)->Unit(benchmark::kMillisecond);
+
+void BM_FftRatio(benchmark::State& st) {
+  const Signals s = make(static_cast<std::size_t>(st.range(0)), 2);
+  dsp::FftRatioOptions o;
+  o.fmax_hz = 120e3;
+  for (auto _ : st) {
+    const auto r = dsp::impedance_fft({s.v1, s.v2, kFs, 3140.0, 0, {}}, o);
+    benchmark::DoNotOptimize(r.z_ohm.data());
+  }
+}
+BENCHMARK(BM_FftRatio)->Arg(1000000)->Unit(benchmark::kMillisecond);
+
+// 1e6 samples as 20 records of 5e4 (the seed's cross-spectra set-up), and as
+// one record in Welch segments of 5e4 with 50 % overlap.
+void BM_CrossSpectra(benchmark::State& st) {
+  const bool welch = st.range(0) != 0;
+  std::vector<Signals> sig;
+  std::vector<dsp::DividerRecord> recs;
+  if (welch) sig.push_back(make(1000000, 3));
+  else
+    for (int k = 0; k < 20; ++k) sig.push_back(make(50000, 10 + k));
+  for (const auto& s : sig) recs.push_back({s.v1, s.v2, kFs, 3140.0, 0, {}});
+  dsp::CrossSpectraOptions o;
+  o.segment = 50000;
+  o.overlap = welch ? 0.5 : 0.0;
+  o.window = {welch ? dsp::WindowKind::Hann : dsp::WindowKind::Rectangular, 0};
+  o.fmax_hz = 120e3;
+  for (auto _ : st) {
+    const auto r = dsp::impedance_xspec(recs, o);
+    benchmark::DoNotOptimize(r.z_ohm.data());
+  }
+}
+BENCHMARK(BM_CrossSpectra)->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond);
+
+}  // namespace

@@ -1,0 +1,74 @@
+#include "dsp/fft.hpp"
+
+#include <fftw3.h>
+
+#include <algorithm>
+#include <cstring>
+#include <mutex>
+#include <new>
+#include <stdexcept>
+
+namespace piezo::dsp {
+
+namespace {
+std::mutex& planner_mutex() {
+  static std::mutex m;
+  return m;
+}
+}  // namespace
+
+RealFft::RealFft(std::size_t n) : n_(n) {
+  if (n < 2) throw std::invalid_argument("RealFft: size must be >= 2");
+  std::lock_guard<std::mutex> lock(planner_mutex());
+  rbuf_ = fftw_alloc_real(n);
+  auto* c = fftw_alloc_complex(n / 2 + 1);
+  cbuf_ = c;
+  if (!rbuf_ || !c) throw std::bad_alloc();
+  fwd_ = fftw_plan_dft_r2c_1d(static_cast<int>(n), rbuf_, c, FFTW_ESTIMATE);
+  inv_ = fftw_plan_dft_c2r_1d(static_cast<int>(n), c, rbuf_, FFTW_ESTIMATE);
+  if (!fwd_ || !inv_) throw std::runtime_error("RealFft: FFTW planning failed");
+}
+
+RealFft::~RealFft() {
+  std::lock_guard<std::mutex> lock(planner_mutex());
+  if (fwd_) fftw_destroy_plan(static_cast<fftw_plan>(fwd_));
+  if (inv_) fftw_destroy_plan(static_cast<fftw_plan>(inv_));
+  fftw_free(rbuf_);
+  fftw_free(cbuf_);
+}
+
+void RealFft::forward(const double* in, std::size_t count, std::complex<double>* out) {
+  count = std::min(count, n_);
+  std::memcpy(rbuf_, in, count * sizeof(double));
+  std::fill(rbuf_ + count, rbuf_ + n_, 0.0);
+  fftw_execute(static_cast<fftw_plan>(fwd_));
+  std::memcpy(static_cast<void*>(out), cbuf_, bins() * sizeof(fftw_complex));
+}
+
+void RealFft::inverse(const std::complex<double>* in, double* out, std::size_t count) {
+  std::memcpy(cbuf_, static_cast<const void*>(in), bins() * sizeof(fftw_complex));
+  fftw_execute(static_cast<fftw_plan>(inv_));  // c2r destroys its input: cbuf_ is scratch
+  std::memcpy(out, rbuf_, std::min(count, n_) * sizeof(double));
+}
+
+std::size_t good_fft_size(std::size_t n) {
+  if (n <= 2) return 2;
+  for (std::size_t m = n;; ++m) {
+    std::size_t r = m;
+    for (std::size_t p : {2u, 3u, 5u, 7u})
+      while (r % p == 0) r /= p;
+    if (r == 1) return m;
+  }
+}
+
+Eigen::VectorXcd rfft(const Eigen::Ref<const Eigen::VectorXd>& x, std::size_t nfft) {
+  if (static_cast<std::size_t>(x.size()) > nfft)
+    throw std::invalid_argument("rfft: nfft shorter than the signal");
+  RealFft f(nfft);
+  Eigen::VectorXd tmp = x;  // contiguous copy
+  Eigen::VectorXcd out(static_cast<Eigen::Index>(f.bins()));
+  f.forward(tmp.data(), static_cast<std::size_t>(tmp.size()), out.data());
+  return out;
+}
+
+}  // namespace piezo::dsp

@@ -1,0 +1,31 @@
+#pragma once
+// Direct FFT ratio (seed §4.1, §5.1.1): Z(f_k) = R1·V2(f_k)/(V1(f_k) − V2(f_k)) from
+// one record, on the FFT bins f_k = k·fs/nfft. Suffers from the periodic
+// assumption (leakage) and a resolution of fs/nfft; kept as the reference the
+// Laplace method is compared with. Per-point uncertainty by first-order
+// propagation of white noise of the estimated std on v1 and v2.
+#include <Eigen/Core>
+
+#include "dsp/divider.hpp"
+#include "dsp/features.hpp"
+#include "dsp/impedance_types.hpp"
+#include "dsp/windows.hpp"
+
+namespace piezo::dsp {
+
+struct FftRatioOptions {
+  DividerPrep prep;        // prep.max_samples: record length from t = 0 (0: all)
+  Window window;           // default rectangular: a transient starts at t = 0
+  std::size_t nfft = 0;    // 0: the record length (no zero padding)
+  // First difference of both channels before the FFT. Z = V2/(V1 − V2) is
+  // unchanged (the same filter on both), but a drive step becomes an impulse, so
+  // the periodic extension of a step/exp_decay record has no jump: without it
+  // V1(f_k) of a step held to the record's end is ~0 off DC and Z is garbage.
+  bool difference = true;
+  double fmin_hz = 0.0, fmax_hz = 0.0;  // bins kept; fmax 0: Nyquist
+  FeatureOptions features;
+};
+
+ImpedanceResult impedance_fft(const DividerRecord& rec, const FftRatioOptions& opt = {});
+
+}  // namespace piezo::dsp

@@ -1,0 +1,14 @@
+#pragma once
+// Pure formatters of an ImpedanceResult: CSV (f_hz,re_ohm,im_ohm) and Touchstone
+// 1-port (.s1p) in Z format, real/imaginary. Touchstone 1.x stores Z-parameters
+// normalised to the reference resistance R given in the option line.
+#include <iosfwd>
+
+#include "dsp/impedance_types.hpp"
+
+namespace piezo::dsp {
+
+void write_impedance_csv(std::ostream& os, const ImpedanceResult& r);
+void write_touchstone_s1p(std::ostream& os, const ImpedanceResult& r, double reference_ohm = 50.0);
+
+}  // namespace piezo::dsp

@@ -1,0 +1,130 @@
+#include "dsp/prony_impedance.hpp"
+
+#include <cmath>
+#include <numbers>
+#include <random>
+#include <stdexcept>
+
+namespace piezo::dsp {
+
+namespace {
+constexpr double kTwoPi = 2.0 * std::numbers::pi;
+
+Eigen::MatrixXd stack(const DividerSignals& s) {
+  Eigen::MatrixXd y(s.size(), 3);
+  y.col(0) = s.v1;
+  y.col(1) = s.v2;
+  y.col(2) = s.i;
+  return y;
+}
+
+// Matches each reference frequency with the nearest of `found` within ±2 %.
+void accumulate(const std::vector<Feature>& ref, const std::vector<Feature>& found,
+                std::vector<std::vector<double>>& acc) {
+  for (std::size_t r = 0; r < ref.size(); ++r) {
+    double best = kNaN, dist = 0.02 * ref[r].f_hz;
+    for (const auto& f : found)
+      if (std::abs(f.f_hz - ref[r].f_hz) < dist) { dist = std::abs(f.f_hz - ref[r].f_hz); best = f.f_hz; }
+    if (std::isfinite(best)) acc[r].push_back(best);
+  }
+}
+
+double stddev(const std::vector<double>& v) {
+  if (v.size() < 2) return kNaN;
+  double m = 0, s = 0;
+  for (double x : v) m += x;
+  m /= double(v.size());
+  for (double x : v) s += (x - m) * (x - m);
+  return std::sqrt(s / double(v.size() - 1));
+}
+}  // namespace
+
+std::complex<double> PronyImpedance::z(double f_hz) const {
+  const std::complex<double> s(0.0, kTwoPi * f_hz);
+  return r1_ohm * laplace(fit, 1, s) / (laplace(fit, 0, s) - laplace(fit, 1, s));
+}
+
+PronyImpedance fit_prony_impedance(const DividerRecord& rec, const PronyImpedanceOptions& opt) {
+  const DividerSignals s = prepare_divider(rec, "impedance_prony", opt.prep);
+  const double span = s.i.maxCoeff() - s.i.minCoeff();
+  if (!(span > 1e-12 * std::max(s.v1.cwiseAbs().maxCoeff(), s.v2.cwiseAbs().maxCoeff()) / rec.r1_ohm))
+    throw std::invalid_argument("impedance_prony: no current flows (v1 == v2): Z is undefined");
+  PronyImpedance out;
+  out.r1_ohm = rec.r1_ohm;
+  out.fit = prony_ss(stack(s), s.sample_rate_hz, opt.prony);
+  return out;
+}
+
+PronySummary summarize(const PronyFit& fit) {
+  PronySummary p;
+  p.order = fit.order;
+  p.order_automatic = fit.order_automatic;
+  for (Eigen::Index k = 0; k < fit.singular_values.size(); ++k)
+    p.singular_values_normalized.push_back(fit.singular_values[k] / fit.singular_values[0]);
+  p.poles = pole_table(fit);
+  return p;
+}
+
+ImpedanceResult impedance_prony(const DividerRecord& rec, const Eigen::VectorXd& f_hz,
+                                const PronyImpedanceOptions& opt) {
+  if (f_hz.size() < 2) throw std::invalid_argument("impedance_prony: need at least 2 frequencies");
+  const PronyImpedance model = fit_prony_impedance(rec, opt);
+  ImpedanceResult r;
+  r.method = "prony";
+  r.samples_used = static_cast<std::size_t>(model.fit.samples);
+  r.f_hz = f_hz;
+  r.z_ohm.resize(f_hz.size());
+  for (Eigen::Index k = 0; k < f_hz.size(); ++k) r.z_ohm[k] = model.z(f_hz[k]);
+  r.prony = summarize(model.fit);
+
+  const double fmin = std::max(f_hz.minCoeff(), opt.features.fmin_hz);
+  const double fmax = std::min(f_hz.maxCoeff(), opt.features.fmax_hz);
+  const double step = opt.feature_step_hz > 0 ? opt.feature_step_hz
+                                              : (f_hz.maxCoeff() - f_hz.minCoeff()) / double(f_hz.size() - 1) / 4.0;
+  auto features_of = [&](const PronyImpedance& m) {
+    return find_features([&m](double f) { return m.z(f); }, fmin, fmax, step, opt.features);
+  };
+  r.features = features_of(model);
+
+  if (opt.bootstrap > 0) {
+    // Parametric bootstrap: model + white noise of the fit's residual RMS on v1, v2.
+    const DividerSignals s = prepare_divider(rec, "impedance_prony", opt.prep);
+    const Eigen::MatrixXd clean = reconstruct(model.fit, s.size());
+    std::mt19937_64 rng(opt.bootstrap_seed);
+    std::normal_distribution<double> nd;
+    PronyImpedanceOptions o2 = opt;
+    o2.prony.order = model.fit.order;
+    std::vector<std::vector<double>> res(r.features.resonances.size()),
+        anti(r.features.antiresonances.size()), cap(1);
+    Eigen::VectorXd zvar = Eigen::VectorXd::Zero(f_hz.size());
+    std::size_t good = 0;
+    for (std::size_t b = 0; b < opt.bootstrap; ++b) {
+      Eigen::MatrixXd y(s.size(), 3);
+      for (Eigen::Index k = 0; k < s.size(); ++k) {
+        y(k, 0) = clean(k, 0) + model.fit.residual_rms[0] * nd(rng);
+        y(k, 1) = clean(k, 1) + model.fit.residual_rms[1] * nd(rng);
+      }
+      y.col(2) = (y.col(0) - y.col(1)) / rec.r1_ohm;
+      PronyImpedance m2;
+      m2.r1_ohm = rec.r1_ohm;
+      try {
+        m2.fit = prony_ss(y, s.sample_rate_hz, o2.prony);
+      } catch (const std::invalid_argument&) {
+        continue;  // a degenerate replicate carries no information
+      }
+      for (Eigen::Index k = 0; k < f_hz.size(); ++k) zvar[k] += std::norm(m2.z(f_hz[k]) - r.z_ohm[k]);
+      ++good;
+      const auto f2 = features_of(m2);
+      accumulate(r.features.resonances, f2.resonances, res);
+      accumulate(r.features.antiresonances, f2.antiresonances, anti);
+      if (std::isfinite(f2.capacitance_f)) cap[0].push_back(f2.capacitance_f);
+    }
+    for (std::size_t k = 0; k < res.size(); ++k) r.features.resonances[k].sigma_hz = stddev(res[k]);
+    for (std::size_t k = 0; k < anti.size(); ++k) r.features.antiresonances[k].sigma_hz = stddev(anti[k]);
+    r.features.capacitance_sigma_f = stddev(cap[0]);
+    if (good >= 2) r.z_sigma_ohm = (zvar / double(good)).cwiseSqrt();
+  }
+  return r;
+}
+
+}  // namespace piezo::dsp

@@ -1,0 +1,47 @@
+#pragma once
+// The proposed Laplace-domain impedance estimator (seed §4.2, §4.3.2): v1, v2 and
+// the current i = (v1 − v2)/R1 from t = 0 are decomposed together by the
+// multi-signal Prony-SS method (one set of global poles, so the output holds the
+// input's poles), and
+//     Z(s) = V2(s)/I(s) = R1·V2(s)/(V1(s) − V2(s))          (eqs 113-116, 170)
+// is evaluated from the pole–residue forms at s = jω on any grid: no leakage,
+// any resolution. The drive step at t = 0 is part of the one-sided transform:
+// the fit starts at the first sample of the excitation, so nothing is lost.
+#include <complex>
+#include <cstdint>
+
+#include "dsp/divider.hpp"
+#include "dsp/features.hpp"
+#include "dsp/impedance_types.hpp"
+#include "dsp/prony_ss.hpp"
+
+namespace piezo::dsp {
+
+struct PronyImpedanceOptions {
+  PronyOptions prony;
+  DividerPrep prep;  // prep.max_samples: the samples from t = 0 decomposed (0: all)
+  FeatureOptions features;
+  double feature_step_hz = 0.0;  // search grid of the features; 0: grid step / 4
+  // Parametric bootstrap for the uncertainties of the features and of Z per point
+  // (z_sigma_ohm): refits with white noise of the fit's residual RMS added to the
+  // model on v1 and v2, at the chosen order. 0: no σ.
+  std::size_t bootstrap = 0;
+  std::uint64_t bootstrap_seed = 7;
+};
+
+struct PronyImpedance {
+  PronyFit fit;  // signals: 0 = v1, 1 = v2, 2 = i
+  double r1_ohm = 0.0;
+  std::complex<double> z(double f_hz) const;  // eq. 116 at s = j2πf
+};
+
+PronyImpedance fit_prony_impedance(const DividerRecord& rec, const PronyImpedanceOptions& opt = {});
+
+// Z on the grid f_hz (ascending, >= 0), features, order and singular values.
+ImpedanceResult impedance_prony(const DividerRecord& rec, const Eigen::VectorXd& f_hz,
+                                const PronyImpedanceOptions& opt = {});
+
+// The summary (order, normalised singular values, poles) of a fit.
+PronySummary summarize(const PronyFit& fit);
+
+}  // namespace piezo::dsp
