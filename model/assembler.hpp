@@ -1,0 +1,49 @@
+#pragma once
+// Assembler: element split matrices → one sparse system (seed eqs 77-84).
+// All parameter matrices share ONE symmetric sparsity pattern over the full
+// DOF vector x = [U; Φ_int; V] (model/mesh.hpp), so that re-weighting for a
+// new material (eqs 234, 242, 245) is an AXPY over value arrays, and a sparse
+// factorisation analysed once can be reused for every material.
+#include <Eigen/SparseCore>
+#include <array>
+#include <complex>
+
+#include "model/material.hpp"
+#include "model/mesh.hpp"
+
+namespace piezo::model {
+
+using SpMat = Eigen::SparseMatrix<double>;
+using SpMatC = Eigen::SparseMatrix<std::complex<double>>;
+
+class SplitSystem {
+ public:
+  SplitSystem() = default;
+  SplitSystem(const TubeMesh& mesh, const DofMap& dofs, double density_kg_m3, int gauss_points);
+
+  int size() const { return static_cast<int>(pattern_.rows()); }
+  // Pattern (both triangles stored); its values are the unweighted sum and carry no meaning.
+  const SpMat& pattern() const { return pattern_; }
+  const Eigen::VectorXd& values(MaterialParam p) const { return k_[static_cast<int>(p)]; }
+  const Eigen::VectorXd& mass_values() const { return m_; }
+
+  // out ← Σ_p w_p·K_p − σ·M on the shared pattern (out is given the pattern if needed).
+  void combine(const MaterialWeights& w, double sigma, SpMat& out) const;
+  // Same with complex weights and complex mass factor (for the direct harmonic solve):
+  // out ← Σ_p w_p·K_p + w_m·M.
+  void combine(const std::array<std::complex<double>, kNumMaterialParams>& w,
+               std::complex<double> w_m, SpMatC& out) const;
+  // One split matrix (or the mass) as a standalone sparse matrix on the full DOFs.
+  SpMat matrix(MaterialParam p) const;
+  SpMat mass() const;
+  // Position of (row, col) in the value arrays; −1 if not in the pattern.
+  int position(int row, int col) const;
+
+ private:
+  SpMat with_values(const Eigen::VectorXd& v) const;
+  SpMat pattern_;
+  std::array<Eigen::VectorXd, kNumMaterialParams> k_;
+  Eigen::VectorXd m_;
+};
+
+}  // namespace piezo::model

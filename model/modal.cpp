@@ -1,0 +1,219 @@
+#include "model/modal.hpp"
+
+#include <Spectra/MatOp/SparseSymMatProd.h>
+#include <Spectra/SymGEigsShiftSolver.h>
+
+#include <algorithm>
+#include <cmath>
+#include <numeric>
+#include <stdexcept>
+
+namespace piezo::model {
+
+namespace {
+
+// y = (K_cond − σM)⁻¹ x on the U space, applied through the full coupled
+// system [K_UU − σM, K_UΦ; K_ΦU, K_ΦΦ] [y; Φ] = [x; 0] (zero charge on every
+// free potential DOF = static condensation of Φ). Factorised before use.
+class CondensedShiftInvert {
+ public:
+  using Scalar = double;
+  CondensedShiftInvert(const CoupledFactor& f, int n_u, double sigma)
+      : f_(&f), n_u_(n_u), sigma_(sigma), rhs_(Eigen::VectorXd::Zero(f.size())) {}
+  Eigen::Index rows() const { return n_u_; }
+  Eigen::Index cols() const { return n_u_; }
+  void set_shift(const Scalar& sigma) {
+    if (sigma != sigma_)
+      throw std::logic_error("CondensedShiftInvert: factorised for a different shift");
+  }
+  void perform_op(const Scalar* x_in, Scalar* y_out) const {
+    rhs_.head(n_u_) = Eigen::Map<const Eigen::VectorXd>(x_in, n_u_);
+    f_->solve(rhs_, sol_);
+    Eigen::Map<Eigen::VectorXd>(y_out, n_u_) = sol_.head(n_u_);
+  }
+
+ private:
+  const CoupledFactor* f_;
+  int n_u_;
+  double sigma_;
+  mutable Eigen::VectorXd rhs_, sol_;
+};
+
+}  // namespace
+
+void ModalOptions::validate() const {
+  const char* fn = "ModalOptions::validate";
+  if (n_modes < 1) throw std::invalid_argument(std::string(fn) + ": n_modes must be >= 1");
+  if (!(shift_hz > 0)) throw std::invalid_argument(std::string(fn) + ": shift_hz must be > 0");
+  if (ncv != 0 && ncv <= n_modes)
+    throw std::invalid_argument(std::string(fn) + ": ncv must exceed n_modes (or be 0)");
+  if (!(tolerance > 0)) throw std::invalid_argument(std::string(fn) + ": tolerance must be > 0");
+  if (max_iterations < 1)
+    throw std::invalid_argument(std::string(fn) + ": max_iterations must be >= 1");
+  if (!(active_coupling >= 0))
+    throw std::invalid_argument(std::string(fn) + ": active_coupling must be >= 0");
+}
+
+const char* to_string(Symmetry s) {
+  switch (s) {
+    case Symmetry::symmetric: return "symmetric";
+    case Symmetry::antisymmetric: return "antisymmetric";
+    default: return "mixed";
+  }
+}
+
+const char* to_string(Electrodes e) {
+  return e == Electrodes::short_circuit ? "short_circuit" : "open_circuit";
+}
+
+std::vector<double> ModalResult::active_frequencies_hz() const {
+  std::vector<double> f;
+  for (const auto& m : modes)
+    if (m.electrically_active) f.push_back(m.frequency_hz);
+  return f;
+}
+
+ModalSolver::ModalSolver(const TubeModel& model) : model_(&model), factor_(model) {
+  m_uu_ = model.split().m;
+  all_u_.resize(model.n_u());
+  std::iota(all_u_.begin(), all_u_.end(), 0);
+}
+
+double ModalSolver::clamped_capacitance(const PiezoMaterialE& material, Eigen::VectorXd* g) {
+  validate(material, "ModalSolver::clamped_capacitance");
+  Eigen::VectorXd x;
+  const double c0 = factor_.charge_for_unit_voltage(weights(material), all_u_, &x);
+  if (g) *g = (factor_.matrix() * x).head(model_->n_u());  // g = K_UΦ [Φ_int; 1]
+  return c0;
+}
+
+double ModalSolver::static_capacitance(const PiezoMaterialE& material,
+                                       Eigen::VectorXd* u_static) {
+  validate(material, "ModalSolver::static_capacitance");
+  // The only zero-energy mode of the free tube is the rigid axial translation;
+  // fixing one u_z removes it without loading the tube (the electric load is
+  // self-equilibrated), so Q is that of the free tube.
+  const int fix[1] = {model_->dofs().u_z(0)};
+  Eigen::VectorXd x;
+  const double c = factor_.charge_for_unit_voltage(weights(material), fix, &x);
+  if (u_static) {
+    Eigen::VectorXd u = x.head(model_->n_u());
+    Eigen::VectorXd rigid = Eigen::VectorXd::Zero(model_->n_u());
+    for (int n = 0; n < model_->mesh().num_nodes(); ++n) rigid[model_->dofs().u_z(n)] = 1.0;
+    const Eigen::VectorXd mr = m_uu_ * rigid;
+    u -= (mr.dot(u) / mr.dot(rigid)) * rigid;  // M-orthogonal to the rigid mode
+    *u_static = std::move(u);
+  }
+  return c;
+}
+
+ModalResult ModalSolver::solve(const PiezoMaterialE& material, Electrodes electrodes,
+                               const ModalOptions& opt) {
+  validate(material, "ModalSolver::solve");
+  opt.validate();
+  const int nu = model_->n_u();
+  if (opt.n_modes >= nu) throw std::invalid_argument("ModalSolver::solve: n_modes >= n_u");
+  ModalResult res;
+  res.electrodes = electrodes;
+  const auto w = weights(material);
+
+  Eigen::VectorXd g;
+  res.c_clamped = clamped_capacitance(material, &g);
+
+  const double sigma = -std::pow(2.0 * M_PI * opt.shift_hz, 2);
+  if (!factor_.factorize(w, sigma, electrodes)) {
+    res.message = "singular shifted system";
+    return res;
+  }
+  CondensedShiftInvert op(factor_, nu, sigma);
+  Spectra::SparseSymMatProd<double> bop(m_uu_);
+  const int ncv = std::min<int>(nu, opt.ncv > 0 ? opt.ncv : std::max(2 * opt.n_modes + 1, opt.n_modes + 20));
+  Spectra::SymGEigsShiftSolver<CondensedShiftInvert, Spectra::SparseSymMatProd<double>,
+                               Spectra::GEigsMode::ShiftInvert>
+      eigs(op, bop, opt.n_modes, ncv, sigma);
+  eigs.init();
+  res.n_converged = static_cast<int>(
+      eigs.compute(Spectra::SortRule::LargestMagn, opt.max_iterations, opt.tolerance));
+  res.converged = eigs.info() == Spectra::CompInfo::Successful;
+  if (!res.converged) {
+    res.message = "Lanczos did not converge: " + std::to_string(res.n_converged) + " of " +
+                  std::to_string(opt.n_modes) + " modes";
+    if (res.n_converged == 0) return res;
+  }
+  const Eigen::VectorXd lambda = eigs.eigenvalues();
+  const Eigen::MatrixXd vecs = eigs.eigenvectors();
+  std::vector<int> order(lambda.size());
+  std::iota(order.begin(), order.end(), 0);
+  std::sort(order.begin(), order.end(), [&](int a, int b) { return lambda[a] < lambda[b]; });
+
+  SpMat k_uu = w[0] * model_->split().k_c[0];
+  for (int i = 1; i < 5; ++i) k_uu += w[i] * model_->split().k_c[i];
+
+  res.shapes.resize(nu, static_cast<Eigen::Index>(order.size()));
+  const double rigid_omega = 2.0 * M_PI * 1e-3 * opt.shift_hz;
+  for (std::size_t j = 0; j < order.size(); ++j) {
+    Eigen::VectorXd phi = vecs.col(order[j]);
+    const double mnorm = std::sqrt(phi.dot(m_uu_ * phi));
+    phi /= mnorm;
+    // Sign convention: largest |u_r| component positive (reproducible shapes).
+    Eigen::Index imax;
+    phi.cwiseAbs().maxCoeff(&imax);
+    if (phi[imax] < 0) phi = -phi;
+    Mode m;
+    m.eigenvalue = lambda[order[j]];
+    m.omega = std::sqrt(std::max(m.eigenvalue, 0.0));
+    m.frequency_hz = m.omega / (2.0 * M_PI);
+    const Eigen::VectorXd sym = 0.5 * (phi + model_->mirror(phi));
+    m.symmetric_fraction = sym.dot(m_uu_ * sym);
+    m.symmetry = m.symmetric_fraction > 0.99   ? Symmetry::symmetric
+                 : m.symmetric_fraction < 0.01 ? Symmetry::antisymmetric
+                                               : Symmetry::mixed;
+    m.participation = g.dot(phi);
+    m.kappa = phi.dot(k_uu * phi);
+    if (m.omega > rigid_omega)
+      m.coupling = m.participation * m.participation / (m.omega * m.omega * res.c_clamped);
+    m.electrically_active = m.symmetric_fraction > 0.5 && m.coupling > opt.active_coupling;
+    res.shapes.col(static_cast<Eigen::Index>(j)) = phi;
+    res.modes.push_back(m);
+  }
+  return res;
+}
+
+ModalPortModel ModalSolver::port_model(const PiezoMaterialE& material, const ModalOptions& opt,
+                                       ModalResult* sc_result) {
+  ModalResult sc = solve(material, Electrodes::short_circuit, opt);
+  ModalPortModel p;
+  p.converged = sc.converged;
+  p.c_clamped = sc.c_clamped;
+  Eigen::VectorXd us;
+  p.c_static = static_capacitance(material, &us);
+  double sum1 = 0, sum2 = 0, omega_max = 0;
+  const double rigid_omega = 2.0 * M_PI * 1e-3 * opt.shift_hz;
+  for (const auto& m : sc.modes) {
+    if (m.omega <= rigid_omega) continue;  // rigid translation: p = 0 exactly
+    p.modes.push_back({m.omega, m.participation, m.kappa, m.symmetry == Symmetry::symmetric});
+    const double p2w2 = m.participation * m.participation / (m.omega * m.omega);
+    sum1 += p2w2;
+    sum2 += p2w2 / (m.omega * m.omega);
+    omega_max = std::max(omega_max, m.omega);
+  }
+  // Residual pseudo-mode from the two moments of the truncated modes (port_model.hpp).
+  const double r1 = p.c_static - p.c_clamped - sum1;
+  const double r2 = us.dot(m_uu_ * us) - sum2;
+  p.c_residual = r1;
+  if (r1 > 0 && r2 > 0 && r1 / r2 > omega_max * omega_max) {
+    const double wr = std::sqrt(r1 / r2);
+    PortMode res;
+    res.omega = wr;
+    res.participation = std::sqrt(r1) * wr;
+    res.kappa = wr * wr;  // K_UU ≈ K_sc for the high modes it stands for
+    res.symmetric = true;
+    res.residual = true;
+    p.modes.push_back(res);
+    p.c_residual = 0.0;
+  }
+  if (sc_result) *sc_result = std::move(sc);
+  return p;
+}
+
+}  // namespace piezo::model

@@ -1,0 +1,91 @@
+#pragma once
+// Modal analysis of the tube with short-circuited (V = 0, eq. 88) or
+// open-circuited (zero net charge, static condensation eq. 92) electrodes:
+// the lowest N modes of (K_cond − ω²M) U = 0 by Spectra's shift-invert
+// generalized Lanczos, where (K_cond − σM)⁻¹ is applied by solving the full
+// coupled system (internal potentials condensed implicitly). The mechanical
+// boundary is free–free, so mode 0 is the rigid axial translation (0 Hz).
+//
+// Per mode: frequency, M-normalised shape, symmetry about the mid-plane, and
+// electrical participation p_k = gᵀφ_k (whether it shows up in the impedance).
+#include <Eigen/Core>
+#include <string>
+#include <vector>
+
+#include "model/coupled_solver.hpp"
+#include "model/port_model.hpp"
+#include "model/tube_model.hpp"
+
+namespace piezo::model {
+
+struct ModalOptions {
+  int n_modes = 10;
+  // σ = −(2π·shift_hz)²: below the rigid-body mode, so the N lowest modes are
+  // the N largest eigenvalues of the shift-inverted operator.
+  double shift_hz = 1000.0;
+  int ncv = 0;  // Lanczos basis size; 0 → max(2N + 1, N + 20) (capped at n_u)
+  double tolerance = 1e-10;
+  int max_iterations = 1000;
+  // A mode is electrically active if it is symmetric about the mid-plane and
+  // its coupling p_k²/(ω_k² C0) exceeds this (see model/README.md).
+  double active_coupling = 1e-3;
+  void validate() const;
+};
+
+enum class Symmetry { symmetric, antisymmetric, mixed };
+const char* to_string(Symmetry s);
+const char* to_string(Electrodes e);
+
+struct Mode {
+  double frequency_hz = 0;
+  double omega = 0;                // rad/s (0 for the rigid-body mode)
+  double eigenvalue = 0;           // ω² as computed (may be ~ −0 for the rigid mode)
+  Symmetry symmetry = Symmetry::mixed;
+  double symmetric_fraction = 0;   // ‖sym part‖²_M / ‖φ‖²_M, 1 = symmetric, 0 = antisymmetric
+  double participation = 0;        // p_k = gᵀφ_k  (C per unit modal coordinate)
+  double coupling = 0;             // p_k² / (ω_k² C0); 0 for the rigid mode
+  double kappa = 0;                // φ_kᵀ K_UU φ_k
+  bool electrically_active = false;
+};
+
+struct ModalResult {
+  Electrodes electrodes = Electrodes::short_circuit;
+  bool converged = false;   // all requested modes converged
+  int n_converged = 0;
+  std::string message;      // why not, when !converged
+  std::vector<Mode> modes;  // ascending frequency
+  Eigen::MatrixXd shapes;   // n_u × modes.size(), φᵀMφ = I
+  double c_clamped = 0;     // C0 (F)
+
+  // Electrically active modes (symmetric, coupling above threshold), ascending.
+  std::vector<double> active_frequencies_hz() const;
+};
+
+// Holds the symbolic factorisation: construct once per TubeModel and call for
+// as many materials as needed. Not thread-safe (one solver per thread).
+class ModalSolver {
+ public:
+  explicit ModalSolver(const TubeModel& model);
+
+  ModalResult solve(const PiezoMaterialE& material, Electrodes electrodes,
+                    const ModalOptions& options = {});
+
+  // Clamped capacitance C0 (U = 0) and the electrode load vector g (n_u).
+  double clamped_capacitance(const PiezoMaterialE& material, Eigen::VectorXd* g = nullptr);
+  // Capacitance of the free tube at ω → 0 (static solve, rigid mode clamped);
+  // optionally the static displacement for V = 1, rigid translation removed.
+  double static_capacitance(const PiezoMaterialE& material, Eigen::VectorXd* u_static = nullptr);
+  // Short-circuit modes + C0 + C_static (+ residual mode) → the electrical port model.
+  ModalPortModel port_model(const PiezoMaterialE& material, const ModalOptions& options = {},
+                            ModalResult* sc_result = nullptr);
+
+  const TubeModel& model() const { return *model_; }
+
+ private:
+  const TubeModel* model_;
+  CoupledFactor factor_;
+  SpMat m_uu_, k_uu_;
+  std::vector<int> all_u_;  // DOF list to clamp U for C0
+};
+
+}  // namespace piezo::model

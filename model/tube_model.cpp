@@ -1,0 +1,51 @@
+#include "model/tube_model.hpp"
+
+#include <cmath>
+
+namespace piezo::model {
+
+TubeModel::TubeModel(const TubeGeometry& geometry, const MeshOptions& mesh, int gauss_points)
+    : geometry_(geometry) {
+  geometry_.validate();
+  mesh_ = std::make_unique<TubeMesh>(geometry_, mesh);
+  dofs_ = std::make_unique<DofMap>(*mesh_);
+  system_ = SplitSystem(*mesh_, *dofs_, geometry_.density_kg_m3, gauss_points);
+  const int nu = dofs_->n_u(), np = dofs_->n_phi();
+  split_.m = system_.mass().topLeftCorner(nu, nu);
+  for (int i = 0; i < 5; ++i)
+    split_.k_c[i] = system_.matrix(static_cast<MaterialParam>(i)).topLeftCorner(nu, nu);
+  for (int i = 0; i < 3; ++i)
+    split_.k_e[i] = system_.matrix(static_cast<MaterialParam>(5 + i)).block(0, nu, nu, np);
+  for (int i = 0; i < 2; ++i)
+    split_.k_eps[i] = system_.matrix(static_cast<MaterialParam>(8 + i)).bottomRightCorner(np, np);
+}
+
+AssembledMatrices TubeModel::assemble(const PiezoMaterialE& material) const {
+  validate(material, "TubeModel::assemble");
+  const auto w = weights(material);
+  AssembledMatrices a;
+  a.m = split_.m;
+  a.k_uu = w[0] * split_.k_c[0];
+  for (int i = 1; i < 5; ++i) a.k_uu += w[i] * split_.k_c[i];
+  a.k_uphi = w[5] * split_.k_e[0];
+  for (int i = 1; i < 3; ++i) a.k_uphi += w[5 + i] * split_.k_e[i];
+  a.k_phiphi = w[8] * split_.k_eps[0] + w[9] * split_.k_eps[1];
+  return a;
+}
+
+Eigen::VectorXd TubeModel::mirror(const Eigen::VectorXd& u) const {
+  Eigen::VectorXd p(u.size());
+  for (int n = 0; n < mesh_->num_nodes(); ++n) {
+    const int m = mesh_->mirror(n);
+    p[dofs_->u_r(n)] = u[dofs_->u_r(m)];
+    p[dofs_->u_z(n)] = -u[dofs_->u_z(m)];
+  }
+  return p;
+}
+
+double TubeModel::analytic_capacitance(double eps33) const {
+  return 2.0 * M_PI * eps33 * geometry_.length_m /
+         std::log(geometry_.outer_diameter_m / geometry_.inner_diameter_m);
+}
+
+}  // namespace piezo::model
