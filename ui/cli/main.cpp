@@ -15,6 +15,7 @@ int main(int argc, char** argv) {
   app.add_flag("--json", ctx.json, "Machine-readable JSON output on stdout")->trigger_on_parse();
   register_capture_commands(app, ctx);
   register_demo_command(app, ctx);
+  register_model_commands(app, ctx);
   try {
     app.parse(argc, argv);
   } catch (const CLI::Success& e) {

@@ -1,0 +1,78 @@
+// FE tube model on the default mesh (MeshOptions{} = 2 × 24 Q2 elements):
+// assembly of the split system, re-weight + modal solve of 10 modes (short and
+// open circuit), a 600-point modal-superposition impedance sweep, and a
+// divider transient (20000 samples at 10 MS/s). Targets (2-core machine):
+// modal solve < 50 ms, sweep < 20 ms.
+#include <benchmark/benchmark.h>
+
+#include "model/harmonic.hpp"
+#include "model/material_presets.hpp"
+#include "model/modal.hpp"
+#include "model/transient.hpp"
+
+namespace {
+using namespace piezo::model;
+
+PiezoMaterialE material() {
+  return to_e_form(to_d_form(IsotropicPiezoParams{6.66e10, 0.3333, -210e-12, 2294 * kEps0}));
+}
+
+void BM_AssembleTubeModel(benchmark::State& state) {
+  for (auto _ : state) {
+    TubeModel tm(TubeGeometry{}, MeshOptions{});
+    benchmark::DoNotOptimize(tm.system().pattern().nonZeros());
+  }
+}
+BENCHMARK(BM_AssembleTubeModel)->Unit(benchmark::kMillisecond);
+
+void BM_ModalSolve10(benchmark::State& state) {
+  TubeModel tm(TubeGeometry{}, MeshOptions{});
+  ModalSolver s(tm);
+  const auto m = material();
+  const auto ec = state.range(0) ? Electrodes::open_circuit : Electrodes::short_circuit;
+  ModalOptions o;
+  o.n_modes = 10;
+  for (auto _ : state) benchmark::DoNotOptimize(s.solve(m, ec, o).modes.size());
+  state.SetLabel(state.range(0) ? "open circuit" : "short circuit");
+}
+BENCHMARK(BM_ModalSolve10)->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond);
+
+void BM_PortModel20(benchmark::State& state) {
+  TubeModel tm(TubeGeometry{}, MeshOptions{});
+  ModalSolver s(tm);
+  const auto m = material();
+  ModalOptions o;
+  o.n_modes = 20;
+  for (auto _ : state) benchmark::DoNotOptimize(s.port_model(m, o).modes.size());
+}
+BENCHMARK(BM_PortModel20)->Unit(benchmark::kMillisecond);
+
+void BM_ImpedanceSweep600(benchmark::State& state) {
+  TubeModel tm(TubeGeometry{}, MeshOptions{});
+  ModalSolver s(tm);
+  ModalOptions o;
+  o.n_modes = 20;
+  const auto port = s.port_model(material(), o);
+  const auto f = frequency_grid(200, 120000, 200);  // 600 points
+  RayleighDamping d;
+  d.beta = 1e-7;
+  for (auto _ : state) benchmark::DoNotOptimize(admittance_modal(port, f, d).data());
+  state.SetItemsProcessed(state.iterations() * static_cast<int64_t>(f.size()));
+}
+BENCHMARK(BM_ImpedanceSweep600)->Unit(benchmark::kMillisecond);
+
+void BM_DividerTransient20k(benchmark::State& state) {
+  TubeModel tm(TubeGeometry{}, MeshOptions{});
+  ModalSolver s(tm);
+  ModalOptions o;
+  o.n_modes = 20;
+  const auto port = s.port_model(material(), o);
+  RayleighDamping d;
+  d.beta = 1e-7;
+  DividerSimulator sim(port, d, DividerCircuit{}, 1e7);
+  std::vector<double> v1(20000);
+  for (std::size_t k = 0; k < v1.size(); ++k) v1[k] = std::exp(-3000.0 * k / 1e7);
+  for (auto _ : state) benchmark::DoNotOptimize(sim.simulate(v1).data());
+}
+BENCHMARK(BM_DividerTransient20k)->Unit(benchmark::kMillisecond);
+}  // namespace
