@@ -48,5 +48,6 @@ class ProgressBar {
 void register_capture_commands(CLI::App& app, Context& ctx);
 void register_demo_command(CLI::App& app, Context& ctx);
 void register_model_commands(CLI::App& app, Context& ctx);
+void register_update_command(CLI::App& app, Context& ctx);
 
 }  // namespace piezo::cli
