@@ -1,0 +1,58 @@
+// `piezobench model …` end to end: JSON shape of `model modal`, CSV of
+// `model impedance`, exit code 2 on bad input.
+#include <gtest/gtest.h>
+
+#include <array>
+#include <cstdio>
+#include <memory>
+#include <nlohmann/json.hpp>
+#include <string>
+
+namespace {
+struct Run {
+  int code;
+  std::string out;
+};
+Run run(const std::string& args) {
+  const std::string cmd = std::string(PIEZO_CLI) + " " + args + " 2>/dev/null";
+  std::unique_ptr<FILE, int (*)(FILE*)> p(popen(cmd.c_str(), "r"), pclose);
+  std::string out;
+  std::array<char, 4096> buf{};
+  std::size_t n;
+  while ((n = fread(buf.data(), 1, buf.size(), p.get())) > 0) out.append(buf.data(), n);
+  const int status = pclose(p.release());
+  return {WEXITSTATUS(status), out};
+}
+}  // namespace
+
+TEST(CmdModel, ModalJsonListsTheActiveModes) {
+  auto r = run("model modal --material apc850 --isotropic "
+               "--set YE11=6.66e10,nu12=0.3333,d31=-210e-12,epsT33_rel=2294 --modes 10 --json");
+  ASSERT_EQ(r.code, 0) << r.out;
+  auto j = nlohmann::json::parse(r.out);
+  ASSERT_EQ(j["short_circuit_hz"].size(), 3u);
+  ASSERT_EQ(j["open_circuit_hz"].size(), 3u);
+  EXPECT_EQ(j["modes"].size(), 20u);
+  // Tables 4/5 targets within 1 %.
+  const double res[3] = {51400, 55000, 82600}, anti[3] = {52400, 55800, 101600};
+  for (int i = 0; i < 3; ++i) {
+    EXPECT_NEAR(j["short_circuit_hz"][i].get<double>() / res[i], 1.0, 1e-2);
+    EXPECT_NEAR(j["open_circuit_hz"][i].get<double>() / anti[i], 1.0, 1e-2);
+  }
+}
+
+TEST(CmdModel, ImpedanceCsv) {
+  auto r = run("model impedance --material apc850 --fmin 1000 --fmax 3000 --step 1000 "
+               "--rayleigh-beta 1e-7 --csv");
+  ASSERT_EQ(r.code, 0);
+  EXPECT_EQ(r.out.rfind("f_hz,re_ohm,im_ohm\n", 0), 0u);
+  int lines = 0;
+  for (char c : r.out) lines += c == '\n';
+  EXPECT_EQ(lines, 4);
+}
+
+TEST(CmdModel, BadInputExitsTwo) {
+  EXPECT_EQ(run("model modal --material unobtainium --json").code, 2);
+  EXPECT_EQ(run("model modal --isotropic --set sE33=1e-11").code, 2);
+  EXPECT_EQ(run("model impedance --fmin 10 --fmax 5 --step 1").code, 2);
+}
