@@ -38,10 +38,11 @@ void BM_UpdateCmcm(benchmark::State& state) {
   const auto f = table45();
   pm::TubeModel tube(pm::TubeGeometry{});
   pm::ModalSolver solver(tube);
-  const auto cls = state.range(0) ? pu::MaterialClass::transversely_isotropic(
-                                        piezo::model::PiezoMaterialD{0, 0, -5.74e-12, 18.5e-12, 46e-12, 0,
-                                                                     400e-12, 590e-12, 1851 * pm::kEps0, 0})
-                                  : pu::MaterialClass::isotropic();
+  const auto cls =
+      state.range(0)
+          ? pu::MaterialClass::transversely_isotropic(piezo::model::PiezoMaterialD{
+                0, 0, -5.74e-12, 18.5e-12, 46e-12, 0, 400e-12, 590e-12, 1851 * pm::kEps0, 0})
+          : pu::MaterialClass::isotropic();
   for (auto _ : state) {
     auto r = pu::update_cmcm(tube, solver, cls, kOriginal, f);
     if (!r.ok()) state.SkipWithError(r.message.c_str());

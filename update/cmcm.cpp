@@ -12,13 +12,20 @@ namespace piezo::update {
 
 const char* to_string(UpdateStatus s) {
   switch (s) {
-    case UpdateStatus::converged: return "converged";
-    case UpdateStatus::max_iterations: return "max_iterations";
-    case UpdateStatus::ambiguous_pairing: return "ambiguous_pairing";
-    case UpdateStatus::too_few_modes: return "too_few_modes";
-    case UpdateStatus::non_physical: return "non_physical";
-    case UpdateStatus::solver_failure: return "solver_failure";
-    default: return "bad_input";
+    case UpdateStatus::converged:
+      return "converged";
+    case UpdateStatus::max_iterations:
+      return "max_iterations";
+    case UpdateStatus::ambiguous_pairing:
+      return "ambiguous_pairing";
+    case UpdateStatus::too_few_modes:
+      return "too_few_modes";
+    case UpdateStatus::non_physical:
+      return "non_physical";
+    case UpdateStatus::solver_failure:
+      return "solver_failure";
+    default:
+      return "bad_input";
   }
 }
 
@@ -33,7 +40,7 @@ TsvdSolution solve_tsvd(const Eigen::MatrixXd& g, const Eigen::VectorXd& f, doub
   const double cut = rel_tol * s.singular_values[0];
   const Eigen::VectorXd utf = svd.matrixU().transpose() * f;
   for (Eigen::Index p = 0; p < s.singular_values.size(); ++p) {
-    if (!(s.singular_values[p] > cut)) break;  // sorted decreasingly (eq. 192)
+    if (!(s.singular_values[p] > cut)) break;                       // sorted decreasingly (eq. 192)
     s.x += svd.matrixV().col(p) * (utf[p] / s.singular_values[p]);  // eq. 193
     ++s.rank;
   }
@@ -64,7 +71,7 @@ CmcmEquations cmcm_equations(const Eigen::MatrixXd& k, const std::vector<Eigen::
       if (std::abs(mx(i, j)) < min_cross * ni * nj) continue;
       const double b = lambda_star[j] / lambda[i];  // eq. 185
       Eigen::VectorXd row(ne + nb);
-      for (int n = 0; n < ne; ++n) row[n] = an[n](i, j) / kx(i, j);           // eq. 182
+      for (int n = 0; n < ne; ++n) row[n] = an[n](i, j) / kx(i, j);            // eq. 182
       for (int n = 0; n < nb; ++n) row[ne + n] = -b * bn[n](i, j) / mx(i, j);  // eqs 183, 187
       rows.push_back(row);
       rhs.push_back(b - 1.0);
@@ -112,7 +119,8 @@ CmcmResult extended_cmcm(const model::TubeModel& tube, model::ModalSolver& solve
       return res;
     }
   for (int j = 0; j < nj; ++j)
-    if (!(phase.measured_hz[j] > 0) || (j > 0 && !(phase.measured_hz[j] > phase.measured_hz[j - 1]))) {
+    if (!(phase.measured_hz[j] > 0) ||
+        (j > 0 && !(phase.measured_hz[j] > phase.measured_hz[j - 1]))) {
       res.message = phase.name + ": measured frequencies must be positive and strictly ascending";
       return res;
     }
@@ -226,9 +234,8 @@ CmcmResult extended_cmcm(const model::TubeModel& tube, model::ModalSolver& solve
           std::ostringstream s;
           s.precision(4);
           s << phase.name << ": ambiguous pairing at iteration " << it << " for measured mode "
-            << j + 1 << " (" << phase.measured_hz[j] << " Hz): best MAC " << mac1
-            << ", runner-up " << mac2 << " (need >= " << opt.mac_min << " and a margin of "
-            << opt.mac_margin << ")";
+            << j + 1 << " (" << phase.measured_hz[j] << " Hz): best MAC " << mac1 << ", runner-up "
+            << mac2 << " (need >= " << opt.mac_min << " and a margin of " << opt.mac_margin << ")";
           res.status = UpdateStatus::ambiguous_pairing;
           res.message = s.str();
           return res;
@@ -258,8 +265,8 @@ CmcmResult extended_cmcm(const model::TubeModel& tube, model::ModalSolver& solve
     Eigen::VectorXd f(static_cast<Eigen::Index>(pairs.size()));
     for (std::size_t m = 0; m < pairs.size(); ++m) {
       const auto [i, j] = pairs[m];
-      for (int n = 0; n < nt; ++n) g(m, n) = an[n](i, j) / kx(i, j);         // eq. 182
-      f[m] = (lambda_star[j] * mx(i, j) - rem(i, j)) / kx(i, j) - 1.0;       // eqs 185-187
+      for (int n = 0; n < nt; ++n) g(m, n) = an[n](i, j) / kx(i, j);    // eq. 182
+      f[m] = (lambda_star[j] * mx(i, j) - rem(i, j)) / kx(i, j) - 1.0;  // eqs 185-187
     }
     const TsvdSolution sol = solve_tsvd(g, f, opt.svd_rel_tol);  // eq. 193
     res.equations = static_cast<int>(pairs.size());

@@ -68,26 +68,26 @@ CmcmEquations cmcm_equations(const Eigen::MatrixXd& k, const std::vector<Eigen::
 
 // ---------------------------------------------------------------- extended CMCM on the tube
 struct CmcmPhase {
-  std::string name;                       // "elastic" / "piezo" (messages)
+  std::string name;  // "elastic" / "piezo" (messages)
   model::Electrodes electrodes = model::Electrodes::short_circuit;
-  std::vector<double> theta0;             // base coordinates (non-zero)
+  std::vector<double> theta0;  // base coordinates (non-zero)
   // Material for coordinates θ; throws std::invalid_argument when non-physical.
   std::function<model::PiezoMaterialE(std::span<const double>)> material;
-  std::vector<double> measured_hz;        // ascending; paired with active modes in order
+  std::vector<double> measured_hz;  // ascending; paired with active modes in order
 };
 
 struct CmcmOptions {
-  int max_iterations = 500;        // the seed needed 300 for α3
-  double tolerance = 1e-9;         // converged when max_n |α_k − α_{k−1}| < tolerance
+  int max_iterations = 500;  // the seed needed 300 for α3
+  double tolerance = 1e-9;   // converged when max_n |α_k − α_{k−1}| < tolerance
   double svd_rel_tol = 1e-10;
-  double min_cross = 1e-3;         // see cmcm_equations
+  double min_cross = 1e-3;  // see cmcm_equations
   // Include the i ≠ j equations. Exact at the fixed point, but with lagged shapes
   // they restate the previous iterate to first order (Φ_iᵀMΦ*_j ≈
   // Σ α_n Φ_iᵀK_nΦ_j/(λ_j − λ_i)), so they pin α and the iteration creeps, as in
   // the seed's Fig. 37 (300 iterations). Off by default; see update/README.md.
   bool cross_modes = false;
-  double mac_min = 0.9;            // tracked mode must keep MAC ≥ mac_min …
-  double mac_margin = 0.2;         // … and beat the runner-up by this much
+  double mac_min = 0.9;     // tracked mode must keep MAC ≥ mac_min …
+  double mac_margin = 0.2;  // … and beat the runner-up by this much
   model::ModalOptions modal = [] {
     model::ModalOptions o;
     o.n_modes = 12;
@@ -98,15 +98,15 @@ struct CmcmOptions {
 struct CmcmResult {
   UpdateStatus status = UpdateStatus::bad_input;
   std::string message;
-  std::vector<double> alpha;   // relative corrections of theta0
-  std::vector<double> theta;   // θ0 (1 + α)
+  std::vector<double> alpha;  // relative corrections of theta0
+  std::vector<double> theta;  // θ0 (1 + α)
   int iterations = 0;
   std::vector<std::vector<double>> alpha_history;  // one entry per iteration
-  std::vector<double> model_hz_initial;  // paired model frequencies of the base model
-  std::vector<double> model_hz;          // paired frequencies of the last modal solve
-  std::vector<int> mode_index;           // index of each paired mode in the last solve
-  double min_mac = 1.0;                  // lowest tracking MAC seen
-  int equations = 0, rank = 0;           // last G γ = f
+  std::vector<double> model_hz_initial;            // paired model frequencies of the base model
+  std::vector<double> model_hz;                    // paired frequencies of the last modal solve
+  std::vector<int> mode_index;                     // index of each paired mode in the last solve
+  double min_mac = 1.0;                            // lowest tracking MAC seen
+  int equations = 0, rank = 0;                     // last G γ = f
   bool ok() const { return status == UpdateStatus::converged; }
 };
 

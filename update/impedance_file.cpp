@@ -27,9 +27,11 @@ void check_curve(const ImpedanceCurve& c, const std::string& path, const char* f
     throw std::invalid_argument(std::string(fn) + ": fewer than 5 points in '" + path + "'");
   for (std::size_t i = 0; i < c.f_hz.size(); ++i) {
     if (!(c.f_hz[i] >= 0) || !std::isfinite(c.z_ohm[i].real()) || !std::isfinite(c.z_ohm[i].imag()))
-      throw std::invalid_argument(std::string(fn) + ": bad value on data row " + std::to_string(i + 1));
+      throw std::invalid_argument(std::string(fn) + ": bad value on data row " +
+                                  std::to_string(i + 1));
     if (i > 0 && !(c.f_hz[i] > c.f_hz[i - 1]))
-      throw std::invalid_argument(std::string(fn) + ": frequencies must be strictly ascending (row " +
+      throw std::invalid_argument(std::string(fn) +
+                                  ": frequencies must be strictly ascending (row " +
                                   std::to_string(i + 1) + ")");
   }
 }
@@ -38,7 +40,8 @@ bool parse_numbers(const std::string& line, char sep, std::vector<double>& out) 
   out.clear();
   std::string item;
   std::stringstream ss(line);
-  while (sep == ' ' ? static_cast<bool>(ss >> item) : static_cast<bool>(std::getline(ss, item, sep))) {
+  while (sep == ' ' ? static_cast<bool>(ss >> item)
+                    : static_cast<bool>(std::getline(ss, item, sep))) {
     std::size_t used = 0;
     try {
       out.push_back(std::stod(item, &used));
@@ -108,19 +111,26 @@ ImpedanceCurve read_touchstone_s1p(const std::string& path) {
     ++lineno;
     if (auto bang = line.find('!'); bang != std::string::npos) line.resize(bang);
     if (line.find_first_not_of(" \t\r") == std::string::npos) continue;
-    if (line.find_first_not_of(" \t") != std::string::npos && line[line.find_first_not_of(" \t")] == '#') {
+    if (line.find_first_not_of(" \t") != std::string::npos &&
+        line[line.find_first_not_of(" \t")] == '#') {
       if (option_seen) continue;  // only the first option line counts
       option_seen = true;
       std::stringstream ss(line.substr(line.find('#') + 1));
       std::string tok;
       while (ss >> tok) {
         tok = lower(tok);
-        if (tok == "hz") unit = 1;
-        else if (tok == "khz") unit = 1e3;
-        else if (tok == "mhz") unit = 1e6;
-        else if (tok == "ghz") unit = 1e9;
-        else if (tok == "s" || tok == "z") param = tok;
-        else if (tok == "ri" || tok == "ma" || tok == "db") format = tok;
+        if (tok == "hz")
+          unit = 1;
+        else if (tok == "khz")
+          unit = 1e3;
+        else if (tok == "mhz")
+          unit = 1e6;
+        else if (tok == "ghz")
+          unit = 1e9;
+        else if (tok == "s" || tok == "z")
+          param = tok;
+        else if (tok == "ri" || tok == "ma" || tok == "db")
+          format = tok;
         else if (tok == "r") {
           if (!(ss >> z0) || !(z0 > 0))
             throw std::invalid_argument(std::string(fn) + ": bad reference impedance");
@@ -134,7 +144,8 @@ ImpedanceCurve read_touchstone_s1p(const std::string& path) {
       throw std::invalid_argument(std::string(fn) + ": line " + std::to_string(lineno) +
                                   " is not 'f a b' of a one-port file");
     std::complex<double> x;
-    if (format == "ri") x = {v[1], v[2]};
+    if (format == "ri")
+      x = {v[1], v[2]};
     else {
       const double mag = format == "ma" ? v[1] : std::pow(10.0, v[1] / 20.0);
       x = std::polar(mag, v[2] * M_PI / 180.0);
@@ -149,7 +160,8 @@ ImpedanceCurve read_touchstone_s1p(const std::string& path) {
 
 ImpedanceCurve read_impedance_file(const std::string& path) {
   const auto dot = path.rfind('.');
-  if (dot != std::string::npos && lower(path.substr(dot)) == ".s1p") return read_touchstone_s1p(path);
+  if (dot != std::string::npos && lower(path.substr(dot)) == ".s1p")
+    return read_touchstone_s1p(path);
   return read_impedance_csv(path);
 }
 
@@ -165,9 +177,11 @@ void write_impedance_csv(const std::string& path, const ImpedanceCurve& c) {
 ExtractedFeatures extract_features(const ImpedanceCurve& c, const FeatureOptions& opt) {
   const char* fn = "extract_features";
   const std::size_t n = c.f_hz.size();
-  if (n < 5 || c.z_ohm.size() != n) throw std::invalid_argument(std::string(fn) + ": too few points");
+  if (n < 5 || c.z_ohm.size() != n)
+    throw std::invalid_argument(std::string(fn) + ": too few points");
   std::vector<double> db(n);
-  for (std::size_t i = 0; i < n; ++i) db[i] = 20.0 * std::log10(std::max(std::abs(c.z_ohm[i]), 1e-300));
+  for (std::size_t i = 0; i < n; ++i)
+    db[i] = 20.0 * std::log10(std::max(std::abs(c.z_ohm[i]), 1e-300));
   ExtractedFeatures out;
   auto& mf = out.features;
   std::size_t i = 1;
@@ -201,7 +215,8 @@ ExtractedFeatures extract_features(const ImpedanceCurve& c, const FeatureOptions
     i = k + 1;
   }
   if (mf.resonances_hz.empty())
-    throw std::invalid_argument(std::string(fn) + ": no resonance/anti-resonance pair with at least " +
+    throw std::invalid_argument(std::string(fn) +
+                                ": no resonance/anti-resonance pair with at least " +
                                 std::to_string(opt.min_prominence_db) + " dB prominence");
   const double f_max_low = opt.low_f_fraction * mf.resonances_hz.front();
   int best = -1;

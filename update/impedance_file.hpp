@@ -14,7 +14,7 @@
 namespace piezo::update {
 
 struct ImpedanceCurve {
-  std::vector<double> f_hz;                  // strictly ascending
+  std::vector<double> f_hz;  // strictly ascending
   std::vector<std::complex<double>> z_ohm;
 };
 
@@ -25,17 +25,17 @@ ImpedanceCurve read_impedance_file(const std::string& path);  // by extension (.
 void write_impedance_csv(const std::string& path, const ImpedanceCurve& c);
 
 struct FeatureOptions {
-  int max_modes = 3;                  // resonance/anti-resonance pairs kept (lowest first)
+  int max_modes = 3;  // resonance/anti-resonance pairs kept (lowest first)
   // Rise from a minimum to the following maximum, and the deepest dip stepped
   // over on the way up (weak inactive modes: 1.5 dB at ζ = 2.5e-4 on our tube).
   double min_prominence_db = 3.0;
-  double low_f_fraction = 0.05;       // low-f point at or below this fraction of the first resonance …
+  double low_f_fraction = 0.05;  // low-f point at or below this fraction of the first resonance …
   double capacitive_phase_tol_deg = 5.0;  // … where the phase is within this of −90°
 };
 
 struct ExtractedFeatures {
   MeasuredFeatures features;
-  double low_z_phase_deg = 0;         // phase of Z at the chosen low-frequency point
+  double low_z_phase_deg = 0;  // phase of Z at the chosen low-frequency point
 };
 
 // Throws std::invalid_argument when no resonance pair or no capacitive point is found.

@@ -16,8 +16,8 @@ namespace {
 constexpr int kNp = 4;
 
 struct Evaluation {
-  Eigen::VectorXd r;            // weighted residuals
-  Eigen::MatrixXd j;            // weighted Jacobian (filled on demand)
+  Eigen::VectorXd r;  // weighted residuals
+  Eigen::MatrixXd j;  // weighted Jacobian (filled on demand)
   std::vector<double> f_sc, f_oc;
   double cost = 0;
 };
@@ -116,7 +116,8 @@ class Problem {
       }
       return true;
     };
-    if (!modes(model::Electrodes::short_circuit, mf_.resonances_hz, 0, ev.f_sc)) return std::nullopt;
+    if (!modes(model::Electrodes::short_circuit, mf_.resonances_hz, 0, ev.f_sc))
+      return std::nullopt;
     if (!modes(model::Electrodes::open_circuit, mf_.antiresonances_hz, nr_, ev.f_oc))
       return std::nullopt;
     const double w2 = std::pow(2.0 * M_PI * mf_.low_z_hz, 2);
@@ -214,9 +215,9 @@ LmResult update_lm(const model::TubeModel& tube, model::ModalSolver& solver,
   res.model_resonances_hz = cur->f_sc;
   res.model_antiresonances_hz = cur->f_oc;
   if (!converged)
-    return done(UpdateStatus::max_iterations,
-                "Levenberg-Marquardt did not converge in " + std::to_string(opt.max_iterations) +
-                    " iterations");
+    return done(UpdateStatus::max_iterations, "Levenberg-Marquardt did not converge in " +
+                                                  std::to_string(opt.max_iterations) +
+                                                  " iterations");
   return done(UpdateStatus::converged, "");
 }
 

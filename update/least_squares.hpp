@@ -30,8 +30,8 @@ struct LmResult {
   std::string message;
   TubeParams updated;
   int iterations = 0, evaluations = 0;
-  double cost = 0;                       // ½‖r‖² at the answer
-  std::vector<double> residuals;         // resonances, anti-resonances, capacitance (relative)
+  double cost = 0;                // ½‖r‖² at the answer
+  std::vector<double> residuals;  // resonances, anti-resonances, capacitance (relative)
   std::vector<double> model_resonances_hz, model_antiresonances_hz;
   double seconds = 0;
   bool ok() const { return status == UpdateStatus::converged; }

@@ -50,7 +50,7 @@ double eps_s33_from(double c_sum, double eps_t33, double a) {
 
 double d31_from_a(double c_sum, double eps_t33, double a, double d31_sign) {
   const double e31 = std::sqrt(a * eps_s33_from(c_sum, eps_t33, a));  // eq. 252 (magnitude)
-  return (d31_sign < 0 ? -e31 : e31) / c_sum;                          // eq. 253
+  return (d31_sign < 0 ? -e31 : e31) / c_sum;                         // eq. 253
 }
 
 Coordinates MaterialClass::coordinates(const TubeParams& p) const {
@@ -78,12 +78,12 @@ TubeParams MaterialClass::params(const Coordinates& q, double d31_sign) const {
     throw std::invalid_argument("MaterialClass::params: non-physical stiffnesses c1, c2");
   TubeParams p;
   if (kind_ == ModelClass::isotropic) {
-    p.nu12 = q.c2 / (q.c1 + q.c2);                                     // eq. 254
+    p.nu12 = q.c2 / (q.c1 + q.c2);                                    // eq. 254
     p.y_e11 = q.c2 / p.nu12 * (1.0 + p.nu12) * (1.0 - 2.0 * p.nu12);  // eq. 255
-    if (q.c2 == 0) p.y_e11 = q.c1;                                     // nu = 0 limit
+    if (q.c2 == 0) p.y_e11 = q.c1;                                    // nu = 0 limit
   } else {
-    p.nu12 = q.c2 / q.c1;                           // −sE12/sE11
-    p.y_e11 = (q.c1 * q.c1 - q.c2 * q.c2) / q.c1;   // 1/sE11
+    p.nu12 = q.c2 / q.c1;                          // −sE12/sE11
+    p.y_e11 = (q.c1 * q.c1 - q.c2 * q.c2) / q.c1;  // 1/sE11
   }
   p.eps_t33 = q.eps_t33;
   p.d31 = d31_from_a(q.c1 + q.c2, q.eps_t33, q.a, d31_sign);

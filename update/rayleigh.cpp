@@ -20,8 +20,9 @@ RayleighFit rayleigh_from_damping(double f1_hz, double zeta1, double f2_hz, doub
     return r;
   }
   const double w1 = 2 * M_PI * f1_hz, w2 = 2 * M_PI * f2_hz;
-  r.damping.alpha = (2 * zeta1 * w1 * w2 * w2 - 2 * zeta2 * w1 * w1 * w2) / (w2 * w2 - w1 * w1);  // eq. 168
-  r.damping.beta = (2 * zeta1 * w1 - 2 * zeta2 * w2) / (w1 * w1 - w2 * w2);                    // eq. 169
+  r.damping.alpha =
+      (2 * zeta1 * w1 * w2 * w2 - 2 * zeta2 * w1 * w1 * w2) / (w2 * w2 - w1 * w1);  // eq. 168
+  r.damping.beta = (2 * zeta1 * w1 - 2 * zeta2 * w2) / (w1 * w1 - w2 * w2);         // eq. 169
   if (r.damping.alpha < 0 || r.damping.beta < 0) {
     std::ostringstream s;
     s.precision(4);

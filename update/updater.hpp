@@ -44,16 +44,17 @@ struct UpdateResult {
   TubeParams original, updated;
   Coordinates original_q, updated_q;
   EFormSummary updated_e;
-  double alpha1 = 0, alpha2 = 0, alpha3 = 0;  // relative to the original c1, c2 and the seed's base a
+  double alpha1 = 0, alpha2 = 0,
+         alpha3 = 0;  // relative to the original c1, c2 and the seed's base a
   int iterations_elastic = 0, iterations_piezo = 0;  // CMCM iterations, summed over sweeps
   std::vector<int> elastic_per_sweep, piezo_per_sweep;
   int sweeps = 0;
-  double eps_t33_eq201 = 0;        // eq. 201
-  double c_measured = 0;           // 1/(2π f_L |Z_L|)
-  double c_model_after = 0;        // FE model at f_L, updated
+  double eps_t33_eq201 = 0;  // eq. 201
+  double c_measured = 0;     // 1/(2π f_L |Z_L|)
+  double c_model_after = 0;  // FE model at f_L, updated
   std::vector<double> model_resonances_before_hz, model_antiresonances_before_hz;
   std::vector<double> model_resonances_hz, model_antiresonances_hz;  // updated model
-  CmcmResult elastic, piezo;       // details of the last sweep
+  CmcmResult elastic, piezo;                                         // details of the last sweep
   double seconds = 0;
   bool ok() const { return status == UpdateStatus::converged; }
 };

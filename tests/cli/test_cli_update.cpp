@@ -37,9 +37,9 @@ TEST(CliUpdate, Table45JsonFields) {
 }
 
 TEST(CliUpdate, BothMethodsAndOverlay) {
-  const std::string overlay =
-      (std::filesystem::temp_directory_path() / ("piezo_overlay_" + std::to_string(::getpid()) + ".csv"))
-          .string();
+  const std::string overlay = (std::filesystem::temp_directory_path() /
+                               ("piezo_overlay_" + std::to_string(::getpid()) + ".csv"))
+                                  .string();
   const auto r = run_cli(kTable45 + "--method both --overlay " + overlay + " --json");
   ASSERT_EQ(r.exit_code, 0) << r.err;
   const auto j = nlohmann::json::parse(r.out);
@@ -66,7 +66,7 @@ TEST(CliUpdate, NegativeRayleighIsRefusedNotUsed) {
 
 TEST(CliUpdate, BadInputExitsTwo) {
   EXPECT_EQ(run_cli("update --resonances 51400,55000 --json").exit_code, 2);  // no anti-res / low-z
-  EXPECT_EQ(run_cli(kTable45 + "--low-z 26804 --json").exit_code, 2);        // not OHM@HZ
+  EXPECT_EQ(run_cli(kTable45 + "--low-z 26804 --json").exit_code, 2);         // not OHM@HZ
   EXPECT_EQ(run_cli(kTable45 + "--method newton --json").exit_code, 2);
   EXPECT_EQ(run_cli(kTable45 + "--set foo=1 --json").exit_code, 2);
   EXPECT_EQ(run_cli("update /nonexistent/z.csv --json").exit_code, 2);

@@ -77,7 +77,8 @@ TEST(CmcmClassic, RecoversStiffnessAndMassCorrections) {
   const std::vector<double> k0{4e6, 3e6, 3e6, 2e6, 2e6, 1e6};
   const auto kn = chain_springs(n, k0);
   // Two stiffness groups and two mass groups.
-  std::vector<Eigen::MatrixXd> kg(2, Eigen::MatrixXd::Zero(n, n)), mg(2, Eigen::MatrixXd::Zero(n, n));
+  std::vector<Eigen::MatrixXd> kg(2, Eigen::MatrixXd::Zero(n, n)),
+      mg(2, Eigen::MatrixXd::Zero(n, n));
   for (int e = 0; e < n; ++e) kg[e < 3 ? 0 : 1] += kn[e];
   for (int i = 0; i < n; ++i) mg[i < 2 ? 0 : 1](i, i) = 1.0 + 0.1 * i;
   const Eigen::MatrixXd k = kg[0] + kg[1], m = mg[0] + mg[1];
@@ -85,8 +86,8 @@ TEST(CmcmClassic, RecoversStiffnessAndMassCorrections) {
   // groups would leave (α, β) = t·(1, 1, 1, 1) in the null space of G.
   const Eigen::MatrixXd ks = 1.12 * kg[0] + 0.93 * kg[1], ms = 0.95 * mg[0] + mg[1];
   const auto a = eig(k, m), b = eig(ks, ms);
-  const auto eq = cmcm_equations(k, kg, m, {mg[0]}, a.phi, a.lambda, b.phi.leftCols(3),
-                                 b.lambda.head(3));
+  const auto eq =
+      cmcm_equations(k, kg, m, {mg[0]}, a.phi, a.lambda, b.phi.leftCols(3), b.lambda.head(3));
   const auto s = solve_tsvd(eq.g, eq.f);
   ASSERT_EQ(s.rank, 3);
   EXPECT_NEAR(s.x[0], 0.12, 1e-9);

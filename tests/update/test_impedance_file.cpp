@@ -116,7 +116,8 @@ TEST_F(FileUpdate, UpdateFromACsvFile) {
   write_impedance_csv(p, fe_curve(*solver_, cls.e_form(kTarget)));
   const auto ex = extract_features(read_impedance_file(p));
   fs::remove(p);
-  const auto r = update_cmcm(*tube_, *solver_, cls, {6.3e10, 0.31, -175e-12, 1576 * kEps0}, ex.features);
+  const auto r =
+      update_cmcm(*tube_, *solver_, cls, {6.3e10, 0.31, -175e-12, 1576 * kEps0}, ex.features);
   ASSERT_TRUE(r.ok()) << r.message;
   std::printf("[file] f_L %.0f Hz: YE11 %+.4f%% nu12 %+.4f%% d31 %+.4f%% epsT33 %+.4f%%\n",
               ex.features.low_z_hz, 100 * (r.updated.y_e11 / kTarget.y_e11 - 1),

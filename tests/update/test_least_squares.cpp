@@ -46,10 +46,11 @@ double max_rel_diff(const TubeParams& a, const TubeParams& b) {
 
 void print(const char* what, const TubeParams& c, const TubeParams& l, double t_c, double t_l,
            int it_l) {
-  std::printf("[%s] CMCM vs LM: YE11 %.6g / %.6g, nu12 %.6f / %.6f, d31 %.5g / %.5g, "
-              "epsT33 %.2f / %.2f eps0; max rel diff %.2e; %.3f s / %.3f s (LM %d iterations)\n",
-              what, c.y_e11, l.y_e11, c.nu12, l.nu12, c.d31, l.d31, c.eps_t33 / kEps0,
-              l.eps_t33 / kEps0, max_rel_diff(c, l), t_c, t_l, it_l);
+  std::printf(
+      "[%s] CMCM vs LM: YE11 %.6g / %.6g, nu12 %.6f / %.6f, d31 %.5g / %.5g, "
+      "epsT33 %.2f / %.2f eps0; max rel diff %.2e; %.3f s / %.3f s (LM %d iterations)\n",
+      what, c.y_e11, l.y_e11, c.nu12, l.nu12, c.d31, l.d31, c.eps_t33 / kEps0, l.eps_t33 / kEps0,
+      max_rel_diff(c, l), t_c, t_l, it_l);
 }
 
 // Inverse crime: both must land on the target, so they agree to 1e-6
@@ -111,7 +112,8 @@ TEST_F(LeastSquares, TransverselyIsotropicClassConverges) {
 TEST_F(LeastSquares, IterationCapIsAStatus) {
   LmOptions o;
   o.max_iterations = 1;
-  const auto lm = update_lm(*tube_, *solver_, MaterialClass::isotropic(), kOriginal, published(), o);
+  const auto lm =
+      update_lm(*tube_, *solver_, MaterialClass::isotropic(), kOriginal, published(), o);
   EXPECT_EQ(lm.status, UpdateStatus::max_iterations);
   EXPECT_FALSE(lm.message.empty());
 }

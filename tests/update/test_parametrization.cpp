@@ -45,7 +45,8 @@ TEST(Parametrization, RoundTripBothClasses) {
   nominal.d33 = 400e-12;
   nominal.d15 = 590e-12;
   nominal.eps_t11 = 1851 * kEps0;
-  for (const auto& cls : {MaterialClass::isotropic(), MaterialClass::transversely_isotropic(nominal)}) {
+  for (const auto& cls :
+       {MaterialClass::isotropic(), MaterialClass::transversely_isotropic(nominal)}) {
     const TubeParams p{6.66e10, 0.3333, -210e-12, 2294 * kEps0};
     const auto back = cls.params(cls.coordinates(p));
     EXPECT_NEAR(back.y_e11 / p.y_e11, 1.0, 1e-13) << to_string(cls.kind());

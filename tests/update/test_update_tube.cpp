@@ -46,7 +46,8 @@ class TubeUpdate : public ::testing::Test {
     mf.resonances_hz = f.resonances_hz;
     mf.antiresonances_hz = f.antiresonances_hz;
     mf.low_z_hz = 400;
-    mf.low_z_ohm = 1.0 / (2 * M_PI * 400 * model_capacitance(*solver_, m, 400, CmcmOptions{}.modal));
+    mf.low_z_ohm =
+        1.0 / (2 * M_PI * 400 * model_capacitance(*solver_, m, 400, CmcmOptions{}.modal));
     return mf;
   }
   static MeasuredFeatures published() {
@@ -129,7 +130,8 @@ TEST_F(TubeUpdate, PublishedTable45Features) {
 TEST_F(TubeUpdate, AnalyticCapacitanceOptionUsesEq201) {
   UpdateOptions o;
   o.capacitance = CapacitanceModel::analytic;
-  const auto r = update_cmcm(*tube_, *solver_, MaterialClass::isotropic(), kOriginal, published(), o);
+  const auto r =
+      update_cmcm(*tube_, *solver_, MaterialClass::isotropic(), kOriginal, published(), o);
   ASSERT_TRUE(r.ok()) << r.message;
   EXPECT_DOUBLE_EQ(r.updated.eps_t33, r.eps_t33_eq201);
   EXPECT_NEAR(rel(r.updated.eps_t33, kTarget.eps_t33), 0, 1e-3);
@@ -156,10 +158,11 @@ TEST_F(TubeUpdate, SinglePassIterationCountsAndCrossModeCreep) {
   cross.cross_modes = true;
   cross.max_iterations = 100;
   const auto creep = extended_cmcm(*tube_, *solver_, p, cross);
-  std::printf("[single pass, elastic] diagonal equations: %d iterations, alpha %.6f %.6f; with "
-              "cross-mode equations: %s after %d, alpha %.6f %.6f\n",
-              diag.iterations, diag.alpha[0], diag.alpha[1], to_string(creep.status),
-              creep.iterations, creep.alpha[0], creep.alpha[1]);
+  std::printf(
+      "[single pass, elastic] diagonal equations: %d iterations, alpha %.6f %.6f; with "
+      "cross-mode equations: %s after %d, alpha %.6f %.6f\n",
+      diag.iterations, diag.alpha[0], diag.alpha[1], to_string(creep.status), creep.iterations,
+      creep.alpha[0], creep.alpha[1]);
   EXPECT_EQ(creep.status, UpdateStatus::max_iterations);
   EXPECT_FALSE(creep.message.empty());
   EXPECT_GT(std::abs(creep.alpha[0] - diag.alpha[0]), 1e-4);  // still creeping
@@ -169,7 +172,8 @@ TEST_F(TubeUpdate, IterationCapIsAStatusWithAMessage) {
   UpdateOptions o;
   o.cmcm.max_iterations = 2;
   o.cmcm.tolerance = 1e-14;
-  const auto r = update_cmcm(*tube_, *solver_, MaterialClass::isotropic(), kOriginal, published(), o);
+  const auto r =
+      update_cmcm(*tube_, *solver_, MaterialClass::isotropic(), kOriginal, published(), o);
   EXPECT_EQ(r.status, UpdateStatus::max_iterations);
   EXPECT_NE(r.message.find("not converged"), std::string::npos) << r.message;
 }
@@ -178,7 +182,8 @@ TEST_F(TubeUpdate, AmbiguousPairingIsReported) {
   UpdateOptions o;
   o.cmcm.mac_min = 0.9;
   o.cmcm.mac_margin = 1.0;  // no mode can beat its runner-up by a full unit of MAC
-  const auto r = update_cmcm(*tube_, *solver_, MaterialClass::isotropic(), kOriginal, published(), o);
+  const auto r =
+      update_cmcm(*tube_, *solver_, MaterialClass::isotropic(), kOriginal, published(), o);
   EXPECT_EQ(r.status, UpdateStatus::ambiguous_pairing);
   EXPECT_NE(r.message.find("ambiguous pairing"), std::string::npos) << r.message;
 }
@@ -186,7 +191,8 @@ TEST_F(TubeUpdate, AmbiguousPairingIsReported) {
 TEST_F(TubeUpdate, TooFewActiveModesIsReported) {
   UpdateOptions o;
   o.cmcm.modal.n_modes = 3;  // rigid + 2 elastic modes: at most one active
-  const auto r = update_cmcm(*tube_, *solver_, MaterialClass::isotropic(), kOriginal, published(), o);
+  const auto r =
+      update_cmcm(*tube_, *solver_, MaterialClass::isotropic(), kOriginal, published(), o);
   EXPECT_EQ(r.status, UpdateStatus::too_few_modes);
   EXPECT_NE(r.message.find("electrically active"), std::string::npos) << r.message;
 }

@@ -14,11 +14,11 @@
 
 #include "model/harmonic.hpp"
 #include "model/material_presets.hpp"
+#include "ui/cli/cli_common.hpp"
 #include "update/impedance_file.hpp"
 #include "update/least_squares.hpp"
 #include "update/rayleigh.hpp"
 #include "update/updater.hpp"
-#include "ui/cli/cli_common.hpp"
 
 namespace piezo::cli {
 
@@ -42,7 +42,8 @@ std::map<std::string, double> parse_set(const std::string& s) {
   while (std::getline(ss, item, ',')) {
     if (item.empty()) continue;
     const auto eq = item.find('=');
-    if (eq == std::string::npos || eq == 0) throw InputError("--set: expected key=value, got '" + item + "'");
+    if (eq == std::string::npos || eq == 0)
+      throw InputError("--set: expected key=value, got '" + item + "'");
     const std::string val = item.substr(eq + 1);
     std::size_t used = 0;
     double v = NAN;
@@ -59,8 +60,8 @@ std::map<std::string, double> parse_set(const std::string& s) {
 }
 
 nlohmann::json params_json(const pu::MaterialClass& cls, const pu::TubeParams& p) {
-  nlohmann::json j = {{"YE11", p.y_e11}, {"nu12", p.nu12}, {"d31", p.d31},
-                      {"epsT33_rel", p.eps_t33 / pm::kEps0}};
+  nlohmann::json j = {
+      {"YE11", p.y_e11}, {"nu12", p.nu12}, {"d31", p.d31}, {"epsT33_rel", p.eps_t33 / pm::kEps0}};
   try {
     const auto e = cls.e_summary(cls.coordinates(p), p.d31 < 0 ? -1 : 1);
     j["cE11"] = e.c_e11;
@@ -72,7 +73,8 @@ nlohmann::json params_json(const pu::MaterialClass& cls, const pu::TubeParams& p
   return j;
 }
 
-std::vector<std::complex<double>> model_impedance(pm::ModalSolver& solver, const pm::PiezoMaterialE& m,
+std::vector<std::complex<double>> model_impedance(pm::ModalSolver& solver,
+                                                  const pm::PiezoMaterialE& m,
                                                   const std::vector<double>& f,
                                                   const pm::RayleighDamping& d) {
   pm::ModalOptions o;
@@ -134,8 +136,9 @@ void run_update(Context& ctx, const UpdateArgs& a) {
   if (!kv.empty())
     throw InputError("--set: '" + kv.begin()->first +
                      "' is not an updated parameter (YE11, nu12, d31, epsT33_rel)");
-  const pu::MaterialClass cls = a.isotropic ? pu::MaterialClass::isotropic()
-                                            : pu::MaterialClass::transversely_isotropic(preset.material);
+  const pu::MaterialClass cls = a.isotropic
+                                    ? pu::MaterialClass::isotropic()
+                                    : pu::MaterialClass::transversely_isotropic(preset.material);
   (void)cls.e_form(p0);  // non-physical original → std::invalid_argument → exit 2
 
   pm::MeshOptions mesh;
@@ -147,7 +150,8 @@ void run_update(Context& ctx, const UpdateArgs& a) {
   pu::UpdateOptions uo;
   uo.cmcm.max_iterations = a.max_iterations;
   uo.cmcm.cross_modes = a.cross_modes;
-  uo.capacitance = a.capacitance == "fe" ? pu::CapacitanceModel::fe : pu::CapacitanceModel::analytic;
+  uo.capacitance =
+      a.capacitance == "fe" ? pu::CapacitanceModel::fe : pu::CapacitanceModel::analytic;
 
   nlohmann::json out;
   out["method"] = a.method;
@@ -175,8 +179,9 @@ void run_update(Context& ctx, const UpdateArgs& a) {
                {"evaluations", lm.evaluations},
                {"cost", lm.cost},
                {"residuals", lm.residuals},
-               {"model_after", {{"resonances_hz", lm.model_resonances_hz},
-                                {"antiresonances_hz", lm.model_antiresonances_hz}}},
+               {"model_after",
+                {{"resonances_hz", lm.model_resonances_hz},
+                 {"antiresonances_hz", lm.model_antiresonances_hz}}},
                {"seconds", lm.seconds}};
     try {
       lm_json["alpha"] = alpha_json(lm.updated);
@@ -188,7 +193,8 @@ void run_update(Context& ctx, const UpdateArgs& a) {
       out["updated"] = lm_json["updated"];
       if (lm_json.contains("alpha")) out["alpha"] = lm_json["alpha"];
       // LM updates all four parameters jointly: one iteration count for both groups.
-      out["iterations"] = {{"elastic", lm.iterations}, {"piezo", lm.iterations}, {"lm", lm.iterations}};
+      out["iterations"] = {
+          {"elastic", lm.iterations}, {"piezo", lm.iterations}, {"lm", lm.iterations}};
       out["converged"] = converged;
       out["status"] = pu::to_string(lm.status);
       out["message"] = lm.message;
@@ -213,9 +219,8 @@ void run_update(Context& ctx, const UpdateArgs& a) {
     out["status"] = pu::to_string(r.status);
     out["message"] = r.message;
     out["eps_t33_eq201_rel"] = r.eps_t33_eq201 / pm::kEps0;
-    out["capacitance"] = {{"model", a.capacitance},
-                          {"measured_f", r.c_measured},
-                          {"model_after_f", r.c_model_after}};
+    out["capacitance"] = {
+        {"model", a.capacitance}, {"measured_f", r.c_measured}, {"model_after_f", r.c_model_after}};
     out["model_before"] = {{"resonances_hz", r.model_resonances_before_hz},
                            {"antiresonances_hz", r.model_antiresonances_before_hz}};
     out["model_after"] = {{"resonances_hz", r.model_resonances_hz},
@@ -238,14 +243,20 @@ void run_update(Context& ctx, const UpdateArgs& a) {
     while (std::getline(ss, item, ',')) {
       const auto c = item.find(':');
       if (c == std::string::npos) throw InputError("--damping: expected F:ZETA,F:ZETA");
-      fz.emplace_back(pu::parse_list(item.substr(0, c)).at(0), pu::parse_list(item.substr(c + 1)).at(0));
+      fz.emplace_back(pu::parse_list(item.substr(0, c)).at(0),
+                      pu::parse_list(item.substr(c + 1)).at(0));
     }
     if (fz.size() != 2) throw InputError("--damping: exactly two modes F1:ZETA1,F2:ZETA2");
-    const auto fit = pu::rayleigh_from_damping(fz[0].first, fz[0].second, fz[1].first, fz[1].second);
-    out["rayleigh"] = {{"ok", fit.ok}, {"message", fit.message},
-                       {"alpha", fit.damping.alpha}, {"beta", fit.damping.beta}};
-    if (fit.ok) damping = fit.damping;
-    else std::fprintf(stderr, "piezobench: %s\n", fit.message.c_str());
+    const auto fit =
+        pu::rayleigh_from_damping(fz[0].first, fz[0].second, fz[1].first, fz[1].second);
+    out["rayleigh"] = {{"ok", fit.ok},
+                       {"message", fit.message},
+                       {"alpha", fit.damping.alpha},
+                       {"beta", fit.damping.beta}};
+    if (fit.ok)
+      damping = fit.damping;
+    else
+      std::fprintf(stderr, "piezobench: %s\n", fit.message.c_str());
   }
 
   if (!a.overlay.empty()) {
@@ -281,8 +292,10 @@ void run_update(Context& ctx, const UpdateArgs& a) {
       if (std::isfinite(zm.real())) os << std::arg(zm) * 180 / M_PI;
       os << '\n';
     }
-    out["overlay"] = {{"file", a.overlay}, {"points", f.size()},
-                      {"rayleigh_alpha", damping.alpha}, {"rayleigh_beta", damping.beta}};
+    out["overlay"] = {{"file", a.overlay},
+                      {"points", f.size()},
+                      {"rayleigh_alpha", damping.alpha},
+                      {"rayleigh_beta", damping.beta}};
   }
 
   if (ctx.json) {
@@ -306,7 +319,8 @@ void run_update(Context& ctx, const UpdateArgs& a) {
                 out["iterations"]["piezo"].get<int>());
     if (out.contains("lm"))
       std::printf("  LM: YE11 %.6g nu12 %.6g d31 %.6g epsT33_rel %.6g (%s)\n",
-                  out["lm"]["updated"]["YE11"].get<double>(), out["lm"]["updated"]["nu12"].get<double>(),
+                  out["lm"]["updated"]["YE11"].get<double>(),
+                  out["lm"]["updated"]["nu12"].get<double>(),
                   out["lm"]["updated"]["d31"].get<double>(),
                   out["lm"]["updated"]["epsT33_rel"].get<double>(),
                   out["lm"]["status"].get<std::string>().c_str());
@@ -318,21 +332,26 @@ void run_update(Context& ctx, const UpdateArgs& a) {
 
 void register_update_command(CLI::App& app, Context& ctx) {
   auto a = std::make_shared<UpdateArgs>();
-  auto* cmd = app.add_subcommand("update", "FE model updating from impedance features (extended CMCM, LM)");
+  auto* cmd =
+      app.add_subcommand("update", "FE model updating from impedance features (extended CMCM, LM)");
   cmd->add_option("FILE", a->file, "Impedance file: CSV f_hz,re_ohm,im_ohm or Touchstone .s1p");
   cmd->add_option("--resonances", a->resonances, "Resonances F1,F2,… [Hz]");
   cmd->add_option("--antiresonances", a->antiresonances, "Anti-resonances F1,F2,… [Hz]");
   cmd->add_option("--low-z", a->low_z, "|Z| at a low frequency, OHM@HZ (e.g. 26804@400)");
-  cmd->add_option("--material", a->material, "Material preset of the original model")->capture_default_str();
+  cmd->add_option("--material", a->material, "Material preset of the original model")
+      ->capture_default_str();
   cmd->add_flag("--isotropic", a->isotropic, "Isotropic-simplification class (seed §6.4.3)");
   cmd->add_option("--set", a->set, "Original parameters: YE11=…,nu12=…,d31=…,epsT33_rel=…");
   cmd->add_option("--method", a->method, "cmcm, lm or both")->capture_default_str();
   cmd->add_option("--overlay", a->overlay, "Write |Z| of original, updated and measured to CSV");
   cmd->add_option("--damping", a->damping, "Rayleigh fit from two modes: F1:ZETA1,F2:ZETA2");
-  cmd->add_option("--capacitance", a->capacitance, "fe (FE capacitance at f_L) or analytic (eq. 201)")
+  cmd->add_option("--capacitance", a->capacitance,
+                  "fe (FE capacitance at f_L) or analytic (eq. 201)")
       ->capture_default_str();
-  cmd->add_option("--max-iterations", a->max_iterations, "CMCM iteration cap per phase")->capture_default_str();
-  cmd->add_flag("--cross-modes", a->cross_modes, "Include the i != j CMCM equations (seed-faithful, slow)");
+  cmd->add_option("--max-iterations", a->max_iterations, "CMCM iteration cap per phase")
+      ->capture_default_str();
+  cmd->add_flag("--cross-modes", a->cross_modes,
+                "Include the i != j CMCM equations (seed-faithful, slow)");
   cmd->add_option("--nr", a->n_radial, "Elements through the wall")->capture_default_str();
   cmd->add_option("--nz", a->n_axial, "Elements along the length")->capture_default_str();
   add_json_flag(cmd, ctx);
