@@ -50,5 +50,6 @@ void register_demo_command(CLI::App& app, Context& ctx);
 void register_measure_commands(CLI::App& app, Context& ctx);
 void register_model_commands(CLI::App& app, Context& ctx);
 void register_impedance_command(CLI::App& app, Context& ctx);
+void register_update_command(CLI::App& app, Context& ctx);
 
 }  // namespace piezo::cli

@@ -1,0 +1,89 @@
+// `piezobench update`: JSON field names (scripts depend on them), exit codes,
+// overlay file, refusal of bad input and of a negative Rayleigh fit.
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+#include <nlohmann/json.hpp>
+
+#include "tests/support/run_cli.hpp"
+
+namespace {
+
+using piezo::test::run_cli;
+const std::string kTable45 =
+    "update --resonances 51400,55000,82600 --antiresonances 52400,55800,101600 --low-z 26804@400 "
+    "--material apc850 --isotropic --set YE11=6.3e10,nu12=0.31,d31=-175e-12,epsT33_rel=1576 ";
+
+TEST(CliUpdate, Table45JsonFields) {
+  const auto r = run_cli(kTable45 + "--json");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const auto j = nlohmann::json::parse(r.out);
+  for (const char* k : {"YE11", "nu12", "d31", "epsT33_rel", "cE11", "cE12", "e31", "epsS33_rel"}) {
+    EXPECT_TRUE(j["updated"].contains(k)) << k;
+    EXPECT_TRUE(j["original"].contains(k)) << k;
+  }
+  for (const char* k : {"alpha1", "alpha2", "alpha3"}) EXPECT_TRUE(j["alpha"].contains(k)) << k;
+  EXPECT_TRUE(j["iterations"]["elastic"].is_number_integer());
+  EXPECT_TRUE(j["iterations"]["piezo"].is_number_integer());
+  EXPECT_TRUE(j["converged"].get<bool>());
+  EXPECT_EQ(j["measured"]["resonances_hz"].size(), 3u);
+  EXPECT_EQ(j["model_after"]["resonances_hz"].size(), 3u);
+  EXPECT_EQ(j["model_after"]["antiresonances_hz"].size(), 3u);
+  // Same numbers as test_update_tube's PublishedTable45Features (0.1 % goal on YE11, d31, εT33).
+  EXPECT_NEAR(j["updated"]["YE11"].get<double>() / 6.66e10, 1, 1e-3);
+  EXPECT_NEAR(j["updated"]["d31"].get<double>() / -210e-12, 1, 1e-3);
+  EXPECT_NEAR(j["updated"]["epsT33_rel"].get<double>() / 2294, 1, 1e-3);
+}
+
+TEST(CliUpdate, BothMethodsAndOverlay) {
+  const std::string overlay = (std::filesystem::temp_directory_path() /
+                               ("piezo_overlay_" + std::to_string(::getpid()) + ".csv"))
+                                  .string();
+  const auto r = run_cli(kTable45 + "--method both --overlay " + overlay + " --json");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const auto j = nlohmann::json::parse(r.out);
+  ASSERT_TRUE(j.contains("lm"));
+  EXPECT_TRUE(j["lm"]["converged"].get<bool>());
+  EXPECT_LT(std::abs(j["lm_minus_cmcm_relative"]["d31"].get<double>()), 1e-2);
+  std::ifstream in(overlay);
+  std::string header;
+  std::getline(in, header);
+  EXPECT_EQ(header.rfind("f_hz,original_abs_ohm,updated_abs_ohm,measured_abs_ohm", 0), 0u);
+  int lines = 0;
+  for (std::string l; std::getline(in, l);) ++lines;
+  EXPECT_EQ(lines, j["overlay"]["points"].get<int>());
+  std::filesystem::remove(overlay);
+}
+
+TEST(CliUpdate, NegativeRayleighIsRefusedNotUsed) {
+  const auto r = run_cli(kTable45 + "--damping 50000:0.02,100000:0.005 --json");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const auto j = nlohmann::json::parse(r.out);
+  EXPECT_FALSE(j["rayleigh"]["ok"].get<bool>());
+  EXPECT_NE(j["rayleigh"]["message"].get<std::string>().find("negative"), std::string::npos);
+}
+
+TEST(CliUpdate, BadInputExitsTwo) {
+  EXPECT_EQ(run_cli("update --resonances 51400,55000 --json").exit_code, 2);  // no anti-res / low-z
+  EXPECT_EQ(run_cli(kTable45 + "--low-z 26804 --json").exit_code, 2);         // not OHM@HZ
+  EXPECT_EQ(run_cli(kTable45 + "--method newton --json").exit_code, 2);
+  EXPECT_EQ(run_cli(kTable45 + "--set foo=1 --json").exit_code, 2);
+  EXPECT_EQ(run_cli("update /nonexistent/z.csv --json").exit_code, 2);
+  const auto r = run_cli(
+      "update --resonances 51400,55000,82600 --antiresonances 52400,55800,101600 "
+      "--low-z 26804@400 --material nosuch --json");
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_TRUE(nlohmann::json::parse(r.out).contains("error"));
+}
+
+TEST(CliUpdate, NonConvergenceExitsOneWithTheResult) {
+  const auto r = run_cli(kTable45 + "--max-iterations 1 --json");
+  EXPECT_EQ(r.exit_code, 1);
+  const auto j = nlohmann::json::parse(r.out);
+  EXPECT_FALSE(j["converged"].get<bool>());
+  EXPECT_EQ(j["status"].get<std::string>(), "max_iterations");
+  EXPECT_FALSE(j["message"].get<std::string>().empty());
+}
+
+}  // namespace

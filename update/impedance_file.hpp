@@ -1,0 +1,44 @@
+#pragma once
+// Measured impedance functions from files, and the features the updater
+// needs from them (seed §6.4.1): resonances = |Z| minima, anti-resonances =
+// |Z| maxima (each refined below the grid by a parabola through the three
+// samples around it, in dB), and |Z| at one frequency in the capacitive region.
+//   CSV:        f_hz,re_ohm,im_ohm   (header line and '#' comments allowed)
+//   Touchstone: .s1p, option line "# <Hz|kHz|MHz|GHz> <S|Z> <RI|MA|DB> R <Z0>"
+#include <complex>
+#include <string>
+#include <vector>
+
+#include "update/features.hpp"
+
+namespace piezo::update {
+
+struct ImpedanceCurve {
+  std::vector<double> f_hz;  // strictly ascending
+  std::vector<std::complex<double>> z_ohm;
+};
+
+// Throw std::invalid_argument (bad content) or std::runtime_error (cannot open).
+ImpedanceCurve read_impedance_csv(const std::string& path);
+ImpedanceCurve read_touchstone_s1p(const std::string& path);
+ImpedanceCurve read_impedance_file(const std::string& path);  // by extension (.s1p, else CSV)
+void write_impedance_csv(const std::string& path, const ImpedanceCurve& c);
+
+struct FeatureOptions {
+  int max_modes = 3;  // resonance/anti-resonance pairs kept (lowest first)
+  // Rise from a minimum to the following maximum, and the deepest dip stepped
+  // over on the way up (weak inactive modes: 1.5 dB at ζ = 2.5e-4 on our tube).
+  double min_prominence_db = 3.0;
+  double low_f_fraction = 0.05;  // low-f point at or below this fraction of the first resonance …
+  double capacitive_phase_tol_deg = 5.0;  // … where the phase is within this of −90°
+};
+
+struct ExtractedFeatures {
+  MeasuredFeatures features;
+  double low_z_phase_deg = 0;  // phase of Z at the chosen low-frequency point
+};
+
+// Throws std::invalid_argument when no resonance pair or no capacitive point is found.
+ExtractedFeatures extract_features(const ImpedanceCurve& c, const FeatureOptions& opt = {});
+
+}  // namespace piezo::update
