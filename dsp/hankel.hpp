@@ -15,6 +15,7 @@ namespace piezo::dsp {
 
 class RealFft;
 
+// Not thread-safe: the FFT products share one plan and its buffers.
 class BlockHankel {
  public:
   // y: K × m, one signal per column. ξ = `rows` block rows, η = `cols` columns;

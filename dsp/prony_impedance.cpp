@@ -51,7 +51,15 @@ PronyImpedance fit_prony_impedance(const DividerRecord& rec, const PronyImpedanc
     throw std::invalid_argument("impedance_prony: no current flows (v1 == v2): Z is undefined");
   PronyImpedance out;
   out.r1_ohm = rec.r1_ohm;
-  out.fit = prony_ss(stack(s), s.sample_rate_hz, opt.prony);
+  PronyOptions po = opt.prony;
+  if (!po.order && po.noise_mixing.size() == 0 && s.size() >= 24) {
+    // Noise model of the divider: independent n1, n2 on the measured channels,
+    // the current's noise is (n1 − n2)/R1 (not a third independent source).
+    const double s1 = estimate_noise_std(s.v1), s2 = estimate_noise_std(s.v2);
+    po.noise_mixing.resize(3, 2);
+    po.noise_mixing << s1, 0.0, 0.0, s2, s1 / rec.r1_ohm, -s2 / rec.r1_ohm;
+  }
+  out.fit = prony_ss(stack(s), s.sample_rate_hz, po);
   return out;
 }
 

@@ -144,6 +144,9 @@ PronyFit prony_ss(const Eigen::Ref<const Eigen::MatrixXd>& y, double sample_rate
                                                            sample_rate_hz / (5.0 * opt.band_hz)))
                             : 1;
   const bool automatic = !opt.order.has_value();
+  if (automatic && k_used < 24)
+    fail("too short for the automatic order: " + std::to_string(k_used) +
+         " samples, need at least 24 (or give the order)");
   Eigen::MatrixXd noise;  // simulated noise, scaled like the data (automatic order only)
   if (automatic) {
     Eigen::MatrixXd mix = opt.noise_mixing;
