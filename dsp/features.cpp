@@ -143,6 +143,8 @@ ImpedanceFeatures find_features(const Eigen::VectorXd& f, const Eigen::VectorXcd
     out.resonances.push_back(refine_quadratic(f, y, sy, i, opt.fit_points));
   for (Eigen::Index i : prominent_extrema(f, y, -1.0, opt))
     out.antiresonances.push_back(refine_quadratic(f, y, sy, i, opt.fit_points));
+  for (auto* list : {&out.resonances, &out.antiresonances})
+    for (auto& ft : *list) ft.extremum_hz = ft.f_hz;
   double lo, hi;
   capacitance_band(f, out, opt, lo, hi);
   fit_capacitance(f, z, zs, lo, hi, out);
@@ -177,6 +179,8 @@ ImpedanceFeatures find_features(const std::function<std::complex<double>(double)
     out.resonances.push_back({golden(f[i - 1], f[i + 1], +1.0), kNaN});
   for (Eigen::Index i : prominent_extrema(f, y, -1.0, opt))
     out.antiresonances.push_back({golden(f[i - 1], f[i + 1], -1.0), kNaN});
+  for (auto* list : {&out.resonances, &out.antiresonances})
+    for (auto& ft : *list) ft.extremum_hz = ft.f_hz;
   double lo, hi;
   capacitance_band(f, out, opt, lo, hi);
   fit_capacitance(f, z, Eigen::VectorXd(), lo, hi, out);

@@ -27,9 +27,16 @@ struct DividerRecord {
 };
 
 // A frequency with its standard uncertainty (NaN when unknown).
+// For Prony estimates f_hz is the natural frequency |s*|/2π of the zero (for a
+// resonance) or pole (anti-resonance) of Z(s) found next to the |Z| extremum —
+// the short-/open-circuit modal frequency, free of the damping bias of the
+// extremum; extremum_hz is where |Z(jω)| peaks. Estimators without a pole
+// model report the extremum in both.
 struct Feature {
   double f_hz = kNaN;
   double sigma_hz = kNaN;
+  double extremum_hz = kNaN;
+  double damping_ratio = kNaN;  // of that zero / pole (Prony only)
 };
 
 struct ImpedanceFeatures {

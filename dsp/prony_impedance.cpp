@@ -44,6 +44,71 @@ std::complex<double> PronyImpedance::z(double f_hz) const {
   return r1_ohm * laplace(fit, 1, s) / (laplace(fit, 0, s) - laplace(fit, 1, s));
 }
 
+std::complex<double> PronyImpedance::zero_or_pole(double f_hz, bool resonance) const {
+  // Newton on Z(s) = V2/I (resonance) or on 1/Z(s) (anti-resonance): V2 and I
+  // share the divider's poles, which sit next to the anti-resonances when R1
+  // is large; in the ratio they cancel, so the iteration sees a smooth function.
+  auto g = [&](std::complex<double> s) {
+    const std::complex<double> v2 = laplace(fit, 1, s), i = laplace(fit, 2, s);
+    return resonance ? v2 / i : i / v2;
+  };
+  const double scale = kTwoPi * f_hz;
+  // Damped Newton (a step is halved until |g| decreases), from several starts
+  // around the extremum: with two close modes plain Newton jumps to the wrong
+  // root. The root kept is the one nearest to the extremum within ±5 %.
+  std::complex<double> best(kNaN, kNaN);
+  double best_dist = 0.05 * scale;
+  for (double zeta0 : {0.0, 0.005, 0.01, 0.02, 0.04}) {
+    std::complex<double> x(-zeta0 * scale, scale);
+    double gx = std::abs(g(x));
+    bool converged = false;
+    for (int it = 0; it < 60 && std::isfinite(gx); ++it) {
+      const std::complex<double> h(1e-6 * scale, 0.0);
+      const std::complex<double> d = (g(x + h) - g(x - h)) / (2.0 * h);
+      if (d == 0.0) break;
+      std::complex<double> step = g(x) / d;
+      if (std::abs(step) > 0.02 * scale) step *= 0.02 * scale / std::abs(step);  // trust region
+      double gn = std::abs(g(x - step));
+      int halvings = 0;
+      while (!(gn < gx) && halvings < 30) {
+        step *= 0.5;
+        gn = std::abs(g(x - step));
+        ++halvings;
+      }
+      if (!(gn < gx) && std::abs(step) > 1e-9 * scale) break;  // stuck
+      x -= step;
+      gx = gn;
+      // g sums terms that cancel at its zero, so rounding bounds the attainable step.
+      if (std::abs(step) < 1e-10 * scale) {
+        converged = true;
+        break;
+      }
+    }
+    if (!converged) continue;
+    const double dist = std::abs(std::abs(x) - scale);
+    if (x.real() < 0 && dist < best_dist) {
+      best = x;
+      best_dist = dist;
+    }
+  }
+  return best;
+}
+
+void refine_features_to_modal(const PronyImpedance& m, ImpedanceFeatures& f) {
+  auto refine = [&](std::vector<Feature>& list, bool resonance) {
+    for (auto& ft : list) {
+      ft.extremum_hz = ft.f_hz;
+      const auto s = m.zero_or_pole(ft.f_hz, resonance);
+      if (std::isfinite(s.real()) && s.real() < 0) {
+        ft.f_hz = std::abs(s) / kTwoPi;
+        ft.damping_ratio = -s.real() / std::abs(s);
+      }
+    }
+  };
+  refine(f.resonances, true);
+  refine(f.antiresonances, false);
+}
+
 PronyImpedance fit_prony_impedance(const DividerRecord& rec, const PronyImpedanceOptions& opt) {
   const DividerSignals s = prepare_divider(rec, "impedance_prony", opt.prep);
   const double span = s.i.maxCoeff() - s.i.minCoeff();
@@ -90,7 +155,9 @@ ImpedanceResult impedance_prony(const DividerRecord& rec, const Eigen::VectorXd&
   const double step = opt.feature_step_hz > 0 ? opt.feature_step_hz
                                               : (f_hz.maxCoeff() - f_hz.minCoeff()) / double(f_hz.size() - 1) / 4.0;
   auto features_of = [&](const PronyImpedance& m) {
-    return find_features([&m](double f) { return m.z(f); }, fmin, fmax, step, opt.features);
+    auto f = find_features([&m](double f) { return m.z(f); }, fmin, fmax, step, opt.features);
+    refine_features_to_modal(m, f);
+    return f;
   };
   r.features = features_of(model);
 

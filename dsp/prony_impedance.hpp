@@ -33,7 +33,16 @@ struct PronyImpedance {
   PronyFit fit;  // signals: 0 = v1, 1 = v2, 2 = i
   double r1_ohm = 0.0;
   std::complex<double> z(double f_hz) const;  // eq. 116 at s = j2πf
+
+  // The zero (resonance) or pole (anti-resonance) of Z(s) nearest to the |Z|
+  // extremum at f_hz, by Newton's method on Z(s) (zeros) or on 1/Z(s) (poles);
+  // returns s* (NaN if it does not converge).
+  std::complex<double> zero_or_pole(double f_hz, bool resonance) const;
 };
+
+// Replaces each extremum of `f` by the natural frequency of the zero / pole of
+// Z(s) next to it (see Feature); keeps the extremum in extremum_hz.
+void refine_features_to_modal(const PronyImpedance& m, ImpedanceFeatures& f);
 
 PronyImpedance fit_prony_impedance(const DividerRecord& rec, const PronyImpedanceOptions& opt = {});
 

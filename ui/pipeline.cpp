@@ -81,12 +81,36 @@ dsp::ImpedanceResult estimate(const acq::Capture& cap, PipelineResult& out) {
     throw std::invalid_argument("the capture holds no transient \"dut\" shot to estimate Z from");
   const acq::Shot& first = *shots.front();
   const double fmax = std::min(120e3, first.sample_rate_hz / 4), step = 100.0;
+  // Repeated shots of one drive are averaged sample by sample before the fit
+  // (white noise drops by √N; the transient is identical from shot to shot).
+  std::vector<double> v1(first.v1), v2(first.v2);
+  int averaged = 1;
+  for (std::size_t k = 1; k < shots.size(); ++k) {
+    const auto& s = *shots[k];
+    if (s.samples() != first.samples() || s.sample_rate_hz != first.sample_rate_hz ||
+        s.pretrigger_samples != first.pretrigger_samples || s.excitation != first.excitation ||
+        s.amplitude_v != first.amplitude_v || s.decay_per_s != first.decay_per_s)
+      continue;
+    for (std::size_t i = 0; i < v1.size(); ++i) {
+      v1[i] += s.v1[i];
+      v2[i] += s.v2[i];
+    }
+    ++averaged;
+  }
+  for (std::size_t i = 0; i < v1.size(); ++i) {
+    v1[i] /= averaged;
+    v2[i] /= averaged;
+  }
+  out.shots_averaged = averaged;
+  dsp::DividerRecord avg{v1, v2, first.sample_rate_hz, cap.setup.divider_r1_ohm,
+                         static_cast<std::size_t>(std::max<std::int64_t>(0, first.pretrigger_samples)),
+                         first.daq_range_v};
   dsp::PronyImpedanceOptions po;
   const std::size_t post = first.samples() - static_cast<std::size_t>(first.pretrigger_samples);
-  po.prep.max_samples = std::min<std::size_t>(3000, post);
+  po.prep.max_samples = std::min<std::size_t>(6000, post);
   po.prony.band_hz = fmax;
   po.features.fmin_hz = step;
-  auto prony = dsp::impedance_prony(record_of(cap, first), dsp::make_grid(step, fmax, step), po);
+  auto prony = dsp::impedance_prony(avg, dsp::make_grid(step, fmax, step), po);
   out.curves.push_back(curve_of("measured (Prony-SS)", prony));
   for (const auto& f : prony.features.resonances) out.resonances_hz.push_back(f.f_hz);
   for (const auto& f : prony.features.antiresonances) out.antiresonances_hz.push_back(f.f_hz);
@@ -210,8 +234,8 @@ PipelineResult run_pipeline(const PipelineRequest& req, const std::function<void
   auto z = estimate(cap, out);
   {
     char note[160];
-    std::snprintf(note, sizeof note, "Prony-SS order %d on %zu samples: %zu resonances, %zu anti-resonances, C = %.4g F",
-                  out.order, z.samples_used, out.resonances_hz.size(), out.antiresonances_hz.size(),
+    std::snprintf(note, sizeof note, "Prony-SS order %d on %zu samples (%d shot(s) averaged): %zu resonances, %zu anti-resonances, C = %.4g F",
+                  out.order, z.samples_used, out.shots_averaged, out.resonances_hz.size(), out.antiresonances_hz.size(),
                   z.features.capacitance_f);
     out.stages.push_back({"estimate", true, note});
   }

@@ -48,6 +48,7 @@ struct StageReport {
 struct PipelineResult {
   std::string capture_path;
   int shots = 0;
+  int shots_averaged = 0;  // transient dut shots averaged before the Prony fit
   std::vector<Curve> curves;  // measured (Prony), FFT, cross-spectra, original model, updated model
   std::vector<double> resonances_hz, antiresonances_hz;
   std::vector<double> singular_values;  // normalised, for the order plot

@@ -152,8 +152,21 @@ TEST(PronyDivider, ImpedanceResultCarriesFeaturesAndSummary) {
   ASSERT_EQ(r.features.antiresonances.size(), 3u);
   const auto truth = dsp::find_features([&](double f) { return c.model.impedance_at(f); }, 1e3, 120e3, 20.0);
   for (std::size_t k = 0; k < 3; ++k) {
-    EXPECT_NEAR(r.features.resonances[k].f_hz / truth.resonances[k].f_hz, 1.0, 1e-7);
-    EXPECT_NEAR(r.features.antiresonances[k].f_hz / truth.antiresonances[k].f_hz, 1.0, 1e-7);
+    EXPECT_NEAR(r.features.resonances[k].extremum_hz / truth.resonances[k].f_hz, 1.0, 1e-7);
+    EXPECT_NEAR(r.features.antiresonances[k].extremum_hz / truth.antiresonances[k].f_hz, 1.0, 1e-7);
+    // The modal (natural) frequency of the zero of Z is the branch's series
+    // resonance 1/√(LC) exactly (Y's pole s² LC + sRC + 1 = 0 has |s|² = 1/LC),
+    // unlike the |Z| minimum, which damping pulls away from it.
+    const auto& b = c.model.branches[k];
+    EXPECT_NEAR(r.features.resonances[k].f_hz * 2 * M_PI * std::sqrt(b.L * b.C), 1.0, 1e-7);
+    // The anti-resonance: |s| of the zero of the true admittance next to the |Z| maximum.
+    std::complex<double> s0(0, 2 * M_PI * truth.antiresonances[k].f_hz);
+    for (int it = 0; it < 50; ++it) {
+      const std::complex<double> h(1e-3, 0);
+      const auto y = c.model.admittance(s0);
+      s0 -= y / ((c.model.admittance(s0 + h) - c.model.admittance(s0 - h)) / (2.0 * h));
+    }
+    EXPECT_NEAR(r.features.antiresonances[k].f_hz / (std::abs(s0) / (2 * M_PI)), 1.0, 1e-7);
   }
   // Im(1/Z) = ω(C + Dω²) fitted below 0.3·f_r1; the BVD's exact value is C0 + ΣC_n.
   EXPECT_NEAR(r.features.capacitance_f / c.model.static_capacitance(), 1.0, 1e-3);

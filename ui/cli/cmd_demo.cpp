@@ -14,7 +14,7 @@ void register_demo_command(CLI::App& app, Context& ctx) {
   auto* demo = app.add_subcommand("demo", "Run the main job on the embedded simulated bench");
   struct Args {
     std::string out_dir = "demo-out";
-    double noise = 0.01;
+    double noise = 0.005;
     std::uint64_t seed = 2016;
   };
   auto a = std::make_shared<Args>();
@@ -33,7 +33,7 @@ void register_demo_command(CLI::App& app, Context& ctx) {
       req.plan.setup.material = "apc850";
       req.plan.samples = 20000;
       req.plan.pretrigger_samples = 200;
-      req.plan.shots = 3;
+      req.plan.shots = 16;
       // The simulated "real" tube: the seed's Table 4/5 target material in the isotropic class.
       req.sim.material = "apc850";
       req.sim.isotropic = true;
@@ -70,10 +70,16 @@ void register_demo_command(CLI::App& app, Context& ctx) {
       for (const auto& s : res.stages)
         std::cout << "  " << (s.ran ? "[ran]     " : "[skipped] ") << s.name << ": " << s.note << "\n";
       if (!res.params.empty()) {
-        std::printf("\n  %-12s %14s %14s %14s\n", "parameter", "original", "updated", "true");
-        for (const auto& p : res.params)
-          std::printf("  %-12s %14.6g %14.6g %14s\n", p.name.c_str(), p.original, p.updated,
-                      p.truth ? std::to_string(*p.truth).c_str() : "-");
+        std::printf("\n  %-12s %14s %14s %14s %10s\n", "parameter", "original", "updated", "true (sim)",
+                    "error %");
+        for (const auto& p : res.params) {
+          char t[32] = "-", e[32] = "-";
+          if (p.truth) {
+            std::snprintf(t, sizeof t, "%.6g", *p.truth);
+            std::snprintf(e, sizeof e, "%+.3f", 100.0 * (p.updated - *p.truth) / *p.truth);
+          }
+          std::printf("  %-12s %14.6g %14.6g %14s %10s\n", p.name.c_str(), p.original, p.updated, t, e);
+        }
       }
       if (!res.verdict.empty()) std::cout << "\n  gap verdict: " << res.verdict << "\n";
       for (const auto& w : res.warnings) std::cout << "  warning: " << w << "\n";

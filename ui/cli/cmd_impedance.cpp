@@ -61,6 +61,14 @@ nlohmann::json features_json(const dsp::ImpedanceFeatures& f) {
     for (const auto& x : v) a.push_back(sigma ? x.sigma_hz : x.f_hz);
     return a;
   };
+  auto extrema = [](const std::vector<dsp::Feature>& v) {
+    nlohmann::json a = nlohmann::json::array();
+    for (const auto& x : v) a.push_back(x.extremum_hz);
+    return a;
+  };
+  // resonances_hz: modal (natural) frequencies for Prony, |Z| extrema otherwise.
+  j["resonances_zmin_hz"] = extrema(f.resonances);
+  j["antiresonances_zmax_hz"] = extrema(f.antiresonances);
   j["resonances_hz"] = list(f.resonances, false);
   j["resonances_sigma_hz"] = list(f.resonances, true);
   j["antiresonances_hz"] = list(f.antiresonances, false);
