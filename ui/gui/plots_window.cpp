@@ -27,10 +27,19 @@ void render_plots_window(AppState& s) {
   if (ImGui::Button("Fit views")) s.mag_view.fitted = s.phase_view.fitted = s.sv_view.fitted = false;
   PlotSpec mag{"|Z|", "f [Hz]", "ohm", {}, {}, {}}, ph{"phase", "f [Hz]", "deg", {}, {}, {}};
   if (s.result) {
-    for (const auto& c : s.result->curves) {
+    // Draw order: models first (the updated one wide, as a halo), the
+    // measurement last and thin on top, so curves that agree stay visible.
+    std::vector<const ui::Curve*> order;
+    for (const auto& c : s.result->curves)
+      if (c.label.find("model") != std::string::npos) order.push_back(&c);
+    for (const auto& c : s.result->curves)
+      if (c.label.find("model") == std::string::npos) order.push_back(&c);
+    for (const ui::Curve* cp : order) {
+      const auto& c = *cp;
       if (c.label.find("FFT") != std::string::npos && !s.show_fft) continue;
       if (c.label.find("cross") != std::string::npos && !s.show_xspec) continue;
-      Series m{c.label, c.f_hz, {}, colour_for(c.label), 2.0f, false};
+      const float width = c.label.find("updated") != std::string::npos ? 6.0f : 2.0f;
+      Series m{c.label, c.f_hz, {}, colour_for(c.label), width, false};
       Series p = m;
       for (const auto& z : c.z_ohm) {
         m.y.push_back(std::abs(z));
