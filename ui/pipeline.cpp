@@ -6,6 +6,7 @@
 #include <map>
 
 #include "acquisition/capture_file.hpp"
+#include "acquisition/divider_record.hpp"
 #include "acquisition/runner.hpp"
 #include "dsp/cross_spectra.hpp"
 #include "dsp/fft_ratio.hpp"
@@ -55,11 +56,6 @@ acq::Capture acquire(const PipelineRequest& req, PipelineResult& out, const Stag
   out.stages.push_back({"acquire", true, std::to_string(res.shots_written) + " shot(s) on " + bench.description});
   if (res.cancelled) out.warnings.push_back("cancelled during acquisition; kept " + std::to_string(res.shots_written) + " shot(s)");
   return acq::read_capture(res.capture);
-}
-
-dsp::DividerRecord record_of(const acq::Capture& cap, const acq::Shot& s) {
-  return {s.v1, s.v2, s.sample_rate_hz, cap.setup.divider_r1_ohm,
-          static_cast<std::size_t>(std::max<std::int64_t>(0, s.pretrigger_samples)), s.daq_range_v};
 }
 
 Curve curve_of(const std::string& label, const dsp::ImpedanceResult& r) {
@@ -122,10 +118,10 @@ dsp::ImpedanceResult estimate(const acq::Capture& cap, PipelineResult& out) {
     dsp::FftRatioOptions fo;
     fo.fmin_hz = step;
     fo.fmax_hz = fmax;
-    out.curves.push_back(curve_of("measured (FFT)", dsp::impedance_fft(record_of(cap, first), fo)));
+    out.curves.push_back(curve_of("measured (FFT)", dsp::impedance_fft(acq::divider_record(cap, first), fo)));
     std::vector<dsp::DividerRecord> recs;
     for (const auto* s : shots)
-      if (s->excitation == first.excitation) recs.push_back(record_of(cap, *s));
+      if (s->excitation == first.excitation) recs.push_back(acq::divider_record(cap, *s));
     dsp::CrossSpectraOptions xo;
     xo.fmin_hz = step;
     xo.fmax_hz = fmax;

@@ -8,6 +8,7 @@
 #include <memory>
 
 #include "acquisition/capture_file.hpp"
+#include "acquisition/divider_record.hpp"
 #include "dsp/cross_spectra.hpp"
 #include "dsp/fft_ratio.hpp"
 #include "dsp/impedance_io.hpp"
@@ -27,11 +28,6 @@ struct ImpedanceArgs {
   std::size_t bootstrap = 20;
   bool csv = false, s1p = false;
 };
-
-dsp::DividerRecord record_of(const acq::Capture& cap, const acq::Shot& s) {
-  return {s.v1, s.v2, s.sample_rate_hz, cap.setup.divider_r1_ohm,
-          static_cast<std::size_t>(std::max<std::int64_t>(0, s.pretrigger_samples)), s.daq_range_v};
-}
 
 std::vector<const acq::Shot*> dut_shots(const acq::Capture& cap, bool sine) {
   std::vector<const acq::Shot*> out;
@@ -155,7 +151,7 @@ void run(const ImpedanceArgs& a, Context& ctx) {
     std::vector<dsp::SineShot> shots;
     for (const auto* s : dut_shots(cap, true)) {
       if (!s->frequency_hz) throw InputError("sine shot " + s->name + " has no frequency_hz");
-      shots.push_back({record_of(cap, *s), *s->frequency_hz});
+      shots.push_back({acq::divider_record(cap, *s), *s->frequency_hz});
       names.push_back(s->name);
     }
     if (shots.empty()) throw InputError("the capture holds no \"dut\" sine shot");
@@ -179,7 +175,7 @@ void run(const ImpedanceArgs& a, Context& ctx) {
       o.prony.band_hz = fmax;
       o.features.fmin_hz = fmin;
       o.bootstrap = a.bootstrap;
-      r = dsp::impedance_prony(record_of(cap, shot), dsp::make_grid(fmin, fmax, step), o);
+      r = dsp::impedance_prony(acq::divider_record(cap, shot), dsp::make_grid(fmin, fmax, step), o);
       names.push_back(shot.name);
     } else if (a.method == "fft") {
       dsp::FftRatioOptions o;
@@ -187,13 +183,13 @@ void run(const ImpedanceArgs& a, Context& ctx) {
       o.window = {*win, 0.5};
       o.fmin_hz = fmin;
       o.fmax_hz = fmax;
-      r = dsp::impedance_fft(record_of(cap, shot), o);
+      r = dsp::impedance_fft(acq::divider_record(cap, shot), o);
       names.push_back(shot.name);
     } else {  // xspec: every transient dut shot of the chosen shot's excitation
       std::vector<dsp::DividerRecord> recs;
       for (const auto* s : dut_shots(cap, false))
         if (s->excitation == shot.excitation) {
-          recs.push_back(record_of(cap, *s));
+          recs.push_back(acq::divider_record(cap, *s));
           names.push_back(s->name);
         }
       dsp::CrossSpectraOptions o;
