@@ -41,6 +41,8 @@ acq::Capture acquire(const PipelineRequest& req, PipelineResult& out, const Stag
   }
   if (req.instrument == "sim") sim = acq::make_sim_bench(req.sim, req.plan.setup.divider_r1_ohm);
   acq::Bench bench = acq::open_bench({req.instrument, req.daq.empty() ? std::nullopt : std::optional(req.daq)}, sim);
+  out.awg_idn = bench.awg->identity();
+  out.daq_idn = bench.daq->identity();
   acq::RunnerOptions ro;
   ro.overwrite = true;
   ro.software = "piezobench";

@@ -48,7 +48,8 @@ struct StageReport {
 struct PipelineResult {
   std::string capture_path;
   int shots = 0;
-  int shots_averaged = 0;  // transient dut shots averaged before the Prony fit
+  int shots_averaged = 0;
+  std::string awg_idn, daq_idn;  // *IDN? of the instruments used (empty for a replay)  // transient dut shots averaged before the Prony fit
   std::vector<Curve> curves;  // measured (Prony), FFT, cross-spectra, original model, updated model
   std::vector<double> resonances_hz, antiresonances_hz;
   std::vector<double> singular_values;  // normalised, for the order plot

@@ -54,6 +54,8 @@ struct AppState {
   bool show_fft = false, show_xspec = false;
   // Screen rectangles of named buttons, for scripted input in tests.
   std::map<std::string, ImVec4> button_rects;
+  char export_base[256] = "piezobench-report";
+  std::string png_request;  // set by the Export PNG button, served by the frame loop after rendering
   double frame_ms_max_during_job = 0;
   std::vector<double> frame_ms_during_job;
 };

@@ -126,8 +126,13 @@ int main(int argc, char** argv) {
       if (state.result)
         for (const auto& st : state.result->stages)
           state.log.push_back((st.ran ? "  ran " : "  skipped ") + st.name + ": " + st.note);
-      if (state.result && state.result->stages.size() > 0) {
-        state.instrument.state = "connected";
+      if (state.result) {
+        state.instrument.idn_awg = state.result->awg_idn;
+        state.instrument.idn_daq = state.result->daq_idn;
+        state.instrument.state = state.result->awg_idn.empty() ? "replay (no instrument)" : "connected";
+      } else if (!state.error.empty()) {
+        state.instrument.state = "error";
+        state.instrument.last_error = state.error;
       }
     }
 
@@ -137,6 +142,15 @@ int main(int argc, char** argv) {
     glClear(GL_COLOR_BUFFER_BIT);
     ImGui_ImplOpenGL3_RenderDrawData(ImGui::GetDrawData());
 
+    if (!state.png_request.empty()) {  // after rendering, before the swap: the frame is complete
+      try {
+        save_framebuffer_png(state.png_request, w, h);
+        state.log.push_back("exported " + state.png_request);
+      } catch (const std::exception& e) {
+        state.error = e.what();
+      }
+      state.png_request.clear();
+    }
     const bool running = state.job.running();
     if (running) job_seen = true;
     if (script == Script::Waiting && job_seen && !running && !state.result && state.error.empty()) {

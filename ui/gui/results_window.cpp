@@ -1,6 +1,7 @@
 // Results: original vs updated parameters with the change in %, the stages
 // that ran, the gap verdict, warnings and the log.
 #include "ui/gui/windows.hpp"
+#include "ui/report_export.hpp"
 
 namespace piezo::gui {
 
@@ -40,6 +41,26 @@ void render_results_window(AppState& s) {
       ImGui::TextColored(st.ran ? ImVec4(0.5f, 1, 0.5f, 1) : ImVec4(0.7f, 0.7f, 0.7f, 1), "%s %s: %s",
                          st.ran ? "[ran]" : "[skipped]", st.name.c_str(), st.note.c_str());
     for (const auto& w : r.warnings) ImGui::TextColored(ImVec4(1, 0.8f, 0.3f, 1), "warning: %s", w.c_str());
+    ImGui::Separator();
+    ImGui::SetNextItemWidth(260);
+    ImGui::InputText("##export", s.export_base, sizeof s.export_base);
+    const std::string base = s.export_base;
+    auto do_export = [&](const char* label, const std::string& path, auto fn) {
+      ImGui::SameLine();
+      if (ImGui::Button(label)) {
+        try {
+          fn(r, path);
+          s.log.push_back("exported " + path);
+        } catch (const std::exception& e) {
+          s.error = std::string(e.what()) + " (check the folder exists and is writable)";
+        }
+      }
+    };
+    do_export("CSV", base + ".csv", ui::export_csv);
+    do_export("Touchstone", base + ".s1p", ui::export_touchstone);
+    do_export("JSON", base + ".json", ui::export_json);
+    ImGui::SameLine();
+    if (ImGui::Button("PNG")) s.png_request = base + ".png";
   }
   ImGui::Separator();
   ImGui::BeginChild("log", ImVec2(0, 0), true);

@@ -1,0 +1,44 @@
+// GUI/report exports of a pipeline result: CSV in the project's
+// f_hz,re_ohm,im_ohm form, Touchstone Z-format, and the JSON report.
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <sstream>
+
+#include "ui/report_export.hpp"
+
+using namespace piezo;
+
+TEST(ReportExport, CsvTouchstoneAndJson) {
+  ui::PipelineResult r;
+  r.capture_path = "x.h5";
+  r.curves.push_back({"measured (Prony-SS)", {1000.0, 2000.0}, {{10.0, -20.0}, {5.0, -8.0}}});
+  r.params.push_back({"YE11", "Pa", 6.3e10, 6.66e10, 6.66e10});
+  r.stages.push_back({"update", true, "converged"});
+  const auto dir = std::filesystem::temp_directory_path() / ("piezobench-export-" + std::to_string(::getpid()));
+  std::filesystem::create_directories(dir);
+  ui::export_csv(r, (dir / "a.csv").string());
+  ui::export_touchstone(r, (dir / "a.s1p").string());
+  ui::export_json(r, (dir / "a.json").string());
+  std::ifstream csv(dir / "a.csv");
+  std::string header, row;
+  std::getline(csv, header);
+  std::getline(csv, row);
+  EXPECT_EQ(header, "f_hz,re_ohm,im_ohm");
+  EXPECT_EQ(row.substr(0, 5), "1000,");
+  std::ifstream s1p(dir / "a.s1p");
+  std::stringstream ss;
+  ss << s1p.rdbuf();
+  EXPECT_NE(ss.str().find("# HZ Z RI R 50"), std::string::npos) << ss.str();
+  std::ifstream js(dir / "a.json");
+  auto j = nlohmann::json::parse(js);
+  EXPECT_EQ(j["parameters"][0]["name"], "YE11");
+  EXPECT_EQ(j["parameters"][0]["updated"], 6.66e10);
+  EXPECT_EQ(j["stages"][0]["ran"], true);
+  EXPECT_THROW(ui::export_csv(r, (dir / "no/such/dir/a.csv").string()), std::runtime_error);
+  ui::PipelineResult empty;
+  EXPECT_THROW(ui::export_csv(empty, (dir / "b.csv").string()), std::runtime_error);
+  std::filesystem::remove_all(dir);
+}

@@ -1,0 +1,16 @@
+#pragma once
+// Exports of a pipeline result: the measured impedance as CSV (f_hz,re_ohm,im_ohm)
+// and Touchstone 1-port (.s1p, Z format), and a JSON report (parameters,
+// features, stages, warnings). Used by the GUI's Export buttons.
+#include <string>
+
+#include "ui/pipeline.hpp"
+
+namespace piezo::ui {
+
+// Each throws std::runtime_error naming the file when it cannot be written.
+void export_csv(const PipelineResult& r, const std::string& path);
+void export_touchstone(const PipelineResult& r, const std::string& path);
+void export_json(const PipelineResult& r, const std::string& path);
+
+}  // namespace piezo::ui
