@@ -56,7 +56,6 @@ struct AppState {
   std::map<std::string, ImVec4> button_rects;
   char export_base[256] = "piezobench-report";
   std::string png_request;  // set by the Export PNG button, served by the frame loop after rendering
-  double frame_ms_max_during_job = 0;
   std::vector<double> frame_ms_during_job;
 };
 
