@@ -9,6 +9,7 @@
 #include "model/harmonic.hpp"
 #include "update/impedance_file.hpp"
 #include "update/updater.hpp"
+#include "tests/support/tube_fixture.hpp"
 
 namespace piezo::update {
 namespace {
@@ -76,21 +77,9 @@ TEST(ImpedanceFile, TouchstoneFormats) {
   fs::remove(p);
 }
 
-class FileUpdate : public ::testing::Test {
+class FileUpdate : public test::TubeFixture {
  protected:
-  static void SetUpTestSuite() {
-    tube_ = new model::TubeModel(model::TubeGeometry{});
-    solver_ = new model::ModalSolver(*tube_);
-  }
-  static void TearDownTestSuite() {
-    delete solver_;
-    delete tube_;
-  }
-  static model::TubeModel* tube_;
-  static model::ModalSolver* solver_;
 };
-model::TubeModel* FileUpdate::tube_ = nullptr;
-model::ModalSolver* FileUpdate::solver_ = nullptr;
 
 // Extrema found to 2e-4 (grid 10 Hz = 2e-4 of 50 kHz before refinement; the
 // parabola does better, the damping shifts the extrema by ~ζ²).

@@ -6,6 +6,7 @@
 
 #include "update/least_squares.hpp"
 #include "update/updater.hpp"
+#include "tests/support/tube_fixture.hpp"
 
 namespace piezo::update {
 namespace {
@@ -14,21 +15,9 @@ using model::kEps0;
 const TubeParams kOriginal{6.3e10, 0.31, -175e-12, 1576 * kEps0};
 const TubeParams kTarget{6.66e10, 0.3333, -210e-12, 2294 * kEps0};
 
-class LeastSquares : public ::testing::Test {
+class LeastSquares : public test::TubeFixture {
  protected:
-  static void SetUpTestSuite() {
-    tube_ = new model::TubeModel(model::TubeGeometry{});
-    solver_ = new model::ModalSolver(*tube_);
-  }
-  static void TearDownTestSuite() {
-    delete solver_;
-    delete tube_;
-  }
-  static model::TubeModel* tube_;
-  static model::ModalSolver* solver_;
 };
-model::TubeModel* LeastSquares::tube_ = nullptr;
-model::ModalSolver* LeastSquares::solver_ = nullptr;
 
 MeasuredFeatures published() {
   MeasuredFeatures mf;

@@ -8,6 +8,7 @@
 #include <cstdio>
 
 #include "update/updater.hpp"
+#include "tests/support/tube_fixture.hpp"
 
 namespace piezo::update {
 namespace {
@@ -28,16 +29,8 @@ model::PiezoMaterialD apc850_insensitive() {
   return n;
 }
 
-class TubeUpdate : public ::testing::Test {
+class TubeUpdate : public test::TubeFixture {
  protected:
-  static void SetUpTestSuite() {
-    tube_ = new model::TubeModel(model::TubeGeometry{});
-    solver_ = new model::ModalSolver(*tube_);
-  }
-  static void TearDownTestSuite() {
-    delete solver_;
-    delete tube_;
-  }
   // Features of our own FE model of `p` (the inverse crime).
   static MeasuredFeatures own_features(const MaterialClass& cls, const TubeParams& p) {
     const auto m = cls.e_form(p);
@@ -69,11 +62,7 @@ class TubeUpdate : public ::testing::Test {
         r.iterations_elastic, r.iterations_piezo, r.elastic_per_sweep.front(),
         r.piezo_per_sweep.front(), r.sweeps, r.seconds);
   }
-  static model::TubeModel* tube_;
-  static model::ModalSolver* solver_;
 };
-model::TubeModel* TubeUpdate::tube_ = nullptr;
-model::ModalSolver* TubeUpdate::solver_ = nullptr;
 
 // Inverse crime, isotropic class: the features come from this FE model, so the
 // target is a fixed point and must be recovered to the iteration tolerances
