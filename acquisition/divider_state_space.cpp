@@ -4,52 +4,71 @@
 #include <stdexcept>
 #include <unsupported/Eigen/MatrixFunctions>
 
+#include "model/bench_response.hpp"
+
 namespace piezo::acq {
 
-std::vector<std::pair<double, double>> debye_network_for_loss(double c, double tan_delta, double f_lo,
-                                                              double f_hi) {
-  if (tan_delta <= 0) return {};
+std::complex<double> DebyeNetwork::capacitance(double omega) const {
+  std::complex<double> c = c_inf;
+  for (auto [ci, ti] : branches) c += ci / std::complex<double>(1.0, omega * ti);
+  return c;
+}
+
+DebyeNetwork debye_network_for_loss(double c, double tan_delta, double f_lo, double f_hi) {
   if (!(c > 0 && f_hi > f_lo && f_lo > 0))
     throw std::invalid_argument("debye_network_for_loss: need C > 0 and 0 < f_lo < f_hi");
-  // Relaxation times three per decade, a decade beyond the band on each side.
+  if (tan_delta < 0) throw std::invalid_argument("debye_network_for_loss: tan delta must be >= 0");
+  if (tan_delta == 0) return {c, {}};
+  // Relaxation times four per decade, a decade beyond the band on each side;
+  // column 0 is C_inf. Rows: real and imaginary parts relative to |C(ω)|.
   std::vector<double> tau;
-  for (double t = 0.1 / (2 * M_PI * f_hi); t <= 10.0 / (2 * M_PI * f_lo); t *= std::pow(10.0, 1.0 / 3))
+  for (double t = 0.1 / (2 * M_PI * f_hi); t <= 10.0 / (2 * M_PI * f_lo); t *= std::pow(10.0, 0.25))
     tau.push_back(t);
-  const int nw = 200, nb = static_cast<int>(tau.size());
-  Eigen::MatrixXd a(nw, nb);
-  Eigen::VectorXd y(nw);
+  const int nw = 240, nb = static_cast<int>(tau.size()) + 1;
+  Eigen::MatrixXd a(2 * nw, nb);
+  Eigen::VectorXd y(2 * nw);
   for (int i = 0; i < nw; ++i) {
-    double w = 2 * M_PI * f_lo * std::pow(f_hi / f_lo, i / (nw - 1.0));
-    double target = w * c * tan_delta;
-    for (int j = 0; j < nb; ++j) a(i, j) = w * w * tau[j] / (1 + w * w * tau[j] * tau[j]) / target;
-    y(i) = 1.0;  // relative fit: every frequency counts alike
+    const double w = 2 * M_PI * f_lo * std::pow(f_hi / f_lo, i / (nw - 1.0));
+    const std::complex<double> target = model::lossy_capacitance(c, tan_delta, w);
+    const double s = std::abs(target);
+    a(2 * i, 0) = 1.0 / s;
+    a(2 * i + 1, 0) = 0.0;
+    for (int j = 1; j < nb; ++j) {
+      const std::complex<double> col = 1.0 / std::complex<double>(1.0, w * tau[j - 1]);
+      a(2 * i, j) = col.real() / s;
+      a(2 * i + 1, j) = col.imag() / s;
+    }
+    y(2 * i) = target.real() / s;
+    y(2 * i + 1) = target.imag() / s;
   }
-  // Non-negative least squares by an active-set loop (Lawson–Hanson, small problem).
+  // Non-negative least squares by an active-set loop (Lawson–Hanson style, small problem).
   std::vector<bool> active(nb, true);
   Eigen::VectorXd x = Eigen::VectorXd::Zero(nb);
   for (int it = 0; it < 4 * nb; ++it) {
     std::vector<int> idx;
     for (int j = 0; j < nb; ++j)
       if (active[j]) idx.push_back(j);
-    Eigen::MatrixXd sub(nw, static_cast<int>(idx.size()));
+    Eigen::MatrixXd sub(2 * nw, static_cast<int>(idx.size()));
     for (std::size_t k = 0; k < idx.size(); ++k) sub.col(static_cast<int>(k)) = a.col(idx[k]);
-    Eigen::VectorXd s = sub.colPivHouseholderQr().solve(y);
+    Eigen::VectorXd sol = sub.colPivHouseholderQr().solve(y);
     bool neg = false;
     x.setZero();
     for (std::size_t k = 0; k < idx.size(); ++k) {
-      if (s(static_cast<int>(k)) < 0) {
+      if (sol(static_cast<int>(k)) < 0) {
         active[idx[k]] = false;
         neg = true;
       } else {
-        x(idx[k]) = s(static_cast<int>(k));
+        x(idx[k]) = sol(static_cast<int>(k));
       }
     }
     if (!neg) break;
   }
-  std::vector<std::pair<double, double>> out;
-  for (int j = 0; j < nb; ++j)
-    if (x(j) > 0) out.emplace_back(x(j), tau[j]);
-  return out;
+  DebyeNetwork net;
+  net.c_inf = x(0);
+  for (int j = 1; j < nb; ++j)
+    if (x(j) > 0) net.branches.emplace_back(x(j), tau[j - 1]);
+  if (!(net.c_inf > 0)) throw std::runtime_error("debye_network_for_loss: no positive high-frequency capacitance");
+  return net;
 }
 
 DividerStateSpace::DividerStateSpace(const model::ModalPortModel& port, const BenchCircuit& k) {
@@ -61,7 +80,9 @@ DividerStateSpace::DividerStateSpace(const model::ModalPortModel& port, const Be
   std::vector<const model::PortMode*> modes;
   for (const auto& m : port.modes)
     if (m.omega > 0 && m.participation != 0.0) modes.push_back(&m);
-  auto debye = debye_network_for_loss(ce, k.dielectric_loss);
+  const DebyeNetwork net = debye_network_for_loss(ce, k.dielectric_loss);
+  const auto& debye = net.branches;
+  const double c_inf = net.c_inf;  // Ce itself when there is no loss
 
   const bool rs = k.series_resistance_ohm > 0, cp = k.parallel_capacitance_f > 0;
   const bool v2_state = rs && cp;
@@ -76,9 +97,9 @@ DividerStateSpace::DividerStateSpace(const model::ModalPortModel& port, const Be
 
   // Rows of Ce_eff·vt' = (currents into the tube's terminal node) are built in `row`, then scaled.
   Eigen::RowVectorXd row = Eigen::RowVectorXd::Zero(n);
-  double row_b = 0.0, c_node = ce;
+  double row_b = 0.0, c_node = c_inf;
   if (!rs) {  // vt = v2: the node holds Ce + Cp; R1, the DAQ input and Debye branches meet there
-    c_node = ce + k.parallel_capacitance_f;
+    c_node = c_inf + k.parallel_capacitance_f;
     row(i_vt) += -g1 - gd;
     row_b += g1;
     c_(i_vt) = 1.0;
@@ -108,7 +129,7 @@ DividerStateSpace::DividerStateSpace(const model::ModalPortModel& port, const Be
   for (int m = 0; m < nm; ++m) {
     const auto& md = *modes[m];
     const int ix = i_m0 + 2 * m, iy = ix + 1;
-    const double ck = k.damping.alpha + (k.damping.beta + k.extra_beta_s) * md.kappa;
+    const double ck = k.damping.alpha + k.damping.beta * md.kappa + 2.0 * k.extra_damping_ratio * md.omega;
     a_(ix, iy) = 1.0;
     a_(iy, ix) = -md.omega * md.omega;
     a_(iy, iy) = -ck;
@@ -122,7 +143,7 @@ DividerStateSpace::DividerStateSpace(const model::ModalPortModel& port, const Be
   // the modes): the raw matrix mixes ω² ~ 1e11 with p/C, and the matrix
   // exponential's accuracy is relative to the norm. x_s = T x.
   Eigen::VectorXd tdiag = Eigen::VectorXd::Ones(n);
-  tdiag(i_vt) = std::sqrt(ce);
+  tdiag(i_vt) = std::sqrt(c_inf);
   if (v2_state) tdiag(i_v2) = std::sqrt(k.parallel_capacitance_f);
   for (int j = 0; j < nd; ++j) tdiag(i_d0 + j) = std::sqrt(debye[j].first);
   for (int m = 0; m < nm; ++m) tdiag(i_m0 + 2 * m) = modes[m]->omega;

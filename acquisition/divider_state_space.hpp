@@ -29,7 +29,7 @@ struct BenchCircuit {
   double daq_input_resistance_ohm = std::numeric_limits<double>::infinity();
   double dielectric_loss = 0.0;  // tan δ, realised by a Debye network on Ce
   model::RayleighDamping damping;
-  double extra_beta_s = 0.0;  // mechanical_damping effect
+  double extra_damping_ratio = 0.0;  // mechanical_damping effect: c_k += 2 ξ_m ω_k
 };
 
 class DividerStateSpace {
@@ -59,9 +59,17 @@ class DividerStateSpace {
   std::map<long long, Step> cache_;  // key: step length in femtoseconds
 };
 
-// The Debye network (series R–C branches) whose conductance approximates
-// ω·C·tanδ over [f_lo, f_hi]: returns (C_i, τ_i) pairs.
-std::vector<std::pair<double, double>> debye_network_for_loss(double c, double tan_delta,
-                                                              double f_lo = 100.0, double f_hi = 1e6);
+// A capacitor C_inf in parallel with Debye branches (series R–C, C_i and
+// τ_i = R_i C_i): C(ω) = C_inf + Σ C_i/(1 + jωτ_i). Causal by construction.
+struct DebyeNetwork {
+  double c_inf = 0;
+  std::vector<std::pair<double, double>> branches;  // (C_i, τ_i)
+  std::complex<double> capacitance(double omega) const;
+};
+
+// The network whose C(ω) approximates the constant-phase lossy capacitance of
+// model::lossy_capacitance(c, tanδ, ω) over [f_lo, f_hi] (non-negative least
+// squares, relative error). tanδ = 0 gives C_inf = c and no branches.
+DebyeNetwork debye_network_for_loss(double c, double tan_delta, double f_lo = 100.0, double f_hi = 1e6);
 
 }  // namespace piezo::acq

@@ -57,7 +57,7 @@ std::shared_ptr<drivers::sim::SimBench> make_sim_bench(const SimSpec& spec, doub
   c.daq_input_resistance_ohm = fx.daq_input_resistance_ohm;
   c.dielectric_loss = fx.dielectric_loss;
   c.damping = spec.damping;
-  c.extra_beta_s = fx.mechanical_damping;
+  c.extra_damping_ratio = fx.mechanical_damping;
 
   const auto iso = model::isotropic_params(mat.d);
   std::vector<std::pair<std::string, double>> truth = {

@@ -25,8 +25,8 @@ const EffectInfo kCatalogue[] = {
      "deviation of the true series resistor from its nominal value"},
     {"mass_loading", "fraction", 0.0, 0.5, &EffectSet::mass_loading,
      "mass added at the tube's end faces, as a fraction of the tube's mass"},
-    {"mechanical_damping", "s", 0.0, 1e-6, &EffectSet::mechanical_damping,
-     "stiffness-proportional damping beyond the fitted Rayleigh model"},
+    {"mechanical_damping", "damping_ratio", 0.0, 0.05, &EffectSet::mechanical_damping,
+     "modal damping ratio added to every mode (mounting/structural loss, not of Rayleigh form)"},
 };
 }  // namespace
 

@@ -20,7 +20,12 @@ struct EffectSet {
   double channel_gain = 0.0;  // relative gain error of channel 2
   double r1_tolerance = 0.0;  // true R1 = nominal·(1 + r1_tolerance)
   double mass_loading = 0.0;  // added mass at the end faces, fraction of the tube mass
-  double mechanical_damping = 0.0;  // extra stiffness-proportional damping β (s) beyond the fitted Rayleigh model
+  // Damping ratio ξ_m added to EVERY mode (c_k += 2 ξ_m ω_k): frequency-
+  // independent like a hysteretic/mounting loss, which the two-parameter
+  // Rayleigh model (ξ = α/2ω + βω/2) cannot reproduce across the modes. (An
+  // extra stiffness-proportional β would be absorbed exactly by the fitted
+  // Rayleigh β, so it could never be a gap.)
+  double mechanical_damping = 0.0;
 
   bool any() const;
 };

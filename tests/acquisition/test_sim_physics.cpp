@@ -8,6 +8,7 @@
 #include <complex>
 
 #include "acquisition/divider_state_space.hpp"
+#include "model/bench_response.hpp"
 #include "model/material_presets.hpp"
 #include "model/modal.hpp"
 #include "model/transient.hpp"
@@ -116,13 +117,66 @@ TEST(SimPhysics, SteadySineMatchesTheTransferFunction) {
   EXPECT_LT(std::abs(got - want) / std::abs(want), 2e-3);  // residual transient of the slowest modes
 }
 
-TEST(SimPhysics, DebyeNetworkGivesAConstantLossTangent) {
+TEST(SimPhysics, DebyeNetworkFollowsTheConstantPhaseCapacitance) {
   const double c = 2e-9, tan_delta = 0.02;
   auto net = acq::debye_network_for_loss(c, tan_delta);
-  ASSERT_FALSE(net.empty());
+  ASSERT_FALSE(net.branches.empty());
   for (double f = 1e3; f <= 2e5; f *= 1.5) {
-    double w = 2 * M_PI * f, g = 0;
-    for (auto [ci, taui] : net) g += w * w * taui * ci / (1 + w * w * taui * taui);
-    EXPECT_NEAR(g / (w * c), tan_delta, 0.05 * tan_delta) << f;  // within 5 % of tanδ over the band
+    const double w = 2 * M_PI * f;
+    const cd got = net.capacitance(w), want = model::lossy_capacitance(c, tan_delta, w);
+    EXPECT_LT(std::abs(got - want) / std::abs(want), 2e-4) << f;
+    EXPECT_NEAR(-got.imag() / got.real(), tan_delta, 0.02 * tan_delta) << f;  // constant loss tangent
+  }
+  // Causality's price of a constant loss: the real part falls with frequency,
+  // by (2δ/π)·ln(10) per decade (Kramers–Kronig), independent of the fit.
+  const double r = model::lossy_capacitance(c, tan_delta, 2 * M_PI * 1e3).real() /
+                   model::lossy_capacitance(c, tan_delta, 2 * M_PI * 1e4).real();
+  EXPECT_NEAR(std::log(r), 2 * std::atan(tan_delta) / M_PI * std::log(10.0), 1e-12);
+  EXPECT_NEAR(net.capacitance(2 * M_PI * 1e4).real() / net.capacitance(2 * M_PI * 1e5).real(), r, 1e-3);
+}
+
+// The diagnosis's frequency-domain twin of the bench (model/bench_response)
+// against the bench's own state space: every circuit effect at once.
+TEST(SimPhysics, BenchResponseModelEqualsTheSimulatedDivider) {
+  model::EffectSet fx;
+  fx.series_resistance_ohm = 12.0;
+  fx.parallel_capacitance_f = 150e-12;
+  fx.daq_input_resistance_ohm = 1e6;
+  fx.r1_tolerance = 0.02;
+  fx.mechanical_damping = 0.004;
+  fx.dielectric_loss = 0.015;
+  const double r1 = 3140.0;
+  acq::BenchCircuit c;
+  c.damping = beta7();
+  c.r1_ohm = r1 * (1 + fx.r1_tolerance);
+  c.series_resistance_ohm = fx.series_resistance_ohm;
+  c.parallel_capacitance_f = fx.parallel_capacitance_f;
+  c.daq_input_resistance_ohm = fx.daq_input_resistance_ohm;
+  c.dielectric_loss = fx.dielectric_loss;
+  c.extra_damping_ratio = fx.mechanical_damping;
+  acq::DividerStateSpace ss(apc850_port(), c);
+  std::vector<double> f = {1e3, 20e3, 50.5e3, 51.5e3, 55e3, 80e3, 101e3, 120e3};
+  auto z = model::bench_impedance(apc850_port(), beta7(), fx, r1, f);
+  for (std::size_t i = 0; i < f.size(); ++i) {
+    const cd h = ss.transfer(2 * M_PI * f[i]), want = r1 * h / (1.0 - h);
+    EXPECT_LT(std::abs(z[i] - want) / std::abs(want), 5e-4) << f[i];  // the Debye fit's accuracy
+  }
+  // Without the loss the two are the same algebra.
+  fx.dielectric_loss = c.dielectric_loss = 0;
+  acq::DividerStateSpace exact(apc850_port(), c);
+  z = model::bench_impedance(apc850_port(), beta7(), fx, r1, f);
+  for (std::size_t i = 0; i < f.size(); ++i) {
+    const cd h = exact.transfer(2 * M_PI * f[i]), want = r1 * h / (1.0 - h);
+    EXPECT_LT(std::abs(z[i] - want) / std::abs(want), 1e-9) << f[i];
+  }
+  // DAQ effects: the reported ratio of a skewed, mis-gained channel 2.
+  fx.channel_gain = 0.01;
+  fx.channel_skew_s = 50e-9;
+  for (double fi : f) {
+    const double w = 2 * M_PI * fi;
+    const cd h = exact.transfer(w) * 1.01 * std::exp(cd(0, -w * 50e-9));
+    const cd want = r1 * h / (1.0 - h);
+    const cd got = model::reported_impedance(model::tube_admittance(apc850_port(), beta7(), fx, w), fx, r1, w);
+    EXPECT_LT(std::abs(got - want) / std::abs(want), 1e-9) << fi;
   }
 }

@@ -1,0 +1,47 @@
+#include "model/bench_response.hpp"
+
+#include <cmath>
+#include <stdexcept>
+
+namespace piezo::model {
+
+using cd = std::complex<double>;
+
+cd lossy_capacitance(double c, double tan_delta, double omega) {
+  if (tan_delta == 0.0) return c;
+  if (!(omega > 0)) throw std::invalid_argument("lossy_capacitance: needs omega > 0");
+  const double delta = std::atan(tan_delta);
+  return c * std::pow(omega / (2 * M_PI * kDielectricLossRefHz), -2.0 * delta / M_PI) * std::polar(1.0, -delta);
+}
+
+cd tube_admittance(const ModalPortModel& port, const RayleighDamping& d, const EffectSet& fx, double omega) {
+  cd q = lossy_capacitance(port.c_clamped + port.c_residual, fx.dielectric_loss, omega);
+  for (const auto& m : port.modes) {
+    const double ck = d.alpha + d.beta * m.kappa + 2.0 * fx.mechanical_damping * m.omega;
+    q += m.participation * m.participation / cd(m.omega * m.omega - omega * omega, omega * ck);
+  }
+  return cd(0.0, omega) * q;
+}
+
+cd reported_impedance(cd y_tube, const EffectSet& fx, double r1_nominal_ohm, double omega) {
+  if (!(r1_nominal_ohm > 0)) throw std::invalid_argument("reported_impedance: R1 must be positive");
+  cd z = 1.0 / y_tube + fx.series_resistance_ohm;
+  cd y = 1.0 / z + cd(0.0, omega * fx.parallel_capacitance_f);
+  if (std::isfinite(fx.daq_input_resistance_ohm)) y += 1.0 / fx.daq_input_resistance_ohm;
+  const cd zn = 1.0 / y;
+  const cd h = zn / (zn + r1_nominal_ohm * (1.0 + fx.r1_tolerance));
+  const cd hm = h * (1.0 + fx.channel_gain) * std::exp(cd(0.0, -omega * fx.channel_skew_s));
+  return r1_nominal_ohm * hm / (1.0 - hm);
+}
+
+std::vector<cd> bench_impedance(const ModalPortModel& port, const RayleighDamping& d, const EffectSet& fx,
+                                double r1_nominal_ohm, std::span<const double> f_hz) {
+  std::vector<cd> z(f_hz.size());
+  for (std::size_t i = 0; i < f_hz.size(); ++i) {
+    const double w = 2 * M_PI * f_hz[i];
+    z[i] = reported_impedance(tube_admittance(port, d, fx, w), fx, r1_nominal_ohm, w);
+  }
+  return z;
+}
+
+}  // namespace piezo::model

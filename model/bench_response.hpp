@@ -1,0 +1,49 @@
+#pragma once
+// What the divider bench REPORTS as the transducer's impedance when the
+// catalogue's effects (model/effects.hpp) are present: the frequency-domain
+// twin of the simulated bench (acquisition/divider_state_space.hpp), used by
+// the gap diagnosis to fit effects as model extensions.
+//
+//   tube:      Y_t = jω·Q/V, Q/V from the port model with Rayleigh damping,
+//              c_k += 2 ξ_m ω_k (mechanical_damping) and Ce = C0 + C_res made
+//              lossy (dielectric_loss, see lossy_capacitance)
+//   terminals: Z_a = 1/Y_t + R_s (series_resistance)
+//   v2 node:   Y_n = 1/Z_a + jω C_p + 1/R_daq (parallel_capacitance, daq_input_resistance)
+//   divider:   H = v2/v1 = Z_n / (Z_n + R1·(1 + r1_tolerance))
+//   DAQ:       H' = H·(1 + channel_gain)·e^(−jωτ) (channel_skew τ: v2 sampled late)
+//   estimate:  Z_reported = R1·H' / (1 − H')   (eq. 139 with the NOMINAL R1)
+// The bench itself realises the lossy capacitance by a Debye network fitted
+// over 100 Hz – 1 MHz, so the two agree to that network's accuracy.
+#include <complex>
+#include <span>
+#include <vector>
+
+#include "model/effects.hpp"
+#include "model/port_model.hpp"
+
+namespace piezo::model {
+
+// Dielectric loss with a frequency-independent loss angle δ = atan(tanδ) must,
+// to be causal (Kramers–Kronig), come with a slowly falling real part: the
+// constant-phase capacitance
+//   C(ω) = C·(ω/ω_ref)^(−2δ/π)·e^(−jδ),   f_ref = kDielectricLossRefHz,
+// equal to C·(1 − j tanδ)·cos δ at the reference frequency (where εT33 is
+// quoted) and rising by (2δ/π)·ln(10) ≈ 1.5·tanδ per decade below it.
+constexpr double kDielectricLossRefHz = 1e3;
+std::complex<double> lossy_capacitance(double c, double tan_delta, double omega);
+
+// The tube alone: Y_t(ω) with the damping and loss effects of `fx` (circuit
+// and DAQ effects ignored).
+std::complex<double> tube_admittance(const ModalPortModel& port, const RayleighDamping& d,
+                                     const EffectSet& fx, double omega);
+
+// Z_reported(ω) from the tube's admittance (any source) and the circuit/DAQ effects.
+std::complex<double> reported_impedance(std::complex<double> y_tube, const EffectSet& fx,
+                                        double r1_nominal_ohm, double omega);
+
+// Both steps on a frequency grid (Hz).
+std::vector<std::complex<double>> bench_impedance(const ModalPortModel& port, const RayleighDamping& d,
+                                                  const EffectSet& fx, double r1_nominal_ohm,
+                                                  std::span<const double> f_hz);
+
+}  // namespace piezo::model
