@@ -33,6 +33,7 @@ void MeasurementPlan::validate() const {
   if (e.kind == Excitation::Chirp)
     require(e.f_start_hz > 0 && e.f_stop_hz > e.f_start_hz && e.f_stop_hz < nyq,
             "chirp needs 0 < f_start_hz < f_stop_hz < rate/2");
+  require(e.burst_fraction > 0 && e.burst_fraction <= 1, "burst_fraction must be in (0, 1]");
   require(range_v >= 0, "range_v must be >= 0");
 }
 
@@ -54,7 +55,10 @@ std::vector<ExcitationSpec> MeasurementPlan::steps() const {
 
 std::vector<double> synthesize(const ExcitationSpec& e, double fs, std::size_t n) {
   std::vector<double> w(n);
-  const double T = static_cast<double>(n) / fs;
+  const std::size_t nb = e.kind == Excitation::Chirp || e.kind == Excitation::Noise
+                             ? static_cast<std::size_t>(std::llround(e.burst_fraction * static_cast<double>(n)))
+                             : n;
+  const double T = static_cast<double>(nb) / fs;
   switch (e.kind) {
     case Excitation::ExpDecay:
       for (std::size_t k = 0; k < n; ++k) w[k] = std::exp(-e.decay_per_s * k / fs);
@@ -64,7 +68,7 @@ std::vector<double> synthesize(const ExcitationSpec& e, double fs, std::size_t n
       break;
     case Excitation::Chirp: {  // linear sweep over the record
       const double rate = (e.f_stop_hz - e.f_start_hz) / T;
-      for (std::size_t k = 0; k < n; ++k) {
+      for (std::size_t k = 0; k < nb; ++k) {
         double t = k / fs;
         w[k] = std::sin(2 * M_PI * (e.f_start_hz * t + 0.5 * rate * t * t));
       }
@@ -74,9 +78,9 @@ std::vector<double> synthesize(const ExcitationSpec& e, double fs, std::size_t n
       std::mt19937_64 rng(e.noise_seed);
       std::normal_distribution<double> g(0.0, 1.0);
       double peak = 0;
-      for (auto& x : w) {
-        x = g(rng);
-        peak = std::max(peak, std::fabs(x));
+      for (std::size_t k = 0; k < nb; ++k) {
+        w[k] = g(rng);
+        peak = std::max(peak, std::fabs(w[k]));
       }
       for (auto& x : w) x /= peak;
       break;
@@ -113,7 +117,8 @@ MeasurementPlan load_plan_toml(const std::filesystem::path& file) {
   if (auto ex = t["excitation"].as_table()) {
     for (auto& [k, v] : *ex) {
       static const std::vector<std::string> known = {"kind", "amplitude_v", "decay_per_s", "frequency_hz",
-                                                     "f_start_hz", "f_stop_hz", "f_step_hz", "seed"};
+                                                     "f_start_hz", "f_stop_hz", "f_step_hz", "seed",
+                                                     "burst_fraction"};
       if (std::find(known.begin(), known.end(), std::string(k.str())) == known.end())
         fail("excitation." + std::string(k.str()), "unknown key");
     }
@@ -129,6 +134,7 @@ MeasurementPlan load_plan_toml(const std::filesystem::path& file) {
     num(*ex, "f_start_hz", e.f_start_hz, "excitation.");
     num(*ex, "f_stop_hz", e.f_stop_hz, "excitation.");
     num(*ex, "f_step_hz", e.f_step_hz, "excitation.");
+    num(*ex, "burst_fraction", e.burst_fraction, "excitation.");
     if (auto s = (*ex)["seed"].value<std::int64_t>()) e.noise_seed = static_cast<std::uint64_t>(*s);
   }
   if (auto aq = t["acquisition"].as_table()) {

@@ -18,6 +18,10 @@ struct ExcitationSpec {
   double f_start_hz = 1e3, f_stop_hz = 120e3;  // chirp; stepped sine range
   double f_step_hz = 0.0;  // stepped sine: > 0 makes one shot per frequency
   std::uint64_t noise_seed = 1;  // noise excitation
+  // chirp / noise: the burst fills this fraction of the post-trigger record,
+  // then the output rests, so the transducer rings down inside the record
+  // (a burst cut by the record's end biases every FFT-based estimate).
+  double burst_fraction = 1.0;
 };
 
 struct MeasurementPlan {

@@ -11,6 +11,7 @@
 #include "dsp/cross_spectra.hpp"
 #include "dsp/fft_ratio.hpp"
 #include "dsp/prony_impedance.hpp"
+#include "dsp/shot_ensemble.hpp"
 #include "model/harmonic.hpp"
 #include "model/material_spec.hpp"
 #include "model/modal.hpp"
@@ -57,6 +58,24 @@ acq::Capture acquire(const PipelineRequest& req, PipelineResult& out, const Stag
   out.shots = res.shots_written;
   out.stages.push_back({"acquire", true, std::to_string(res.shots_written) + " shot(s) on " + bench.description});
   if (res.cancelled) out.warnings.push_back("cancelled during acquisition; kept " + std::to_string(res.shots_written) + " shot(s)");
+  return acq::read_capture(res.capture);
+}
+
+// A second capture of the same transducer with another plan (e.g. a chirp),
+// written as NAME-heldout.h5 next to the main capture, on the same bench.
+acq::Capture acquire_heldout(const PipelineRequest& req, const acq::MeasurementPlan& plan,
+                             std::shared_ptr<drivers::sim::SimBench>& sim, PipelineResult& out,
+                             const std::atomic<bool>& cancel) {
+  namespace fs = std::filesystem;
+  fs::path main(req.capture_out);
+  const fs::path path = main.parent_path() / (main.stem().string() + "-heldout" + main.extension().string());
+  acq::Bench bench = acq::open_bench({req.instrument, req.daq.empty() ? std::nullopt : std::optional(req.daq)}, sim);
+  acq::RunnerOptions ro;
+  ro.overwrite = true;
+  ro.software = "piezobench";
+  auto res = acq::run_measurement(bench, plan, path, ro, {}, &cancel);
+  out.heldout_path = res.capture.string();
+  out.stages.push_back({"acquire held-out", true, std::to_string(res.shots_written) + " shot(s) into " + out.heldout_path});
   return acq::read_capture(res.capture);
 }
 
@@ -159,7 +178,14 @@ std::vector<std::complex<double>> model_z(model::ModalSolver& solver, const mode
   return model::impedance_from_admittance(y);
 }
 
-void update_stage(const PipelineRequest& req, const acq::Capture& cap, const dsp::ImpedanceResult& z,
+struct UpdateOutcome {
+  bool ok = false;
+  update::TubeParams updated;
+  model::RayleighDamping damping;
+  double first_resonance_hz = 50e3;
+};
+
+UpdateOutcome update_stage(const PipelineRequest& req, const acq::Capture& cap, const dsp::ImpedanceResult& z,
                   const drivers::sim::SimBench* sim, PipelineResult& out) {
   update::MeasuredFeatures feat;
   feat.resonances_hz = out.resonances_hz;
@@ -195,7 +221,7 @@ void update_stage(const PipelineRequest& req, const acq::Capture& cap, const dsp
   out.stages.push_back({"update", r.ok(), note});
   if (!r.ok()) {
     out.warnings.push_back("model update did not converge: " + r.message);
-    return;
+    return {};
   }
   std::map<std::string, double> truth;
   if (sim)
@@ -216,6 +242,95 @@ void update_stage(const PipelineRequest& req, const acq::Capture& cap, const dsp
   const auto damping = damping_from_features(z, out);
   out.curves.push_back({"original model", grid, model_z(solver, cls.e_form(p0), grid, damping)});
   out.curves.push_back({"updated model", grid, model_z(solver, cls.e_form(r.updated), grid, damping)});
+  UpdateOutcome u;
+  u.ok = true;
+  u.updated = r.updated;
+  u.damping = damping;
+  if (!feat.resonances_hz.empty()) u.first_resonance_hz = feat.resonances_hz.front();
+  return u;
+}
+
+// Transient dut shots of one excitation kind (the fit's, or any other).
+std::vector<const acq::Shot*> dut_shots(const acq::Capture& cap, std::optional<acq::Excitation> kind, bool other) {
+  std::vector<const acq::Shot*> v;
+  for (const auto& s : cap.shots) {
+    if (s.role != acq::Role::Dut || s.excitation == acq::Excitation::Sine) continue;
+    if (kind && ((s.excitation == *kind) == other)) continue;
+    v.push_back(&s);
+  }
+  return v;
+}
+
+update::GapData gap_data(const acq::Capture& cap, const std::vector<const acq::Shot*>& shots, double floor,
+                         const std::string& what) {
+  std::vector<dsp::DividerRecord> recs;
+  for (const auto* s : shots) recs.push_back(acq::divider_record(cap, *s));
+  dsp::ShotEnsembleOptions o;
+  o.fmin_hz = 1e3;
+  o.fmax_hz = std::min(120e3, shots.front()->sample_rate_hz / 4);
+  const auto e = dsp::impedance_shot_ensemble(recs, o);
+  update::GapData d;
+  for (Eigen::Index i = 0; i < e.f_hz.size(); ++i) {
+    d.f_hz.push_back(e.f_hz[i]);
+    d.z_ohm.push_back(e.z_ohm[i]);
+    d.sigma_log_mag.push_back(std::hypot(e.sigma_log_mag[i], floor));
+    d.sigma_phase.push_back(std::hypot(e.sigma_phase[i], floor));
+  }
+  d.description = what + ": " + std::to_string(e.shots) + " shots, " + std::to_string(d.size()) + " frequencies";
+  return d;
+}
+
+void diagnose_stage(const PipelineRequest& req, const acq::Capture& cap, const acq::Capture* heldout_cap,
+                    const UpdateOutcome& u, PipelineResult& out, const Stages& progress,
+                    const std::atomic<bool>& cancel) {
+  auto fit_shots = dut_shots(cap, std::nullopt, false);
+  if (fit_shots.empty()) throw std::invalid_argument("gap diagnosis: the capture holds no transient dut shot");
+  const acq::Excitation kind = fit_shots.front()->excitation;
+  fit_shots = dut_shots(cap, kind, false);
+  std::vector<const acq::Shot*> ho_shots;
+  const acq::Capture* ho_cap = &cap;
+  std::string ho_what;
+  if (heldout_cap) {
+    ho_cap = heldout_cap;
+    ho_shots = dut_shots(*heldout_cap, std::nullopt, false);
+    ho_what = "held-out capture " + out.heldout_path;
+  } else if (auto other = dut_shots(cap, kind, true); other.size() >= 3) {
+    ho_shots = other;
+    ho_what = "held-out shots of another excitation";
+  } else if (fit_shots.size() >= 6) {
+    std::vector<const acq::Shot*> even, odd;
+    for (std::size_t i = 0; i < fit_shots.size(); ++i) (i % 2 ? odd : even).push_back(fit_shots[i]);
+    fit_shots = even;
+    ho_shots = odd;
+    ho_what = "held-out odd-numbered shots";
+  }
+  if (fit_shots.size() < 3)
+    throw std::invalid_argument("gap diagnosis: needs at least 3 repeated shots of one drive (the noise is measured from them)");
+  const update::GapData fit = gap_data(cap, fit_shots, req.gap_floor, "fit data");
+  std::optional<update::GapData> ho;
+  if (ho_shots.size() >= 3) ho = gap_data(*ho_cap, ho_shots, req.gap_floor, ho_what);
+  else out.warnings.push_back("gap diagnosis without held-out data (fewer than 3 other shots)");
+
+  auto nominal = model::resolve_material({req.material, req.isotropic, ""});
+  model::TubeGeometry g = cap.setup.geometry();
+  if (!cap.setup.density_kg_m3) g.density_kg_m3 = nominal.density_kg_m3;
+  model::TubeModel tube(g);
+  model::ModalSolver solver(tube);
+  const auto cls = req.isotropic ? update::MaterialClass::isotropic()
+                                 : update::MaterialClass::transversely_isotropic(nominal.d);
+  update::GapOptions go;
+  go.candidates = req.gap_candidates;
+  go.damping_ref_hz = u.first_resonance_hz;
+  auto d = update::diagnose_gap(
+      solver, cls, u.updated, u.damping, cap.setup.divider_r1_ohm, fit, ho ? &*ho : nullptr, go,
+      [&](double f, const std::string& s) { progress(0.7 + 0.29 * f, s); }, &cancel);
+  char note[200];
+  std::snprintf(note, sizeof note, "gap chi2/dof %.2f on %s%s; verdict: %s (%.1f s)", d.gap_fit,
+                fit.description.c_str(), ho ? (", held-out " + std::to_string(d.gap_heldout.value_or(0)).substr(0, 5)).c_str() : "",
+                d.verdict_effect.c_str(), d.seconds);
+  out.stages.push_back({"diagnose", true, note});
+  out.verdict = d.verdict;
+  out.diagnosis = std::move(d);
 }
 
 }  // namespace
@@ -238,9 +353,25 @@ PipelineResult run_pipeline(const PipelineRequest& req, const std::function<void
   }
   if (cancel) return out;
   progress(0.6, "update: extended CMCM");
-  update_stage(req, cap, z, sim.get(), out);
+  const UpdateOutcome u = update_stage(req, cap, z, sim.get(), out);
   if (cancel) return out;
-  out.stages.push_back({"diagnose", false, "gap diagnosis not built into this version yet"});
+  if (!req.diagnose) {
+    out.stages.push_back({"diagnose", false, "not requested"});
+  } else if (!u.ok) {
+    out.stages.push_back({"diagnose", false, "needs a converged update"});
+  } else {
+    std::optional<acq::Capture> heldout;
+    if (!req.heldout_capture.empty()) {
+      out.heldout_path = req.heldout_capture;
+      heldout = acq::read_capture(req.heldout_capture);
+    } else if (req.heldout_plan && req.replay_capture.empty()) {
+      progress(0.65, "acquire: held-out capture");
+      heldout = acquire_heldout(req, *req.heldout_plan, sim, out, cancel);
+    }
+    if (cancel) return out;
+    progress(0.7, "diagnose: gap");
+    diagnose_stage(req, cap, heldout ? &*heldout : nullptr, u, out, progress, cancel);
+  }
   progress(1.0, "done");
   return out;
 }

@@ -12,6 +12,7 @@
 
 #include "acquisition/plan.hpp"
 #include "acquisition/sim_setup.hpp"
+#include "update/gap_diagnosis.hpp"
 
 namespace piezo::ui {
 
@@ -25,6 +26,18 @@ struct PipelineRequest {
   std::string replay_capture;  // non-empty: skip acquisition
   std::string material = "apc850";  // nominal model to update
   bool isotropic = true;
+  // Gap diagnosis (update/gap_diagnosis.hpp). Held-out data, in this order:
+  // `heldout_capture` (replay), a second acquisition with `heldout_plan`
+  // (written next to capture_out as NAME-heldout.h5), dut shots of another
+  // excitation in the capture, or else the odd-numbered repeated shots (the
+  // fit then uses the even ones).
+  bool diagnose = true;
+  std::optional<acq::MeasurementPlan> heldout_plan;
+  std::string heldout_capture;
+  std::vector<std::string> gap_candidates;  // empty: all supported
+  // Relative floor added in quadrature to the measured noise of ln Z (model
+  // and estimator systematics that repeated shots cannot see).
+  double gap_floor = 2e-3;
 };
 
 struct Curve {
@@ -56,6 +69,8 @@ struct PipelineResult {
   int order = 0;
   std::vector<ParamRow> params;
   std::string verdict;
+  std::optional<update::GapDiagnosis> diagnosis;
+  std::string heldout_path;  // the held-out capture, when there is one
   std::vector<StageReport> stages;
   std::vector<std::string> warnings;
 };

@@ -58,9 +58,58 @@ void export_json(const PipelineResult& r, const std::string& path) {
   j["stages"] = nlohmann::json::array();
   for (const auto& s : r.stages) j["stages"].push_back({{"name", s.name}, {"ran", s.ran}, {"note", s.note}});
   j["verdict"] = r.verdict;
+  if (r.diagnosis) j["diagnosis"] = diagnosis_json(*r.diagnosis);
   j["warnings"] = r.warnings;
   auto f = open_out(path);
   f << j.dump(2) << "\n";
+}
+
+nlohmann::json diagnosis_json(const update::GapDiagnosis& d) {
+  auto opt = [](const std::optional<double>& v) { return v ? nlohmann::json(*v) : nlohmann::json(nullptr); };
+  nlohmann::json j;
+  j["verdict"] = d.verdict;
+  j["verdict_effect"] = d.verdict_effect;
+  j["gap"] = d.gap;
+  j["gap_fit"] = d.gap_fit;
+  j["chi2_fit"] = d.chi2_fit;
+  j["n_fit"] = d.n_fit;
+  j["gap_heldout"] = opt(d.gap_heldout);
+  j["chi2_heldout"] = opt(d.chi2_heldout);
+  j["n_heldout"] = d.n_heldout;
+  j["heldout_shrink"] = opt(d.heldout_shrink);
+  j["fit_data"] = d.fit_description;
+  j["heldout_data"] = d.heldout_description;
+  j["added"] = d.added;
+  j["material_base"] = {{"YE11", d.material_base.y_e11}, {"nu12", d.material_base.nu12}, {"d31", d.material_base.d31},
+                        {"epsT33_rel", d.material_base.eps_t33 / model::kEps0}};
+  j["regions"] = nlohmann::json::array();
+  for (const auto& g : d.regions)
+    j["regions"].push_back({{"name", g.name}, {"f_lo_hz", g.f_lo_hz}, {"f_hi_hz", g.f_hi_hz}, {"points", g.points},
+                            {"chi2", g.chi2}, {"share", g.share}, {"kind", g.kind}, {"shift_pct", g.shift_pct},
+                            {"width_pct", g.width_pct}, {"level_db", g.level_db}, {"phase_deg", g.phase_deg}});
+  auto eff = [&](const update::EffectReport& e) {
+    nlohmann::json r = {{"name", e.name}, {"unit", e.unit}, {"alias", e.alias}, {"alias_residual", e.alias_residual},
+                        {"detectability", e.detectability}, {"typical", e.typical},
+                        {"alias_bias_pct", {{"YE11", e.bias_y_e11_pct}, {"nu12", e.bias_nu12_pct},
+                                            {"d31", e.bias_d31_pct}, {"epsT33", e.bias_eps_t33_pct}}}};
+    if (e.fitted) {
+      r["value"] = e.value;
+      r["sigma"] = e.sigma;
+      r["chi2_after"] = e.chi2_after;
+      r["delta_chi2"] = e.delta_chi2;
+      r["shrink_fit"] = e.shrink_fit;
+      r["significant"] = e.significant;
+      r["heldout_shrink"] = opt(e.heldout_shrink);
+    }
+    if (!e.note.empty()) r["note"] = e.note;
+    return r;
+  };
+  j["effects"] = nlohmann::json::array();
+  for (const auto& e : d.effects) j["effects"].push_back(eff(e));
+  j["steps"] = nlohmann::json::array();
+  for (const auto& e : d.steps) j["steps"].push_back(eff(e));
+  j["seconds"] = d.seconds;
+  return j;
 }
 
 }  // namespace piezo::ui

@@ -2,6 +2,7 @@
 // Exports of a pipeline result: the measured impedance as CSV (f_hz,re_ohm,im_ohm)
 // and Touchstone 1-port (.s1p, Z format), and a JSON report (parameters,
 // features, stages, warnings). Used by the GUI's Export buttons.
+#include <nlohmann/json.hpp>
 #include <string>
 
 #include "ui/pipeline.hpp"
@@ -12,5 +13,8 @@ namespace piezo::ui {
 void export_csv(const PipelineResult& r, const std::string& path);
 void export_touchstone(const PipelineResult& r, const std::string& path);
 void export_json(const PipelineResult& r, const std::string& path);
+
+// The gap diagnosis as JSON (the "diagnosis" object of the report and of `demo --json`).
+nlohmann::json diagnosis_json(const update::GapDiagnosis& d);
 
 }  // namespace piezo::ui

@@ -25,16 +25,21 @@ double PiecewiseLinear::at(double time) const {
   return v[j - 1] + f * (v[j] - v[j - 1]);
 }
 
-// The AWG output: the offset before the burst, a jump at t = 0 to the first
-// arb sample, the arb linear between its samples, a jump back after it.
+// The AWG output: a sampled generator interpolating linearly between its
+// samples, the idle level (offset) being its sample before the burst and after
+// it. So the burst's first sample is reached by a ramp from t = −Δt and left
+// by a ramp to the offset: no jump the DAQ's samples could not represent (a
+// jump at t = 0 would sit half a sample away from the ramp that the samples
+// imply, which a divider estimate reads as a 0.5/fs skew between channels).
 PiecewiseLinear SimBench::generator_knots(double t_begin, double t_end) const {
   PiecewiseLinear w;
   const double off = awg_.offset_v;
-  w.t.push_back(std::min(t_begin, 0.0));
+  const double dt_awg = awg_.arb_rate_hz > 0 ? 1.0 / awg_.arb_rate_hz : 0.0;
+  w.t.push_back(std::min(t_begin, -dt_awg));
   w.v.push_back(off);
   if (awg_.output_on && !awg_.arb.empty()) {
-    const double half = 0.5 * awg_.vpp, dt = 1.0 / awg_.arb_rate_hz;
-    w.t.push_back(0.0);
+    const double half = 0.5 * awg_.vpp, dt = dt_awg;
+    w.t.push_back(-dt);
     w.v.push_back(off);
     for (std::size_t i = 0; i < awg_.arb.size(); ++i) {
       double ti = static_cast<double>(i) * dt;
@@ -42,11 +47,8 @@ PiecewiseLinear SimBench::generator_knots(double t_begin, double t_end) const {
       w.t.push_back(ti);
       w.v.push_back(off + half * awg_.arb[i]);
     }
-    // The last arb sample is held for one sample period, then the output returns to the offset.
-    double t_last = w.t.back() + dt;
-    w.t.push_back(t_last);
-    w.v.push_back(w.v.back());
-    w.t.push_back(t_last);
+    // After the last arb sample the output ramps back to the offset over one sample period.
+    w.t.push_back(w.t.back() + dt);
     w.v.push_back(off);
   }
   if (w.t.back() < t_end) {

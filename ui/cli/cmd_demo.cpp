@@ -6,7 +6,10 @@
 #include <iostream>
 
 #include "ui/cli/cli_common.hpp"
+#include "model/effects.hpp"
+#include "ui/cli/diagnosis_text.hpp"
 #include "ui/pipeline.hpp"
+#include "ui/report_export.hpp"
 
 namespace piezo::cli {
 
@@ -16,11 +19,15 @@ void register_demo_command(CLI::App& app, Context& ctx) {
     std::string out_dir = "demo-out";
     double noise = 0.005;
     std::uint64_t seed = 2016;
+    std::vector<std::string> effects;
+    bool no_diagnose = false;
   };
   auto a = std::make_shared<Args>();
   demo->add_option("--out", a->out_dir, "Folder for the demo's files")->capture_default_str();
   demo->add_option("--noise", a->noise, "White noise per channel, std(noise)/std(signal)")->capture_default_str();
   demo->add_option("--seed", a->seed, "Noise seed")->capture_default_str();
+  demo->add_option("--effect", a->effects, "Bench effect the simulated bench adds and the model lacks, NAME=VALUE (repeatable)");
+  demo->add_flag("--no-diagnose", a->no_diagnose, "Stop after the update");
   add_json_flag(demo, ctx);
   demo->callback([&ctx, a] {
     ctx.exit_code = run_command(ctx, [&] {
@@ -40,6 +47,15 @@ void register_demo_command(CLI::App& app, Context& ctx) {
       req.sim.set = "YE11=6.66e10,nu12=0.3333,d31=-210e-12,epsT33_rel=2294";
       req.sim.noise_rel = a->noise;
       req.sim.seed = a->seed;
+      for (const auto& e : a->effects) model::apply_effect_assignment(req.sim.effects, e);
+      req.diagnose = !a->no_diagnose;
+      // Held-out data for the gap diagnosis: a chirp of the same tube, 1-150 kHz.
+      acq::MeasurementPlan ho = req.plan;
+      ho.excitation.kind = acq::Excitation::Chirp;
+      ho.excitation.f_start_hz = 1e3;
+      ho.excitation.f_stop_hz = 150e3;
+      ho.excitation.burst_fraction = 0.6;
+      req.heldout_plan = ho;
       req.capture_out = (fs::path(a->out_dir) / "demo-capture.h5").string();
       req.material = "apc850";
       req.isotropic = true;
@@ -61,6 +77,7 @@ void register_demo_command(CLI::App& app, Context& ctx) {
         j["parameters"].push_back(r);
       }
       j["verdict"] = res.verdict;
+      if (res.diagnosis) j["diagnosis"] = ui::diagnosis_json(*res.diagnosis);
       j["warnings"] = res.warnings;
       if (ctx.json) {
         print_json(j);
@@ -81,7 +98,7 @@ void register_demo_command(CLI::App& app, Context& ctx) {
           std::printf("  %-12s %14.6g %14.6g %14s %10s\n", p.name.c_str(), p.original, p.updated, t, e);
         }
       }
-      if (!res.verdict.empty()) std::cout << "\n  gap verdict: " << res.verdict << "\n";
+      if (res.diagnosis) print_diagnosis(std::cout, *res.diagnosis);
       for (const auto& w : res.warnings) std::cout << "  warning: " << w << "\n";
       std::cout << "\n  capture: " << res.capture_path << " (inspect: piezobench capture info " << res.capture_path
                 << ")\n";

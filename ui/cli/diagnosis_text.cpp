@@ -1,0 +1,51 @@
+#include "ui/cli/diagnosis_text.hpp"
+
+#include <cstdio>
+#include <string>
+
+namespace piezo::cli {
+
+namespace {
+std::string fmt(const char* f, double a, double b = 0, double c = 0) {
+  char buf[128];
+  std::snprintf(buf, sizeof buf, f, a, b, c);
+  return buf;
+}
+}  // namespace
+
+void print_diagnosis(std::ostream& os, const update::GapDiagnosis& d) {
+  os << "\n  gap diagnosis (" << d.fit_description;
+  if (!d.heldout_description.empty()) os << "; " << d.heldout_description;
+  os << ")\n";
+  os << fmt("    misfit chi2/dof %.2f on the fit data", d.gap_fit);
+  if (d.gap_heldout) os << fmt(", %.2f held out", *d.gap_heldout);
+  os << " (1 = at the noise)\n";
+  os << "    where (share of chi2, kind):\n";
+  for (const auto& g : d.regions) {
+    if (g.points == 0) continue;
+    os << fmt("      %5.1f %%  ", 100 * g.share) << g.name << fmt(" [%.1f-%.1f kHz]: ", g.f_lo_hz / 1e3, g.f_hi_hz / 1e3)
+       << g.kind;
+    if (g.kind == "frequency shift") os << fmt(" %+.3f %%", g.shift_pct);
+    if (g.kind == "peak width/height") os << fmt(" damping %+.1f %%", g.width_pct);
+    if (g.kind == "level") os << fmt(" %+.3f dB", g.level_db);
+    if (g.kind == "phase") os << fmt(" %+.3f deg", g.phase_deg);
+    os << "\n";
+  }
+  os << "    candidate effects (refitted with the constants; held-out shrink decides):\n";
+  for (const auto& e : d.effects) {
+    os << "      " << e.name << ": ";
+    if (e.alias) {
+      os << fmt("ALIAS (%.1f %% of its signature left; a typical %.3g ", 100 * e.alias_residual, e.typical) << e.unit
+         << fmt(" would read as epsT33 %+.2f %%, d31 %+.2f %%", e.bias_eps_t33_pct, e.bias_d31_pct)
+         << fmt(", YE11 %+.2f %%)", e.bias_y_e11_pct) << "\n";
+      continue;
+    }
+    os << fmt("%.4g +/- %.2g ", e.value, e.sigma) << e.unit << fmt(", delta chi2 %.1f", e.delta_chi2)
+       << (e.significant ? " (significant)" : "");
+    if (e.heldout_shrink) os << fmt(", held-out shrink %.0f %%", 100 * *e.heldout_shrink);
+    os << "\n";
+  }
+  os << "    verdict: " << d.verdict << "\n";
+}
+
+}  // namespace piezo::cli

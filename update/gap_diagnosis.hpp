@@ -1,0 +1,102 @@
+#pragma once
+// The sim-to-real gap after updating (issue 7): how far the updated model
+// still is from the measurement, where in frequency, of what kind, which
+// unmodelled effect of the catalogue (model/effects.hpp) explains it, and how
+// much it shrinks once that effect is added — judged on held-out data.
+//
+//  1. Base fit: the four material parameters + Rayleigh α, β refitted to the
+//     whole measured Z(f) (update/gap_fit.hpp), starting from the CMCM
+//     update. Its χ² against the measurement's own noise is the gap; a gap
+//     within 3σ of χ²'s spread is "no gap".
+//  2. Where: the base misfit by region (capacitive band, each resonance and
+//     anti-resonance neighbourhood, the bands between, the high-frequency
+//     tail), each with its share of χ² and a decomposition into frequency
+//     shift, peak width/height, level and phase.
+//  3. Identifiability: an effect whose Jacobian column lies (almost) in the
+//     span of the material + damping columns is an ALIAS: the impedance alone
+//     cannot tell it from a change of constants; it is reported with the
+//     bias it would put on them, never as a gap.
+//  4. Which: every identifiable effect refitted together with material and
+//     damping; value ± σ, Δχ² (significant only beyond a 5σ penalty scaled
+//     by the remaining misfit), and the held-out shrink 1 − g_after/g_before
+//     of the excess gap g = √max(0, χ²/N − 1) on data the fit never saw.
+//     Greedy: the best significant effect is added and the rest refitted, at
+//     most `max_effects` times.
+#include <atomic>
+#include <functional>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "update/gap_fit.hpp"
+#include "update/gap_regions.hpp"
+
+namespace piezo::update {
+
+struct EffectReport {
+  std::string name, unit;
+  bool alias = false;
+  double alias_residual = 0;  // ‖(I − P)j‖/‖j‖: 0 = mimicked exactly by the constants
+  double detectability = 0;   // ‖(I − P)j‖ at the typical magnitude, in σ units
+  double typical = 0;         // SI, the magnitude the two numbers above refer to
+  // Bias on the refitted constants that a typical magnitude would cause, %.
+  double bias_y_e11_pct = 0, bias_nu12_pct = 0, bias_d31_pct = 0, bias_eps_t33_pct = 0;
+  bool fitted = false;
+  double value = 0, sigma = 0;  // SI
+  double chi2_after = 0, delta_chi2 = 0, shrink_fit = 0;
+  bool significant = false;
+  std::optional<double> heldout_chi2_after, heldout_shrink;
+  TubeParams material;  // refitted with the effect
+  std::string note;
+};
+
+struct GapCurve {  // misfit ln(Z_meas/Z_model) for plots
+  std::vector<double> f_hz, residual_db, residual_deg, sigma_db, sigma_deg;
+};
+
+struct GapDiagnosis {
+  bool gap = false;  // significant on the fit data or the held-out data
+  double chi2_fit = 0;
+  int n_fit = 0, dof_fit = 0;
+  double gap_fit = 0;  // √(χ²/dof): 1 = at the noise
+  std::optional<double> chi2_heldout, gap_heldout;
+  int n_heldout = 0;
+  std::string fit_description, heldout_description;
+  TubeParams material_base;            // base refit
+  model::RayleighDamping damping_base;
+  std::vector<GapRegion> regions;      // of the base misfit
+  std::vector<EffectReport> effects;   // first round, ranked best first; aliases last
+  std::vector<std::string> added;      // greedy selection, in order
+  std::vector<EffectReport> steps;     // the fit of each added effect (in the model with the previous ones)
+  std::optional<double> heldout_shrink;  // of all added effects together
+  GapCurve before, after;              // base model, and with the added effects
+  std::string verdict_effect;          // "none", an effect name (first added), or "unexplained"
+  std::string verdict;                 // one sentence for the technician
+  double seconds = 0;
+};
+
+struct GapOptions {
+  std::vector<std::string> candidates;  // empty: every effect the model supports
+  int max_effects = 3;
+  double alias_threshold = 0.05;        // alias_residual below this → alias
+  double significance = 25.0;           // Δχ² (1 dof) beyond this, scaled by χ²/dof if > 1
+  double min_heldout_shrink = 0.3;
+  double gap_tolerance = 0.3;           // χ²/N beyond 1 + this (and 3σ) is a gap      // an effect must shrink the held-out gap this much to be added
+  double damping_ref_hz = 50e3;
+  GapFitOptions fit;
+};
+
+// The measured data: `fit` (the capture the update used) and optionally
+// `heldout` (another capture or other shots of the same transducer).
+// Throws std::invalid_argument for bad data and std::runtime_error when the
+// FE model fails; checks `cancel` between candidates.
+GapDiagnosis diagnose_gap(model::ModalSolver& solver, const MaterialClass& cls, const TubeParams& start,
+                          const model::RayleighDamping& damping_start, double r1_nominal_ohm, const GapData& fit,
+                          const GapData* heldout, const GapOptions& opt = {},
+                          const std::function<void(double, const std::string&)>& progress = {},
+                          const std::atomic<bool>* cancel = nullptr);
+
+// Effects GapModel can fit (the catalogue minus those the model cannot represent).
+std::vector<std::string> supported_gap_effects();
+
+}  // namespace piezo::update

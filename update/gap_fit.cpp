@@ -1,0 +1,156 @@
+#include "update/gap_fit.hpp"
+
+#include <Eigen/Dense>
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <stdexcept>
+
+
+namespace piezo::update {
+
+namespace {
+constexpr double kStep = 1e-3;  // x units for the Jacobian
+}
+
+void GapData::validate(const char* who) const {
+  const std::size_t n = f_hz.size();
+  if (n < 8 || z_ohm.size() != n || sigma_log_mag.size() != n || sigma_phase.size() != n)
+    throw std::invalid_argument(std::string(who) + ": gap data needs >= 8 points with Z and both uncertainties");
+  for (std::size_t i = 0; i < n; ++i)
+    if (!(f_hz[i] > 0) || !(sigma_log_mag[i] > 0) || !(sigma_phase[i] > 0) || !std::isfinite(std::abs(z_ohm[i])) ||
+        z_ohm[i] == 0.0)
+      throw std::invalid_argument(std::string(who) + ": gap data point " + std::to_string(i) +
+                                  " has a non-positive frequency/uncertainty or a non-finite Z");
+}
+
+std::vector<double> gap_residuals(const GapModel& m, const GapData& d, const std::vector<double>& x) {
+  const auto z = m.impedance(x, d.f_hz);
+  std::vector<double> r(2 * d.size());
+  for (std::size_t i = 0; i < d.size(); ++i) {
+    const std::complex<double> l = std::log(d.z_ohm[i] / z[i]);
+    r[2 * i] = l.real() / d.sigma_log_mag[i];
+    r[2 * i + 1] = l.imag() / d.sigma_phase[i];
+  }
+  return r;
+}
+
+double gap_chi2(const GapModel& m, const GapData& d, const std::vector<double>& x) {
+  double c = 0;
+  for (double v : gap_residuals(m, d, x)) c += v * v;
+  return std::isfinite(c) ? c : std::numeric_limits<double>::infinity();
+}
+
+std::vector<std::vector<double>> gap_jacobian(const GapModel& m, const GapData& d, const std::vector<double>& x,
+                                              const std::vector<int>& columns) {
+  std::vector<std::vector<double>> out;
+  for (int j : columns) {
+    std::vector<double> xp = x, xm = x;
+    xp[static_cast<std::size_t>(j)] += kStep;
+    xm[static_cast<std::size_t>(j)] -= kStep;
+    auto a = gap_residuals(m, d, xp), b = gap_residuals(m, d, xm);
+    for (std::size_t i = 0; i < a.size(); ++i) a[i] = (a[i] - b[i]) / (2 * kStep);
+    out.push_back(std::move(a));
+  }
+  return out;
+}
+
+GapFit fit_gap(GapModel& m, const GapData& d, const std::vector<double>& x0, const std::vector<bool>& free,
+               const GapFitOptions& opt) {
+  d.validate("fit_gap");
+  const auto& info = m.params();
+  if (x0.size() != info.size() || free.size() != info.size())
+    throw std::invalid_argument("fit_gap: parameter vector does not match the model");
+  std::vector<int> cols;
+  for (int j = 0; j < static_cast<int>(free.size()); ++j)
+    if (free[static_cast<std::size_t>(j)]) cols.push_back(j);
+  const int p = static_cast<int>(cols.size());
+  GapFit fit;
+  fit.free = free;
+  fit.x = x0;
+  for (std::size_t j = 0; j < x0.size(); ++j) fit.x[j] = std::clamp(x0[j], info[j].lower, info[j].upper);
+  fit.n = static_cast<int>(2 * d.size());
+  fit.dof = fit.n - p;
+  auto clamp_all = [&](std::vector<double>& x) {
+    for (std::size_t j = 0; j < x.size(); ++j) x[j] = std::clamp(x[j], info[j].lower, info[j].upper);
+  };
+  Eigen::MatrixXd jtj;
+  for (int outer = 0; outer <= opt.max_relinearisations; ++outer) {
+    double chi = gap_chi2(m, d, fit.x), lambda = 1e-3;
+    bool done = false;
+    for (int it = 0; it < opt.max_iterations && !done; ++it) {
+      ++fit.iterations;
+      const auto r = gap_residuals(m, d, fit.x);
+      const auto jc = gap_jacobian(m, d, fit.x, cols);
+      Eigen::MatrixXd j(fit.n, p);
+      for (int c = 0; c < p; ++c) j.col(c) = Eigen::Map<const Eigen::VectorXd>(jc[static_cast<std::size_t>(c)].data(), fit.n);
+      const Eigen::VectorXd rv = Eigen::Map<const Eigen::VectorXd>(r.data(), fit.n);
+      jtj = j.transpose() * j;
+      const Eigen::VectorXd g = j.transpose() * rv;
+      bool accepted = false;
+      for (int tries = 0; tries < 12 && !accepted; ++tries) {
+        Eigen::MatrixXd a = jtj;
+        for (int c = 0; c < p; ++c) a(c, c) += lambda * std::max(jtj(c, c), 1e-12);
+        const Eigen::VectorXd step = a.ldlt().solve(-g);
+        std::vector<double> xn = fit.x;
+        for (int c = 0; c < p; ++c) xn[static_cast<std::size_t>(cols[static_cast<std::size_t>(c)])] += step(c);
+        clamp_all(xn);
+        const double cn = gap_chi2(m, d, xn);
+        if (std::isfinite(cn) && cn <= chi) {
+          const double rel = (chi - cn) / std::max(chi, 1e-300);
+          fit.x = xn;
+          chi = cn;
+          lambda = std::max(lambda / 3, 1e-9);
+          accepted = true;
+          if (rel < opt.chi2_tolerance) done = true;
+        } else {
+          lambda *= 4;
+        }
+      }
+      if (!accepted) done = true;  // no descent at any damping: a (local) minimum
+    }
+    fit.chi2 = chi;
+    fit.converged = done;
+
+    // The linearised port model is accurate near its reference only.
+    bool far = false;
+    for (int i = 0; i < 4; ++i)
+      if (free[static_cast<std::size_t>(i)]) far = true;
+    if (!far || m.distance_from_linearisation(fit.x) < opt.relinearise_beyond) break;
+    m.relinearise(fit.x);
+    fit.chi2 = gap_chi2(m, d, fit.x);
+  }
+  if (!fit.converged) fit.message = "the gap fit did not converge in " + std::to_string(fit.iterations) + " iterations";
+  fit.sigma_x.assign(info.size(), 0.0);
+  if (p > 0 && jtj.rows() == p) {
+    const Eigen::MatrixXd cov = jtj.completeOrthogonalDecomposition().pseudoInverse();
+    const double scale = std::max(1.0, fit.chi2 / std::max(1, fit.dof));
+    fit.covariance = cov * scale;
+    for (int c = 0; c < p; ++c)
+      fit.sigma_x[static_cast<std::size_t>(cols[static_cast<std::size_t>(c)])] = std::sqrt(std::max(0.0, cov(c, c) * scale));
+  }
+  return fit;
+}
+
+double predictive_chi2(const GapModel& m, const GapData& d, const GapFit& fit) {
+  std::vector<int> cols;
+  for (int j = 0; j < static_cast<int>(fit.free.size()); ++j)
+    if (fit.free[static_cast<std::size_t>(j)]) cols.push_back(j);
+  const auto r = gap_residuals(m, d, fit.x);
+  if (cols.empty() || fit.covariance.rows() != static_cast<Eigen::Index>(cols.size())) {
+    double c = 0;
+    for (double v : r) c += v * v;
+    return c;
+  }
+  const auto jc = gap_jacobian(m, d, fit.x, cols);
+  const int p = static_cast<int>(cols.size());
+  double chi = 0;
+  Eigen::VectorXd ji(p);
+  for (std::size_t i = 0; i < r.size(); ++i) {
+    for (int c = 0; c < p; ++c) ji(c) = jc[static_cast<std::size_t>(c)][i];
+    chi += r[i] * r[i] / (1.0 + ji.dot(fit.covariance * ji));
+  }
+  return std::isfinite(chi) ? chi : std::numeric_limits<double>::infinity();
+}
+
+}  // namespace piezo::update

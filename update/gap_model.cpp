@@ -1,0 +1,190 @@
+#include "update/gap_model.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+
+#include "model/bench_response.hpp"
+
+namespace piezo::update {
+
+namespace {
+constexpr double kMatUnit = 0.01;    // 1 % per x unit
+constexpr double kDampUnit = 1e-3;   // damping ratio per x unit
+constexpr double kLinStep = 0.1;     // x units (0.1 %) for the linearisation differences
+constexpr int kMat = 4;
+
+bool is_conductance(const model::EffectInfo& e) { return e.name == "daq_input_resistance"; }
+}  // namespace
+
+double typical_effect_magnitude(const model::EffectInfo& e) {
+  const std::string n(e.name);
+  if (n == "series_resistance") return 10.0;        // Ω: leads, contacts
+  if (n == "parallel_capacitance") return 100e-12;  // F: fixture, a metre of coax
+  if (n == "daq_input_resistance") return 1e-6;     // S (1 MΩ input)
+  if (n == "dielectric_loss") return 0.01;          // tan δ of a hard PZT
+  if (n == "channel_skew") return 50e-9;            // s
+  if (n == "channel_gain") return 0.01;
+  if (n == "r1_tolerance") return 0.01;             // a 1 % resistor
+  if (n == "mass_loading") return 0.02;
+  if (n == "mechanical_damping") return 2e-3;
+  throw std::invalid_argument("typical_effect_magnitude: unknown effect '" + n + "'");
+}
+
+struct GapModel::Linear {
+  double xm[kMat] = {0, 0, 0, 0};  // material x of the linearisation point
+  model::ModalPortModel base;
+  struct Slope {
+    double c0 = 0, cres = 0;
+    std::vector<double> w, p2, kappa;
+  };
+  Slope d[kMat];  // per x unit
+};
+
+GapModel::GapModel(model::ModalSolver& solver, MaterialClass cls, TubeParams p_ref, model::RayleighDamping damping,
+                   double r1_nominal_ohm, double damping_ref_hz, int n_modes)
+    : solver_(&solver), cls_(std::move(cls)), p_ref_(p_ref), damping0_(damping), r1_(r1_nominal_ohm),
+      w_ref_(2 * M_PI * damping_ref_hz), n_modes_(n_modes) {
+  if (!(r1_ > 0) || !(w_ref_ > 0)) throw std::invalid_argument("GapModel: R1 and the damping reference must be > 0");
+  set_effects({});
+  relinearise(reference_x());
+}
+
+void GapModel::set_effects(const std::vector<std::string>& effects) {
+  params_.clear();
+  const double big = 50.0;  // ±50 % for the material: far outside any plausible update step
+  params_.push_back({GapParam::y_e11, "YE11", nullptr, -big, big});
+  // ν12 must stay below 0.5 (incompressible limit) for the isotropic stiffness to exist.
+  params_.push_back({GapParam::nu12, "nu12", nullptr, -big, std::min(big, std::log(0.495 / p_ref_.nu12) / kMatUnit)});
+  params_.push_back({GapParam::d31, "d31", nullptr, -big, big});
+  params_.push_back({GapParam::eps_t33, "epsT33", nullptr, -big, big});
+  params_.push_back({GapParam::damping_alpha, "rayleigh_alpha", nullptr, 0.0, 200.0});
+  params_.push_back({GapParam::damping_beta, "rayleigh_beta", nullptr, 0.0, 200.0});
+  for (const auto& name : effects) {
+    const auto* e = model::find_effect(name);
+    if (!e) throw std::invalid_argument("GapModel: unknown effect '" + name + "'");
+    const double u = typical_effect_magnitude(*e);
+    double lo, hi;
+    if (is_conductance(*e)) {
+      lo = 0.0;
+      hi = (1.0 / e->lower) / u;
+    } else {
+      lo = e->lower / u;
+      hi = e->upper / u;
+    }
+    params_.push_back({GapParam::effect, name, e, lo, hi});
+  }
+}
+
+std::vector<double> GapModel::reference_x() const {
+  std::vector<double> x(params_.size(), 0.0);
+  x[4] = damping0_.alpha / (2 * w_ref_) / kDampUnit;
+  x[5] = damping0_.beta * w_ref_ / 2 / kDampUnit;
+  for (std::size_t i = 6; i < params_.size(); ++i) {
+    const auto& e = *params_[i].effect;
+    model::EffectSet neutral;
+    const double v = neutral.*(e.field);
+    x[i] = is_conductance(e) ? 0.0 : v / typical_effect_magnitude(e);
+  }
+  return x;
+}
+
+TubeParams GapModel::material(const std::vector<double>& x) const {
+  TubeParams p = p_ref_;
+  p.y_e11 *= std::exp(kMatUnit * x[0]);
+  p.nu12 *= std::exp(kMatUnit * x[1]);
+  p.d31 *= std::exp(kMatUnit * x[2]);
+  p.eps_t33 *= std::exp(kMatUnit * x[3]);
+  return p;
+}
+
+model::RayleighDamping GapModel::damping(const std::vector<double>& x) const {
+  return {2 * w_ref_ * kDampUnit * x[4], 2 / w_ref_ * kDampUnit * x[5]};
+}
+
+double GapModel::effect_value(const std::vector<double>& x, int i) const {
+  const auto& e = *params_.at(static_cast<std::size_t>(i)).effect;
+  const double v = x[static_cast<std::size_t>(i)] * typical_effect_magnitude(e);
+  if (is_conductance(e)) return v > 0 ? 1.0 / v : std::numeric_limits<double>::infinity();
+  return v;
+}
+
+model::EffectSet GapModel::effects(const std::vector<double>& x) const {
+  model::EffectSet fx;
+  for (std::size_t i = 6; i < params_.size(); ++i) fx.*(params_[i].effect->field) = effect_value(x, static_cast<int>(i));
+  return fx;
+}
+
+model::ModalPortModel GapModel::port_at(const TubeParams& p, double mass_fraction) const {
+  if (mass_fraction != 0.0) throw std::invalid_argument("GapModel: end-mass loading is not available in this model");
+  model::ModalOptions mo;
+  mo.n_modes = n_modes_;
+  auto port = solver_->port_model(cls_.e_form(p), mo);
+  if (!port.converged) throw std::runtime_error("gap model: the FE modal solve did not converge");
+  return port;
+}
+
+model::ModalPortModel GapModel::exact_port(const std::vector<double>& x) const { return port_at(material(x), 0.0); }
+
+double GapModel::relinearise(const std::vector<double>& x) {
+  auto lin = std::make_shared<Linear>();
+  double moved = 0;
+  for (int i = 0; i < kMat; ++i) {
+    lin->xm[i] = x[static_cast<std::size_t>(i)];
+    if (lin_) moved = std::max(moved, std::fabs(x[static_cast<std::size_t>(i)] - lin_->xm[i]));
+  }
+  lin->base = port_at(material(x), 0.0);
+  const std::size_t nm = lin->base.modes.size();
+  for (int i = 0; i < kMat; ++i) {
+    std::vector<double> xp = x;
+    xp[static_cast<std::size_t>(i)] += kLinStep;
+    const auto pp = port_at(material(xp), 0.0);
+    if (pp.modes.size() != nm) throw std::runtime_error("gap model: mode count changed under a 0.1 % material step");
+    auto& s = lin->d[i];
+    s.c0 = (pp.c_clamped - lin->base.c_clamped) / kLinStep;
+    s.cres = (pp.c_residual - lin->base.c_residual) / kLinStep;
+    s.w.resize(nm);
+    s.p2.resize(nm);
+    s.kappa.resize(nm);
+    for (std::size_t k = 0; k < nm; ++k) {
+      const auto &a = lin->base.modes[k], &b = pp.modes[k];
+      s.w[k] = (b.omega - a.omega) / kLinStep;
+      s.p2[k] = (b.participation * b.participation - a.participation * a.participation) / kLinStep;
+      s.kappa[k] = (b.kappa - a.kappa) / kLinStep;
+    }
+  }
+  lin_ = std::move(lin);
+  return moved;
+}
+
+double GapModel::distance_from_linearisation(const std::vector<double>& x) const {
+  double d = 0;
+  for (int i = 0; i < kMat; ++i) d = std::max(d, std::fabs(x[static_cast<std::size_t>(i)] - lin_->xm[i]));
+  return d;
+}
+
+std::vector<std::complex<double>> GapModel::impedance(const std::vector<double>& x,
+                                                      const std::vector<double>& f_hz) const {
+  // First-order Taylor of C0, C_res and per mode ω_k, p_k², κ_k (p_k's sign is arbitrary).
+  model::ModalPortModel p = lin_->base;
+  for (std::size_t k = 0; k < p.modes.size(); ++k) {
+    double w = p.modes[k].omega, p2 = p.modes[k].participation * p.modes[k].participation, kap = p.modes[k].kappa;
+    for (int i = 0; i < kMat; ++i) {
+      const double dx = x[static_cast<std::size_t>(i)] - lin_->xm[i];
+      w += lin_->d[i].w[k] * dx;
+      p2 += lin_->d[i].p2[k] * dx;
+      kap += lin_->d[i].kappa[k] * dx;
+    }
+    p.modes[k].omega = w;
+    p.modes[k].participation = std::sqrt(std::max(0.0, p2));
+    p.modes[k].kappa = kap;
+  }
+  for (int i = 0; i < kMat; ++i) {
+    const double dx = x[static_cast<std::size_t>(i)] - lin_->xm[i];
+    p.c_clamped += lin_->d[i].c0 * dx;
+    p.c_residual += lin_->d[i].cres * dx;
+  }
+  return model::bench_impedance(p, damping(x), effects(x), r1_, f_hz);
+}
+
+}  // namespace piezo::update
