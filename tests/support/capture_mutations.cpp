@@ -246,4 +246,13 @@ void add_ignorable_extras(const fs::path& file) {
   H5Fclose(f);
 }
 
+bool strip_truth(const fs::path& file) {
+  hid_t f = H5Fopen(file.c_str(), H5F_ACC_RDWR, H5P_DEFAULT);
+  if (f < 0) throw std::runtime_error("strip_truth: cannot open " + file.string());
+  const bool had = H5Lexists(f, "truth", H5P_DEFAULT) > 0;
+  if (had) H5Ldelete(f, "truth", H5P_DEFAULT);
+  H5Fclose(f);
+  return had;
+}
+
 }  // namespace piezo::test

@@ -62,4 +62,8 @@ void make_capture_with_defect(const std::filesystem::path& file, Defect d);
 // attributes on root, setup and shots, and a non-shot member of /shots.
 void add_ignorable_extras(const std::filesystem::path& file);
 
+// Removes the /truth group (a simulated capture as a real bench would write it).
+// Returns false when the file has no /truth.
+bool strip_truth(const std::filesystem::path& file);
+
 }  // namespace piezo::test
