@@ -370,7 +370,14 @@ PipelineResult run_pipeline(const PipelineRequest& req, const std::function<void
     }
     if (cancel) return out;
     progress(0.7, "diagnose: gap");
-    diagnose_stage(req, cap, heldout ? &*heldout : nullptr, u, out, progress, cancel);
+    try {
+      diagnose_stage(req, cap, heldout ? &*heldout : nullptr, u, out, progress, cancel);
+    } catch (const std::exception& e) {
+      // The capture and the update stand; the diagnosis failing must not lose them.
+      out.stages.push_back({"diagnose", false, std::string("failed: ") + e.what()});
+      out.warnings.push_back(std::string("gap diagnosis failed: ") + e.what() +
+                             " - the update above is still valid; try more shots or a held-out capture");
+    }
   }
   progress(1.0, "done");
   return out;

@@ -102,7 +102,7 @@ GapFit fit_gap(GapModel& m, const GapData& d, const std::vector<double>& x0, con
           chi = cn;
           lambda = std::max(lambda / 3, 1e-9);
           accepted = true;
-          if (rel < opt.chi2_tolerance) done = true;
+          if (rel < opt.chi2_tolerance || chi - cn < 1e-6 * std::max(1.0, static_cast<double>(fit.n))) done = true;
         } else {
           lambda *= 4;
         }

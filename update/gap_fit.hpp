@@ -42,7 +42,7 @@ std::vector<double> gap_residuals(const GapModel& m, const GapData& d, const std
 double gap_chi2(const GapModel& m, const GapData& d, const std::vector<double>& x);
 
 struct GapFitOptions {
-  int max_iterations = 80;
+  int max_iterations = 200;
   double chi2_tolerance = 1e-7;  // relative
   int max_relinearisations = 4;
   double relinearise_beyond = 0.3;  // x units (0.3 % of a material parameter)

@@ -206,7 +206,16 @@ TEST(GapDiagnosisValidation, ThirtySixTransducers) {
   const char* env = std::getenv("GAP_CASES");
   const int n = env ? std::atoi(env) : 36;
   Tally t;
-  for (const auto& c : draw_cases(n, 2026)) score(c, run_case(c, tmp_dir("gap-validation")), t);
+  for (const auto& c : draw_cases(n, 2026)) {
+    auto r = run_case(c, tmp_dir("gap-validation"));
+    if (!r.diagnosis) {  // counted as a miss, with the reason
+      std::printf("  %-22s no diagnosis: %s\n", c.effect.c_str(), r.warnings.empty() ? "?" : r.warnings.back().c_str());
+      t.confusion[c.effect.empty() ? "none" : c.effect]["(failed)"]++;
+      if (c.effect.empty()) ++t.controls; else ++t.identifiable;
+      continue;
+    }
+    score(c, r, t);
+  }
   print(t);
   EXPECT_GE(t.named, 0.9 * t.identifiable);
   EXPECT_GE(t.controls_none, 0.9 * t.controls);
