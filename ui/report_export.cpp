@@ -39,7 +39,7 @@ void export_touchstone(const PipelineResult& r, const std::string& path) {
   dsp::write_touchstone_s1p(f, as_impedance(measured(r)), 50.0);
 }
 
-void export_json(const PipelineResult& r, const std::string& path) {
+nlohmann::json report_json(const PipelineResult& r) {
   nlohmann::json j;
   j["capture"] = r.capture_path;
   j["shots"] = r.shots;
@@ -59,8 +59,12 @@ void export_json(const PipelineResult& r, const std::string& path) {
   for (const auto& s : r.stages) j["stages"].push_back({{"name", s.name}, {"ran", s.ran}, {"note", s.note}});
   j["verdict"] = r.verdict;
   j["warnings"] = r.warnings;
+  return j;
+}
+
+void export_json(const PipelineResult& r, const std::string& path) {
   auto f = open_out(path);
-  f << j.dump(2) << "\n";
+  f << report_json(r).dump(2) << "\n";
 }
 
 }  // namespace piezo::ui
