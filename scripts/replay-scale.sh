@@ -64,7 +64,7 @@ assert j["failed"] == 1 and j["issues"][0]["path"].endswith("T-0021.h5"), j["iss
 EOF
 echo "replay-scale: peak RSS $((rss_kb / 1024)) MB, wall $wall (/usr/bin/time -v)"
 echo "replay-scale: JSON lines: $(lines full.jsonl)"
-grep -A3 '^## Outliers' report/summary.md | tail -1 | sed 's/^/replay-scale: first outlier: /'
+grep -A4 '^## Outliers' report/summary.md | tail -1 | cut -c1-160 | sed 's/^/replay-scale: first outlier: /'
 
 # ------------------------------------------------------------ 3. kill halfway, resume
 rm -rf resumed.h5 resumed.jsonl
