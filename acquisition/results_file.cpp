@@ -19,7 +19,8 @@ namespace fs = std::filesystem;
 
 namespace {
 
-[[noreturn]] void fail(const std::string& file, const std::string& where, const std::string& problem) {
+[[noreturn]] void fail(const std::string& file, const std::string& where,
+                       const std::string& problem) {
   throw ResultsError(file + ": " + where + ": " + problem);
 }
 
@@ -42,26 +43,32 @@ h5::Id vlen_string_type() {
 void write_string_attr(hid_t obj, const char* name, const std::string& value) {
   h5::Id type = vlen_string_type();
   h5::Id space = h5::dataspace(H5Screate(H5S_SCALAR));
-  h5::Id a = h5::attribute(H5Acreate2(obj, name, type.get(), space.get(), H5P_DEFAULT, H5P_DEFAULT));
+  h5::Id a =
+      h5::attribute(H5Acreate2(obj, name, type.get(), space.get(), H5P_DEFAULT, H5P_DEFAULT));
   const char* p = value.c_str();
   if (!a || H5Awrite(a.get(), type.get(), &p) < 0)
-    throw std::runtime_error(std::string("HDF5: cannot write attribute ") + name + ": " + h5::last_error());
+    throw std::runtime_error(std::string("HDF5: cannot write attribute ") + name + ": " +
+                             h5::last_error());
 }
 
-void write_number_attr(hid_t obj, const char* name, hid_t file_type, hid_t mem_type, const void* v) {
+void write_number_attr(hid_t obj, const char* name, hid_t file_type, hid_t mem_type,
+                       const void* v) {
   h5::Id space = h5::dataspace(H5Screate(H5S_SCALAR));
   h5::Id a = h5::attribute(H5Acreate2(obj, name, file_type, space.get(), H5P_DEFAULT, H5P_DEFAULT));
   if (!a || H5Awrite(a.get(), mem_type, v) < 0)
-    throw std::runtime_error(std::string("HDF5: cannot write attribute ") + name + ": " + h5::last_error());
+    throw std::runtime_error(std::string("HDF5: cannot write attribute ") + name + ": " +
+                             h5::last_error());
 }
 
 void write_string_dataset(hid_t grp, const char* name, const std::string& value) {
   h5::Id type = vlen_string_type();
   h5::Id space = h5::dataspace(H5Screate(H5S_SCALAR));
-  h5::Id ds = h5::dataset(H5Dcreate2(grp, name, type.get(), space.get(), H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT));
+  h5::Id ds = h5::dataset(
+      H5Dcreate2(grp, name, type.get(), space.get(), H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT));
   const char* p = value.c_str();
   if (!ds || H5Dwrite(ds.get(), type.get(), H5S_ALL, H5S_ALL, H5P_DEFAULT, &p) < 0)
-    throw std::runtime_error(std::string("HDF5: cannot write dataset ") + name + ": " + h5::last_error());
+    throw std::runtime_error(std::string("HDF5: cannot write dataset ") + name + ": " +
+                             h5::last_error());
 }
 
 void write_doubles(hid_t grp, const char* name, const double* v, int rank, const hsize_t* dims) {
@@ -69,12 +76,14 @@ void write_doubles(hid_t grp, const char* name, const double* v, int rank, const
   h5::Id ds = h5::dataset(
       H5Dcreate2(grp, name, H5T_IEEE_F64LE, space.get(), H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT));
   if (!ds || H5Dwrite(ds.get(), H5T_NATIVE_DOUBLE, H5S_ALL, H5S_ALL, H5P_DEFAULT, v) < 0)
-    throw std::runtime_error(std::string("HDF5: cannot write dataset ") + name + ": " + h5::last_error());
+    throw std::runtime_error(std::string("HDF5: cannot write dataset ") + name + ": " +
+                             h5::last_error());
 }
 
 bool valid_key(const std::string& k) {
   return !k.empty() && k.size() <= 128 && std::all_of(k.begin(), k.end(), [](char c) {
-    return (c >= '0' && c <= '9') || (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || c == '_' || c == '-';
+    return (c >= '0' && c <= '9') || (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || c == '_' ||
+           c == '-';
   });
 }
 
@@ -87,11 +96,13 @@ class Reader {
     acq::fail(file_, where, problem);
   }
 
-  std::optional<std::string> string_attr(hid_t obj, const char* name, const std::string& where) const {
+  std::optional<std::string> string_attr(hid_t obj, const char* name,
+                                         const std::string& where) const {
     if (H5Aexists(obj, name) <= 0) return std::nullopt;
     h5::Id a = h5::attribute(H5Aopen(obj, name, H5P_DEFAULT));
     h5::Id type = h5::datatype(H5Aget_type(a.get()));
-    if (!a || H5Tget_class(type.get()) != H5T_STRING) fail(where + "/" + name, "expected a string attribute");
+    if (!a || H5Tget_class(type.get()) != H5T_STRING)
+      fail(where + "/" + name, "expected a string attribute");
     return read_string(a.get(), type.get(), true, where + "/" + name);
   }
 
@@ -99,11 +110,13 @@ class Reader {
     if (H5Aexists(obj, name) <= 0) return std::nullopt;
     h5::Id a = h5::attribute(H5Aopen(obj, name, H5P_DEFAULT));
     double v = 0;
-    if (!a || H5Aread(a.get(), H5T_NATIVE_DOUBLE, &v) < 0) fail(where + "/" + name, "expected a number");
+    if (!a || H5Aread(a.get(), H5T_NATIVE_DOUBLE, &v) < 0)
+      fail(where + "/" + name, "expected a number");
     return v;
   }
 
-  std::optional<std::int64_t> int_attr(hid_t obj, const char* name, const std::string& where) const {
+  std::optional<std::int64_t> int_attr(hid_t obj, const char* name,
+                                       const std::string& where) const {
     if (H5Aexists(obj, name) <= 0) return std::nullopt;
     h5::Id a = h5::attribute(H5Aopen(obj, name, H5P_DEFAULT));
     h5::Id type = h5::datatype(H5Aget_type(a.get()));
@@ -136,7 +149,8 @@ class Reader {
     if (cols != 1 && dims[1] != cols) fail(p, "wrong shape");
     *rows = dims[0];
     std::vector<double> v(dims[0] * cols);
-    if (!v.empty() && H5Dread(ds.get(), H5T_NATIVE_DOUBLE, H5S_ALL, H5S_ALL, H5P_DEFAULT, v.data()) < 0)
+    if (!v.empty() &&
+        H5Dread(ds.get(), H5T_NATIVE_DOUBLE, H5S_ALL, H5S_ALL, H5P_DEFAULT, v.data()) < 0)
       fail(p, "cannot read (damaged file?): " + h5::last_error());
     return v;
   }
@@ -210,7 +224,8 @@ class Reader {
       fail("/format", "is \"" + *fmt + "\", expected \"" + std::string(kResultsFormatName) + "\"");
     auto ver = int_attr(f, "format_version", "");
     if (!ver || *ver != kResultsFormatVersion)
-      fail("/format_version", "unsupported (this reader knows version " + std::to_string(kResultsFormatVersion) + ")");
+      fail("/format_version",
+           "unsupported (this reader knows version " + std::to_string(kResultsFormatVersion) + ")");
     if (H5Lexists(f, "results", H5P_DEFAULT) <= 0) fail("/results", "missing required group");
   }
 
@@ -219,7 +234,8 @@ class Reader {
     if (H5Tis_variable_str(type) > 0) {
       h5::Id mem = vlen_string_type();
       char* p = nullptr;
-      herr_t rc = attr ? H5Aread(obj, mem.get(), &p) : H5Dread(obj, mem.get(), H5S_ALL, H5S_ALL, H5P_DEFAULT, &p);
+      herr_t rc = attr ? H5Aread(obj, mem.get(), &p)
+                       : H5Dread(obj, mem.get(), H5S_ALL, H5S_ALL, H5P_DEFAULT, &p);
       if (rc < 0) fail(where, "cannot read string: " + h5::last_error());
       std::string out = p ? p : "";
       if (p) H5free_memory(p);
@@ -238,14 +254,16 @@ class Reader {
 
 h5::Id open_existing(const std::string& file, unsigned flags) {
   std::error_code ec;
-  if (!fs::is_regular_file(file, ec)) fail(file, "/", fs::exists(file, ec) ? "not a regular file" : "no such file");
+  if (!fs::is_regular_file(file, ec))
+    fail(file, "/", fs::exists(file, ec) ? "not a regular file" : "no such file");
   h5::quiet_errors();
   if (H5Fis_hdf5(file.c_str()) <= 0) fail(file, "/", "not a readable HDF5 file");
   h5::Id f = h5::file(H5Fopen(file.c_str(), flags, H5P_DEFAULT));
   if (!f)
     fail(file, "/",
-         std::string("cannot open") + (flags == H5F_ACC_RDWR ? " for writing (is another replay writing it?)" : "") +
-             ": " + h5::last_error());
+         std::string("cannot open") +
+             (flags == H5F_ACC_RDWR ? " for writing (is another replay writing it?)" : "") + ": " +
+             h5::last_error());
   return f;
 }
 
@@ -274,7 +292,8 @@ void for_each_result(const fs::path& path, const std::function<void(const Result
     if (!results) rd.fail("/results", "not a group");
     keys = rd.names(results.get(), "/results");
   }
-  std::erase_if(keys, [](const std::string& k) { return !valid_key(k); });  // e.g. a merge's ".incoming"
+  std::erase_if(keys,
+                [](const std::string& k) { return !valid_key(k); });  // e.g. a merge's ".incoming"
   // One record in memory at a time; the lock is released while `fn` runs.
   for (const auto& key : keys) {
     ResultRecord r;
@@ -296,12 +315,14 @@ struct ResultsFile::Impl {
     if (H5Fflush(file.get(), H5F_SCOPE_GLOBAL) < 0)
       throw std::runtime_error("HDF5: cannot flush " + path.string() + ": " + h5::last_error());
     void* handle = nullptr;
-    if (H5Fget_vfd_handle(file.get(), H5P_DEFAULT, &handle) >= 0 && handle) ::fsync(*static_cast<int*>(handle));
+    if (H5Fget_vfd_handle(file.get(), H5P_DEFAULT, &handle) >= 0 && handle)
+      ::fsync(*static_cast<int*>(handle));
   }
 
   // Replaces `key` by the complete anonymous group `g` in one step.
   void link(hid_t g, const std::string& key) {
-    if (H5Lexists(results.get(), key.c_str(), H5P_DEFAULT) > 0 && H5Ldelete(results.get(), key.c_str(), H5P_DEFAULT) < 0)
+    if (H5Lexists(results.get(), key.c_str(), H5P_DEFAULT) > 0 &&
+        H5Ldelete(results.get(), key.c_str(), H5P_DEFAULT) < 0)
       throw std::runtime_error("HDF5: cannot replace record " + key + ": " + h5::last_error());
     if (H5Olink(g, results.get(), key.c_str(), H5P_DEFAULT, H5P_DEFAULT) < 0)
       throw std::runtime_error("HDF5: cannot link record " + key + ": " + h5::last_error());
@@ -361,21 +382,24 @@ ResultsFile ResultsFile::open_or_create(const fs::path& path, const std::string&
 
 void ResultsFile::put(const ResultRecord& rec) {
   if (!impl_ || !impl_->file) throw std::logic_error("ResultsFile::put: file is closed");
-  if (!valid_key(rec.key)) throw std::invalid_argument("ResultsFile::put: bad key '" + rec.key + "'");
+  if (!valid_key(rec.key))
+    throw std::invalid_argument("ResultsFile::put: bad key '" + rec.key + "'");
   std::lock_guard lock(h5::h5_mutex());
   h5::Id g = h5::group(H5Gcreate_anon(impl_->file.get(), H5P_DEFAULT, H5P_DEFAULT));
   if (!g) throw std::runtime_error("HDF5: cannot create a record group: " + h5::last_error());
   write_string_attr(g.get(), "input_path", rec.input_path);
   write_string_attr(g.get(), "sha256", rec.sha256);
   write_string_attr(g.get(), "status", rec.status);
-  write_string_attr(g.get(), "replayed_utc", rec.replayed_utc.empty() ? utc_now() : rec.replayed_utc);
+  write_string_attr(g.get(), "replayed_utc",
+                    rec.replayed_utc.empty() ? utc_now() : rec.replayed_utc);
   write_number_attr(g.get(), "elapsed_s", H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, &rec.elapsed_s);
   write_string_dataset(g.get(), "result_json", rec.result_json);
   if (!rec.curves.empty()) {
     h5::Id cg = h5::group(H5Gcreate2(g.get(), "curves", H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT));
     for (std::size_t k = 0; k < rec.curves.size(); ++k) {
       const auto& c = rec.curves[k];
-      if (c.f_hz.size() != c.z_ohm.size()) throw std::invalid_argument("ResultsFile::put: curve sizes differ");
+      if (c.f_hz.size() != c.z_ohm.size())
+        throw std::invalid_argument("ResultsFile::put: curve sizes differ");
       char name[32];
       std::snprintf(name, sizeof name, "%02zu", k);
       h5::Id cgrp = h5::group(H5Gcreate2(cg.get(), name, H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT));
@@ -402,10 +426,12 @@ std::vector<ResultsFile::IndexEntry> ResultsFile::index() const {
   return out;
 }
 
-std::optional<ResultRecord> ResultsFile::get(const std::string& key, const ResultsReadOptions& opt) const {
+std::optional<ResultRecord> ResultsFile::get(const std::string& key,
+                                             const ResultsReadOptions& opt) const {
   if (!impl_ || !impl_->file) throw std::logic_error("ResultsFile::get: file is closed");
   std::lock_guard lock(h5::h5_mutex());
-  if (!valid_key(key) || H5Lexists(impl_->results.get(), key.c_str(), H5P_DEFAULT) <= 0) return std::nullopt;
+  if (!valid_key(key) || H5Lexists(impl_->results.get(), key.c_str(), H5P_DEFAULT) <= 0)
+    return std::nullopt;
   return Reader(impl_->path.string()).record(impl_->results.get(), key, opt.load_curves);
 }
 
@@ -433,11 +459,13 @@ void ResultsFile::copy_from(const fs::path& src, const std::vector<std::string>&
     const std::string tmp = ".incoming";
     if (H5Lexists(impl_->results.get(), tmp.c_str(), H5P_DEFAULT) > 0)
       H5Ldelete(impl_->results.get(), tmp.c_str(), H5P_DEFAULT);
-    if (H5Ocopy(results.get(), key.c_str(), impl_->results.get(), tmp.c_str(), H5P_DEFAULT, H5P_DEFAULT) < 0)
+    if (H5Ocopy(results.get(), key.c_str(), impl_->results.get(), tmp.c_str(), H5P_DEFAULT,
+                H5P_DEFAULT) < 0)
       rd.fail("/results/" + key, "cannot copy: " + h5::last_error());
     if (H5Lexists(impl_->results.get(), key.c_str(), H5P_DEFAULT) > 0)
       H5Ldelete(impl_->results.get(), key.c_str(), H5P_DEFAULT);
-    if (H5Lmove(impl_->results.get(), tmp.c_str(), impl_->results.get(), key.c_str(), H5P_DEFAULT, H5P_DEFAULT) < 0)
+    if (H5Lmove(impl_->results.get(), tmp.c_str(), impl_->results.get(), key.c_str(), H5P_DEFAULT,
+                H5P_DEFAULT) < 0)
       throw std::runtime_error("HDF5: cannot link record " + key + ": " + h5::last_error());
   }
   impl_->flush_to_disk();

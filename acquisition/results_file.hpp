@@ -19,10 +19,12 @@
 // record readable. Files use the oldest HDF5 format that holds them (no
 // "file open for writing" flag that would refuse the file after a kill).
 #include <complex>
+#include <cstdint>
 #include <filesystem>
 #include <functional>
 #include <memory>
 #include <optional>
+#include <stdexcept>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -45,7 +47,7 @@ struct ResultRecord {
   std::string status;  // "ok" | "failed"
   std::string result_json;
   double elapsed_s = 0;
-  std::string replayed_utc;  // set by put() when empty
+  std::string replayed_utc;         // set by put() when empty
   std::vector<StoredCurve> curves;  // read only when asked for
 };
 
@@ -61,7 +63,8 @@ struct ResultsReadOptions {
 };
 
 // Calls `fn` for every record, in key order; one record in memory at a time.
-void for_each_result(const std::filesystem::path& file, const std::function<void(const ResultRecord&)>& fn,
+void for_each_result(const std::filesystem::path& file,
+                     const std::function<void(const ResultRecord&)>& fn,
                      const ResultsReadOptions& opt = {});
 
 // Opens a results file for appending (creates it when absent). Refuses a file

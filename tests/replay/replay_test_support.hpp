@@ -58,20 +58,21 @@ inline nlohmann::json without_timing(nlohmann::json j) {
 
 inline std::map<std::string, Content> read_content(const fs::path& results) {
   std::map<std::string, Content> out;
-  acq::for_each_result(
-      results,
-      [&](const acq::ResultRecord& r) {
-        out[r.key] = {r.input_path, r.sha256, r.status, without_timing(nlohmann::json::parse(r.result_json)),
-                      r.curves};
-      },
-      {true});
+  acq::for_each_result(results,
+                       [&](const acq::ResultRecord& r) {
+                         out[r.key] = {r.input_path, r.sha256, r.status,
+                                       without_timing(nlohmann::json::parse(r.result_json)),
+                                       r.curves};
+                       },
+                       {true});
   return out;
 }
 
 // Same keys, same paths, digests, statuses, JSON and curves, bit for bit: the
 // pipeline is deterministic (seeded, no threads inside a capture), so one
 // capture replayed in any shard, by any worker, gives the same numbers.
-inline void expect_same_content(const std::map<std::string, Content>& a, const std::map<std::string, Content>& b) {
+inline void expect_same_content(const std::map<std::string, Content>& a,
+                                const std::map<std::string, Content>& b) {
   ASSERT_EQ(a.size(), b.size());
   for (const auto& [key, x] : a) {
     auto it = b.find(key);

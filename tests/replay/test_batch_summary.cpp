@@ -23,13 +23,15 @@ TEST(BatchSummary, DistributionsOutliersAndFailures) {
   const double ye[] = {6.66e10, 6.67e10, 6.65e10, 6.66e10, 6.68e10, 5.9e10};
   const char* digits = "012345";
   for (int k = 0; k < 6; ++k) {
-    const std::string n(1, digits[k]);  // (GCC 12 warns falsely on "x" + std::to_string(k) + "y" here)
+    const std::string n(1,
+                        digits[k]);  // (GCC 12 warns falsely on "x" + std::to_string(k) + "y" here)
     e.push_back(batch_entry("k" + n, ok_record("line/T-00" + n + ".h5", ye[k], 50e3 + k)));
   }
-  e.push_back(batch_entry("kbad", {{"path", "line/bad.h5"},
-                                   {"sha256", "11"},
-                                   {"status", "failed"},
-                                   {"error", {{"kind", "bad capture"}, {"message", "line/bad.h5: /: truncated"}}}}));
+  e.push_back(batch_entry(
+      "kbad", {{"path", "line/bad.h5"},
+               {"sha256", "11"},
+               {"status", "failed"},
+               {"error", {{"kind", "bad capture"}, {"message", "line/bad.h5: /: truncated"}}}}));
   auto s = summarize(e);
   EXPECT_EQ(s.ok, 6u);
   EXPECT_EQ(s.failed, 1u);
@@ -46,11 +48,13 @@ TEST(BatchSummary, DistributionsOutliersAndFailures) {
   const std::string md = batch_summary_markdown(s, "R.h5");
   EXPECT_NE(md.find("7 (6 replayed, 1 failed)"), std::string::npos) << md;
   EXPECT_NE(md.find("line/bad.h5: /: truncated"), std::string::npos);
-  EXPECT_NE(md.find("| [line/T-005.h5](captures/T-005-k5/summary.md) | YE11 |"), std::string::npos) << md;
+  EXPECT_NE(md.find("| [line/T-005.h5](captures/T-005-k5/summary.md) | YE11 |"), std::string::npos)
+      << md;
   EXPECT_EQ(distributions_figure(s).panels.size(), s.distributions.size());
 }
 
 TEST(BatchSummary, ReportFolderNamesAreSafeAndUnique) {
   EXPECT_EQ(capture_report_folder("a b/T:1.h5", "0123456789abcdef"), "captures/T_1-01234567");
-  EXPECT_NE(capture_report_folder("x/T.h5", "aaaaaaaa11"), capture_report_folder("y/T.h5", "bbbbbbbb11"));
+  EXPECT_NE(capture_report_folder("x/T.h5", "aaaaaaaa11"),
+            capture_report_folder("y/T.h5", "bbbbbbbb11"));
 }

@@ -2,9 +2,9 @@
 // simulated captures: a corrupted capture is reported and skipped, reports
 // and exports are written, a killed run resumes without redoing finished
 // captures, and four merged shards equal one unsharded run.
+#include <fcntl.h>
 #include <gtest/gtest.h>
 #include <signal.h>
-#include <fcntl.h>
 #include <spawn.h>
 #include <sys/wait.h>
 
@@ -26,7 +26,8 @@ fs::path make_batch(const fs::path& dir, int good = 4, bool corrupt = true) {
   const fs::path in = dir / "captures";
   const double ye[] = {6.66e10, 6.70e10, 6.62e10, 6.68e10, 6.64e10, 6.69e10};
   for (int k = 0; k < good; ++k)
-    test::make_capture(in / (k % 2 ? "line2/sub" : "line1") / ("T-00" + std::to_string(k) + ".h5"), ye[k % 6], 10 + k);
+    test::make_capture(in / (k % 2 ? "line2/sub" : "line1") / ("T-00" + std::to_string(k) + ".h5"),
+                       ye[k % 6], 10 + k);
   if (corrupt) test::make_truncated_capture(in / "line1" / "T-bad.h5");
   std::ofstream(in / "line1" / "notes.txt") << "not a capture, not picked up from a folder";
   return in;
@@ -60,8 +61,9 @@ TEST(CliReplay, BatchReportsAndSkipsACorruptedCaptureWritesReportsAndResumes) {
   const auto dir = test::fresh_dir("replay-batch");
   const auto in = make_batch(dir);
   const auto out = dir / "results.h5", jsonl = dir / "results.jsonl", rep = dir / "report";
-  const std::string cmd = "replay '" + in.string() + "' --jobs 2 --out '" + out.string() + "' --jsonl '" +
-                          jsonl.string() + "' --report '" + rep.string() + "' --json";
+  const std::string cmd = "replay '" + in.string() + "' --jobs 2 --out '" + out.string() +
+                          "' --jsonl '" + jsonl.string() + "' --report '" + rep.string() +
+                          "' --json";
   auto r = test::run_cli(cmd);
   // Exit 2: the batch completed, one capture was refused.
   ASSERT_EQ(r.exit_code, 2) << r.err;
@@ -134,7 +136,8 @@ TEST(CliReplay, BatchReportsAndSkipsACorruptedCaptureWritesReportsAndResumes) {
   EXPECT_EQ(j2["replayed"], 0);
   EXPECT_EQ(j2["done_before"], 4);
   EXPECT_EQ(j2["failed"], 1);
-  EXPECT_EQ(read_lines(jsonl).size(), 5u);  // this run's lines: the stored ones for skipped captures
+  EXPECT_EQ(read_lines(jsonl).size(),
+            5u);  // this run's lines: the stored ones for skipped captures
   test::expect_same_content(content, test::read_content(out));
 }
 
@@ -142,20 +145,23 @@ TEST(CliReplay, FourMergedShardsEqualOneUnshardedRun) {
   const auto dir = test::fresh_dir("replay-shards");
   const auto in = make_batch(dir, 5, true);
   const auto all = dir / "all.h5";
-  auto r = test::run_cli("replay '" + in.string() + "' --jobs 2 --out '" + all.string() + "' --json");
+  auto r =
+      test::run_cli("replay '" + in.string() + "' --jobs 2 --out '" + all.string() + "' --json");
   ASSERT_EQ(r.exit_code, 2) << r.err;
   // The shards list the inputs in another order (the partition sorts paths).
   std::string shards;
   std::set<std::string> seen;
   for (int i = 0; i < 4; ++i) {
     const auto s = dir / ("shard" + std::to_string(i) + ".h5");
-    auto rs = test::run_cli("replay '" + (in / "line2").string() + "' '" + (in / "line1").string() + "' --shard " +
-                            std::to_string(i) + "/4 --out '" + s.string() + "' --json");
+    auto rs =
+        test::run_cli("replay '" + (in / "line2").string() + "' '" + (in / "line1").string() +
+                      "' --shard " + std::to_string(i) + "/4 --out '" + s.string() + "' --json");
     ASSERT_TRUE(rs.exit_code == 0 || rs.exit_code == 2) << rs.err;
     auto js = nlohmann::json::parse(rs.out);
     EXPECT_EQ(js["found"], 6);
     EXPECT_EQ(js["total"], i < 2 ? 2 : 1);  // 6 captures: 2, 2, 1, 1
-    for (const auto& [key, c] : test::read_content(s)) EXPECT_TRUE(seen.insert(key).second) << c.path << " twice";
+    for (const auto& [key, c] : test::read_content(s))
+      EXPECT_TRUE(seen.insert(key).second) << c.path << " twice";
     shards += " '" + s.string() + "'";
   }
   EXPECT_EQ(seen.size(), 6u);
@@ -166,10 +172,12 @@ TEST(CliReplay, FourMergedShardsEqualOneUnshardedRun) {
   EXPECT_EQ(jm["records"], 6);
   EXPECT_EQ(jm["failed"], 1);
   test::expect_same_content(test::read_content(all), test::read_content(merged));
-  // Merging again into an existing file needs --overwrite; a shard merged twice counts as duplicates.
-  EXPECT_EQ(test::run_cli("replay-merge" + shards + " --out '" + merged.string() + "'").exit_code, 2);
-  auto m2 = test::run_cli("replay-merge" + shards + " '" + (dir / "shard0.h5").string() + "' --overwrite --out '" +
-                          merged.string() + "' --json");
+  // Merging again into an existing file needs --overwrite; a shard merged twice counts as
+  // duplicates.
+  EXPECT_EQ(test::run_cli("replay-merge" + shards + " --out '" + merged.string() + "'").exit_code,
+            2);
+  auto m2 = test::run_cli("replay-merge" + shards + " '" + (dir / "shard0.h5").string() +
+                          "' --overwrite --out '" + merged.string() + "' --json");
   ASSERT_EQ(m2.exit_code, 0) << m2.err;
   EXPECT_EQ(nlohmann::json::parse(m2.out)["duplicates"], 2);
   test::expect_same_content(test::read_content(all), test::read_content(merged));
@@ -179,9 +187,10 @@ TEST(CliReplay, KilledRunResumesWithoutRedoingFinishedCaptures) {
   const auto dir = test::fresh_dir("replay-kill");
   const auto in = make_batch(dir, 6, false);
   const auto out = dir / "results.h5", jsonl = dir / "progress.jsonl";
-  const std::string exe = PIEZO_CLI, in_s = in.string(), out_s = out.string(), jsonl_s = jsonl.string();
-  const char* argv[] = {exe.c_str(), "replay", in_s.c_str(), "--jobs", "1", "--out", out_s.c_str(),
-                        "--jsonl", jsonl_s.c_str(), nullptr};
+  const std::string exe = PIEZO_CLI, in_s = in.string(), out_s = out.string(),
+                    jsonl_s = jsonl.string();
+  const char* argv[] = {exe.c_str(), "replay",      in_s.c_str(), "--jobs",        "1",
+                        "--out",     out_s.c_str(), "--jsonl",    jsonl_s.c_str(), nullptr};
   posix_spawn_file_actions_t fa;
   posix_spawn_file_actions_init(&fa);
   posix_spawn_file_actions_addopen(&fa, 1, "/dev/null", O_WRONLY, 0);
@@ -204,7 +213,9 @@ TEST(CliReplay, KilledRunResumesWithoutRedoingFinishedCaptures) {
   ASSERT_GE(before.size(), 2u);
   ASSERT_LT(before.size(), 6u);
   std::map<std::string, std::pair<std::string, double>> stamps;  // key → (replayed_utc, elapsed_s)
-  acq::for_each_result(out, [&](const acq::ResultRecord& rec) { stamps[rec.key] = {rec.replayed_utc, rec.elapsed_s}; });
+  acq::for_each_result(out, [&](const acq::ResultRecord& rec) {
+    stamps[rec.key] = {rec.replayed_utc, rec.elapsed_s};
+  });
 
   auto r = test::run_cli("replay '" + in_s + "' --jobs 2 --out '" + out_s + "' --json");
   ASSERT_EQ(r.exit_code, 0) << r.err;
@@ -229,12 +240,21 @@ TEST(CliReplay, KilledRunResumesWithoutRedoingFinishedCaptures) {
 TEST(CliReplay, BadOptionsAndFilesAreRefusedClearly) {
   const auto dir = test::fresh_dir("replay-bad");
   test::make_capture(dir / "T.h5", 6.66e10, 1);
-  auto r = test::run_cli("replay '" + dir.string() + "' --shard 4/4 --out '" + (dir / "r.h5").string() + "'");
+  test::make_capture(dir / "U.h5", 6.66e10, 2);
+  auto r = test::run_cli("replay '" + dir.string() + "' --shard 4/4 --out '" +
+                         (dir / "r.h5").string() + "'");
   EXPECT_EQ(r.exit_code, 2);
   EXPECT_NE(r.err.find("--shard '4/4'"), std::string::npos) << r.err;
-  r = test::run_cli("replay '" + (dir / "missing").string() + "' --out '" + (dir / "r.h5").string() + "'");
+  r = test::run_cli("replay '" + (dir / "missing").string() + "' --out '" +
+                    (dir / "r.h5").string() + "'");
   EXPECT_EQ(r.exit_code, 2);
   EXPECT_NE(r.err.find((dir / "missing").string() + ": no such file"), std::string::npos) << r.err;
+  fs::create_directories(dir / "empty");
+  r = test::run_cli("replay '" + (dir / "empty").string() + "' --out '" + (dir / "r.h5").string() +
+                    "'");
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_NE(r.err.find("no capture"), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(dir / "r.h5"));
   // A capture given as the results file is refused, and left as it was.
   const auto before = fs::file_size(dir / "T.h5");
   r = test::run_cli("replay '" + dir.string() + "' --out '" + (dir / "T.h5").string() + "'");
@@ -242,7 +262,8 @@ TEST(CliReplay, BadOptionsAndFilesAreRefusedClearly) {
   EXPECT_NE(r.err.find("expected \"piezo-replay\""), std::string::npos) << r.err;
   EXPECT_EQ(fs::file_size(dir / "T.h5"), before);
   // replay-merge of something that is not a results file: nothing is written.
-  r = test::run_cli("replay-merge '" + (dir / "T.h5").string() + "' --out '" + (dir / "m.h5").string() + "'");
+  r = test::run_cli("replay-merge '" + (dir / "T.h5").string() + "' --out '" +
+                    (dir / "m.h5").string() + "'");
   EXPECT_EQ(r.exit_code, 2);
   EXPECT_NE(r.err.find((dir / "T.h5").string()), std::string::npos) << r.err;
   EXPECT_FALSE(fs::exists(dir / "m.h5"));

@@ -19,8 +19,8 @@ struct Tree {
   fs::path root = fs::temp_directory_path() / ("piezobench-discover-" + std::to_string(::getpid()));
   Tree() {
     fs::remove_all(root);
-    for (const char* f : {"line1/T-002.h5", "line1/T-001.h5", "line2/deep/T-010.hdf5", "line2/notes.txt",
-                          "line2/T-003.h5.partial", "other/extra.dat"}) {
+    for (const char* f : {"line1/T-002.h5", "line1/T-001.h5", "line2/deep/T-010.hdf5",
+                          "line2/notes.txt", "line2/T-003.h5.partial", "other/extra.dat"}) {
       fs::create_directories((root / f).parent_path());
       std::ofstream(root / f) << "x";
     }
@@ -38,10 +38,11 @@ std::vector<std::string> strings(const std::vector<fs::path>& v) {
 
 TEST(Discover, FoldersRecursivelyFilesAsGivenSortedOnce) {
   Tree t;
-  auto found = replay::find_captures({t.s("line2"), t.s("other/extra.dat"), t.s("line1"),
-                                      t.root.string() + "/line1/./T-001.h5"});
-  EXPECT_EQ(strings(found), (std::vector<std::string>{t.s("line1/T-001.h5"), t.s("line1/T-002.h5"),
-                                                      t.s("line2/deep/T-010.hdf5"), t.s("other/extra.dat")}));
+  auto found = replay::find_captures(
+      {t.s("line2"), t.s("other/extra.dat"), t.s("line1"), t.root.string() + "/line1/./T-001.h5"});
+  EXPECT_EQ(strings(found),
+            (std::vector<std::string>{t.s("line1/T-001.h5"), t.s("line1/T-002.h5"),
+                                      t.s("line2/deep/T-010.hdf5"), t.s("other/extra.dat")}));
 }
 
 TEST(Discover, ExcludesTheResultsFileAndNamesAMissingInput) {

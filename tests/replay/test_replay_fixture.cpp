@@ -63,13 +63,14 @@ TEST(ReplayFixture, H5pyCaptureReplaysLikeTheSameDataWrittenByTheBench) {
   ASSERT_EQ(h5py.shots[0].pretrigger_samples, static_cast<std::int64_t>(kPre));
   std::size_t differ = 0;
   for (std::size_t i = 0; i < kN; ++i)
-    differ += h5py.shots[0].v1[i] != cap.shots[0].v1[i] || h5py.shots[0].v2[i] != cap.shots[0].v2[i];
+    differ +=
+        h5py.shots[0].v1[i] != cap.shots[0].v1[i] || h5py.shots[0].v2[i] != cap.shots[0].v2[i];
   ASSERT_EQ(differ, 0u) << "the fixture no longer holds the closed form of tests/dsp/bvd_model.cpp "
                            "(regenerate with `make fixtures`)";
 
   const auto out = dir / "results.h5";
-  auto r = test::run_cli("replay '" + kFixture.string() + "' '" + bench.string() + "' --out '" + out.string() +
-                         "' --json");
+  auto r = test::run_cli("replay '" + kFixture.string() + "' '" + bench.string() + "' --out '" +
+                         out.string() + "' --json");
   ASSERT_EQ(r.exit_code, 0) << r.err;
   auto content = test::read_content(out);
   ASSERT_EQ(content.size(), 2u);
@@ -78,7 +79,8 @@ TEST(ReplayFixture, H5pyCaptureReplaysLikeTheSameDataWrittenByTheBench) {
   ASSERT_EQ(a.status, "ok");
   ASSERT_EQ(b.status, "ok");
   EXPECT_NE(a.sha256, b.sha256);  // two different files…
-  EXPECT_EQ(numbers(a.json), numbers(b.json)) << a.json.dump(1) << "\n" << b.json.dump(1);  // …the same numbers
+  EXPECT_EQ(numbers(a.json), numbers(b.json)) << a.json.dump(1) << "\n"
+                                              << b.json.dump(1);  // …the same numbers
   ASSERT_EQ(a.curves.size(), b.curves.size());
   for (std::size_t c = 0; c < a.curves.size(); ++c) {
     EXPECT_EQ(a.curves[c].f_hz, b.curves[c].f_hz);

@@ -30,7 +30,8 @@ acq::ResultRecord sample(const std::string& key, const std::string& status) {
   r.result_json = R"({"status":")" + status + R"(","µ":"UTF-8 ✓"})";
   r.elapsed_s = 0.25;
   r.replayed_utc = "2026-01-02T03:04:05Z";
-  r.curves.push_back({"measured (Prony-SS)", {100.0, 200.0, 300.0}, {{1.0, -2.0}, {3.0, -4.0}, {5.5, 6.5}}});
+  r.curves.push_back(
+      {"measured (Prony-SS)", {100.0, 200.0, 300.0}, {{1.0, -2.0}, {3.0, -4.0}, {5.5, 6.5}}});
   r.curves.push_back({"updated model", {100.0}, {{7.0, 8.0}}});
   return r;
 }
@@ -118,7 +119,8 @@ TEST(ResultsFile, OtherFilesAreRefusedWithTheirName) {
     acq::ResultsFile::open_or_create(cap, "x");
     FAIL() << "a capture must not be opened as results";
   } catch (const acq::ResultsError& e) {
-    EXPECT_NE(std::string(e.what()).find("\"piezo-capture\", expected \"piezo-replay\""), std::string::npos)
+    EXPECT_NE(std::string(e.what()).find("\"piezo-capture\", expected \"piezo-replay\""),
+              std::string::npos)
         << e.what();
   }
 }

@@ -12,8 +12,10 @@ using namespace piezo;
 namespace fs = std::filesystem;
 
 TEST(Sha256, KnownDigests) {
-  EXPECT_EQ(replay::sha256_bytes(""), "e3b0c44298fc1c149afbf4c8996fb92427ae41e4649b934ca495991b7852b855");
-  EXPECT_EQ(replay::sha256_bytes("abc"), "ba7816bf8f01cfea414140de5dae2223b00361a396177a9cb410ff61f20015ad");
+  EXPECT_EQ(replay::sha256_bytes(""),
+            "e3b0c44298fc1c149afbf4c8996fb92427ae41e4649b934ca495991b7852b855");
+  EXPECT_EQ(replay::sha256_bytes("abc"),
+            "ba7816bf8f01cfea414140de5dae2223b00361a396177a9cb410ff61f20015ad");
   EXPECT_EQ(replay::sha256_bytes("abcdbcdecdefdefgefghfghighijhijkijkljklmklmnlmnomnopnopq"),
             "248d6a61d20638b8e5c026930c3e6039a33ce45964ff2167f6ecedd419db06c1");
 }
@@ -24,7 +26,8 @@ TEST(Sha256, FileOfOneMillionAsSpansManyReads) {
     std::ofstream o(f, std::ios::binary);
     o << std::string(1000000, 'a');
   }
-  EXPECT_EQ(replay::sha256_file(f), "cdc76e5c9914fb9281a1c7e284d73e67f1809a48a497200e046d39ccc7112cd0");
+  EXPECT_EQ(replay::sha256_file(f),
+            "cdc76e5c9914fb9281a1c7e284d73e67f1809a48a497200e046d39ccc7112cd0");
   fs::remove(f);
 }
 

@@ -41,7 +41,13 @@ TEST(SvgPlot, UnusablePointsBreakTheLineAndTextIsEscaped) {
   p.title = "|Z| <measured> & model";
   p.x_scale = p.y_scale = Scale::Log;
   // The NaN and the non-positive value (log axis) each break the line: three runs.
-  p.series.push_back({"a&b", {1, 2, 3, 4, 5, 6, 7}, {1, 2, std::nan(""), 4, 5, -1, 7}, "#000000", 1.0, false, false});
+  p.series.push_back({"a&b",
+                      {1, 2, 3, 4, 5, 6, 7},
+                      {1, 2, std::nan(""), 4, 5, -1, 7},
+                      "#000000",
+                      1.0,
+                      false,
+                      false});
   p.series.push_back({"", {1, 2}, {3, 4}, "#ff0000", 1.0, false, true});
   p.markers.push_back({3.0, "#00ff00"});
   Figure f;

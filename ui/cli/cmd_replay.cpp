@@ -14,6 +14,7 @@
 #include "ui/cli/cli_common.hpp"
 #include "ui/replay/merge.hpp"
 #include "ui/replay/replay_batch.hpp"
+#include "ui/version.hpp"
 
 namespace piezo::cli {
 
@@ -35,8 +36,8 @@ std::string duration(double s) {
 
 std::string progress_text(const replay::ReplayProgress& p) {
   char b[160];
-  std::snprintf(b, sizeof b, "%zu/%zu ok %zu failed %zu done-before %zu | %.2f/s | ETA %s", p.done, p.total, p.ok,
-                p.failed, p.skipped, p.rate_per_s, duration(p.eta_s).c_str());
+  std::snprintf(b, sizeof b, "%zu/%zu ok %zu failed %zu done-before %zu | %.2f/s | ETA %s", p.done,
+                p.total, p.ok, p.failed, p.skipped, p.rate_per_s, duration(p.eta_s).c_str());
   return b;
 }
 
@@ -54,7 +55,8 @@ auto as_input(F&& f) {
 
 void register_replay_commands(CLI::App& app, Context& ctx) {
   // ------------------------------------------------------------------ replay
-  auto* r = app.add_subcommand("replay", "Replay recorded captures headless: impedance, update, diagnosis");
+  auto* r = app.add_subcommand("replay",
+                               "Replay recorded captures headless: impedance, update, diagnosis");
   struct Args {
     std::vector<std::string> inputs;
     std::string out, shard = "0/1", report, jsonl, material;
@@ -62,15 +64,22 @@ void register_replay_commands(CLI::App& app, Context& ctx) {
     bool transverse = false;
   };
   auto a = std::make_shared<Args>();
-  r->add_option("PATH", a->inputs, "Capture files and folders (searched recursively for *.h5)")->required();
-  r->add_option("--out", a->out, "Results file (HDF5, piezo-replay/1); an existing one is resumed")->required();
-  r->add_option("--jobs", a->jobs, "Captures replayed in parallel (threads)")->capture_default_str();
-  r->add_option("--shard", a->shard, "Replay shard I of N (0-based), e.g. $SLURM_ARRAY_TASK_ID/$SLURM_ARRAY_TASK_COUNT")
+  r->add_option("PATH", a->inputs, "Capture files and folders (searched recursively for *.h5)")
+      ->required();
+  r->add_option("--out", a->out, "Results file (HDF5, piezo-replay/1); an existing one is resumed")
+      ->required();
+  r->add_option("--jobs", a->jobs, "Captures replayed in parallel (threads)")
       ->capture_default_str();
-  r->add_option("--report", a->report, "Folder for per-capture reports, exports and the batch summary");
+  r->add_option("--shard", a->shard,
+                "Replay shard I of N (0-based), e.g. $SLURM_ARRAY_TASK_ID/$SLURM_ARRAY_TASK_COUNT")
+      ->capture_default_str();
+  r->add_option("--report", a->report,
+                "Folder for per-capture reports, exports and the batch summary");
   r->add_option("--jsonl", a->jsonl, "One JSON line per capture of this run");
-  r->add_option("--material", a->material, "Nominal material (default: the capture's /setup/material, else apc850)");
-  r->add_flag("--transverse", a->transverse, "Transversely isotropic class instead of the isotropic one");
+  r->add_option("--material", a->material,
+                "Nominal material (default: the capture's /setup/material, else apc850)");
+  r->add_flag("--transverse", a->transverse,
+              "Transversely isotropic class instead of the isotropic one");
   add_json_flag(r, ctx);
   r->callback([&ctx, a] {
     ctx.exit_code = run_command(ctx, [&] {
@@ -83,6 +92,7 @@ void register_replay_commands(CLI::App& app, Context& ctx) {
       if (!a->jsonl.empty()) opt.jsonl = a->jsonl;
       opt.material = a->material;
       opt.isotropic = !a->transverse;
+      opt.software = std::string("piezobench ") + kVersion + " replay";
       g_stop = false;
       std::signal(SIGINT, on_signal);
       std::signal(SIGTERM, on_signal);  // Slurm's warning before a time-limit kill
@@ -93,15 +103,17 @@ void register_replay_commands(CLI::App& app, Context& ctx) {
       cb.progress = [&](const replay::ReplayProgress& p) {
         if (tty) {
           bar.update(p.total ? static_cast<double>(p.done) / p.total : 1.0, progress_text(p));
-        } else if (p.total && p.done * 10 / p.total > last_decile) {  // logs (Slurm, parallel): every 10 %
+        } else if (p.total &&
+                   p.done * 10 / p.total > last_decile) {  // logs (Slurm, parallel): every 10 %
           last_decile = p.done * 10 / p.total;
           std::fprintf(stderr, "replay: %s\n", progress_text(p).c_str());
         }
       };
       cb.issue = [&](const replay::ReplayIssue& i) {
         if (tty) std::fprintf(stderr, "\n");
-        std::fprintf(stderr, "piezobench: replay: %s %s: %s\n", i.kind == "report" ? "report not written for" : "skipped",
-                     i.path.c_str(), i.message.c_str());
+        std::fprintf(stderr, "piezobench: replay: %s %s: %s\n",
+                     i.kind == "report" ? "report not written for" : "skipped", i.path.c_str(),
+                     i.message.c_str());
       };
       auto s = as_input([&] { return replay::run_replay(opt, cb, g_stop); });
       bar.finish();
@@ -120,19 +132,26 @@ void register_replay_commands(CLI::App& app, Context& ctx) {
                           {"jobs", opt.jobs},
                           {"interrupted", s.interrupted}};
       j["issues"] = nlohmann::json::array();
-      for (const auto& i : s.issues) j["issues"].push_back({{"path", i.path}, {"kind", i.kind}, {"message", i.message}});
+      for (const auto& i : s.issues)
+        j["issues"].push_back({{"path", i.path}, {"kind", i.kind}, {"message", i.message}});
       if (ctx.json) {
         print_json(j);
       } else {
-        std::printf("replay: %zu capture(s) found, %zu in shard %s\n", s.found, c.total, a->shard.c_str());
-        std::printf("replay: %zu replayed, %zu failed (skipped), %zu done before; %.1f s, %.2f captures/s with --jobs %zu\n",
-                    c.ok, c.failed, c.skipped, s.wall_s, j["captures_per_s"].get<double>(), opt.jobs);
-        std::printf("results: %s%s%s\n", opt.out.string().c_str(), opt.report_dir ? ", report: " : "",
+        std::printf("replay: %zu capture(s) found, %zu in shard %s\n", s.found, c.total,
+                    a->shard.c_str());
+        std::printf(
+            "replay: %zu replayed, %zu failed (skipped), %zu done before; %.1f s, %.2f captures/s "
+            "with --jobs %zu\n",
+            c.ok, c.failed, c.skipped, s.wall_s, j["captures_per_s"].get<double>(), opt.jobs);
+        std::printf("results: %s%s%s\n", opt.out.string().c_str(),
+                    opt.report_dir ? ", report: " : "",
                     opt.report_dir ? (*opt.report_dir / "summary.md").string().c_str() : "");
         if (s.interrupted) std::printf("interrupted: run the same command again to resume\n");
       }
-      if (s.interrupted || s.report_errors) ctx.exit_code = kInternal;
-      else if (c.failed) ctx.exit_code = kBadInput;
+      if (s.interrupted || s.report_errors)
+        ctx.exit_code = kInternal;
+      else if (c.failed)
+        ctx.exit_code = kBadInput;
     });
   });
 
@@ -156,10 +175,12 @@ void register_replay_commands(CLI::App& app, Context& ctx) {
       for (const auto& i : ma->inputs) opt.inputs.emplace_back(i);
       opt.out = ma->out;
       opt.overwrite = ma->overwrite;
+      opt.software = std::string("piezobench ") + kVersion + " replay-merge";
       if (!ma->report.empty()) opt.report_dir = ma->report;
       if (!ma->jsonl.empty()) opt.jsonl = ma->jsonl;
       auto s = as_input([&] { return replay::merge_results(opt); });
-      for (const auto& w : s.warnings) std::cerr << "piezobench: replay-merge: warning: " << w << "\n";
+      for (const auto& w : s.warnings)
+        std::cerr << "piezobench: replay-merge: warning: " << w << "\n";
       if (ctx.json) {
         print_json({{"results", opt.out.string()},
                     {"inputs", ma->inputs},
@@ -169,8 +190,10 @@ void register_replay_commands(CLI::App& app, Context& ctx) {
                     {"duplicates", s.duplicates},
                     {"warnings", s.warnings}});
       } else {
-        std::printf("replay-merge: %zu record(s) (%zu ok, %zu failed) from %zu file(s) into %s; %zu duplicate(s) left out\n",
-                    s.records, s.ok, s.failed, opt.inputs.size(), opt.out.string().c_str(), s.duplicates);
+        std::printf(
+            "replay-merge: %zu record(s) (%zu ok, %zu failed) from %zu file(s) into %s; %zu "
+            "duplicate(s) left out\n",
+            s.records, s.ok, s.failed, opt.inputs.size(), opt.out.string().c_str(), s.duplicates);
       }
     });
   });

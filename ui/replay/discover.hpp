@@ -24,8 +24,8 @@ ShardSpec parse_shard(std::string_view text);
 // collapse), sorted by their text, `exclude` left out (the results file).
 // A folder's files are found recursively, symlinked folders not followed.
 // Throws std::invalid_argument naming an input that does not exist.
-std::vector<std::filesystem::path> find_captures(const std::vector<std::string>& inputs,
-                                                 const std::vector<std::filesystem::path>& exclude = {});
+std::vector<std::filesystem::path> find_captures(
+    const std::vector<std::string>& inputs, const std::vector<std::filesystem::path>& exclude = {});
 
 // The captures of one shard: position k of the sorted list goes to shard
 // k mod N. Depends only on the sorted list, never on --jobs, directory

@@ -31,7 +31,8 @@ MergeSummary merge_results(const MergeOptions& opt) {
       throw std::invalid_argument("replay-merge: --out " + opt.out.string() + " is also an input");
   std::error_code ec;
   if (fs::exists(opt.out, ec) && !opt.overwrite)
-    throw std::invalid_argument("replay-merge: " + opt.out.string() + " already exists (--overwrite replaces it)");
+    throw std::invalid_argument("replay-merge: " + opt.out.string() +
+                                " already exists (--overwrite replaces it)");
 
   // Which record comes from which input: decided from the indexes first, so
   // that a bad input refuses the merge before anything is written.
@@ -49,14 +50,16 @@ MergeSummary merge_results(const MergeOptions& opt) {
         return;
       }
       ++sum.duplicates;
-      if (it->second.status != "ok" && r.status == "ok") it->second = Choice{k, r.status, r.input_path, r.sha256};
+      if (it->second.status != "ok" && r.status == "ok")
+        it->second = Choice{k, r.status, r.input_path, r.sha256};
     });
   std::map<std::string, std::set<std::string>> digests;  // path → digests
   for (const auto& [key, c] : chosen) digests[c.path].insert(c.sha256);
   for (const auto& [path, d] : digests)
     if (d.size() > 1)
-      sum.warnings.push_back(path + ": " + std::to_string(d.size()) +
-                             " records with different SHA-256 (the file changed between runs); all kept");
+      sum.warnings.push_back(
+          path + ": " + std::to_string(d.size()) +
+          " records with different SHA-256 (the file changed between runs); all kept");
 
   fs::path partial = opt.out;
   partial += ".partial";
@@ -75,14 +78,17 @@ MergeSummary merge_results(const MergeOptions& opt) {
     throw;
   }
   fs::rename(partial, opt.out, ec);
-  if (ec) throw std::runtime_error("replay-merge: cannot rename " + partial.string() + " to " + opt.out.string() + ": " + ec.message());
+  if (ec)
+    throw std::runtime_error("replay-merge: cannot rename " + partial.string() + " to " +
+                             opt.out.string() + ": " + ec.message());
   for (const auto& [key, c] : chosen) (c.status == "ok" ? sum.ok : sum.failed)++;
   sum.records = chosen.size();
 
   if (opt.jsonl) {
     std::ofstream f(*opt.jsonl, std::ios::trunc);
     if (!f) throw std::invalid_argument("--jsonl: cannot write " + opt.jsonl->string());
-    acq::for_each_result(opt.out, [&](const acq::ResultRecord& r) { f << record_json(r).dump() << "\n"; });
+    acq::for_each_result(opt.out,
+                         [&](const acq::ResultRecord& r) { f << record_json(r).dump() << "\n"; });
     if (!f.flush()) throw std::runtime_error("--jsonl: cannot write " + opt.jsonl->string());
   }
   if (opt.report_dir) write_batch_summary(opt.out, *opt.report_dir);

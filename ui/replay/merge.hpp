@@ -18,14 +18,14 @@ struct MergeOptions {
   std::filesystem::path out;
   bool overwrite = false;
   std::optional<std::filesystem::path> report_dir;  // batch summary of the merged file
-  std::optional<std::filesystem::path> jsonl;  // one line per merged record
+  std::optional<std::filesystem::path> jsonl;       // one line per merged record
   std::string software = "piezobench replay-merge";
 };
 
 struct MergeSummary {
   std::size_t records = 0;  // in the output
   std::size_t ok = 0, failed = 0;
-  std::size_t duplicates = 0;  // records left out because their key was already merged
+  std::size_t duplicates = 0;         // records left out because their key was already merged
   std::vector<std::string> warnings;  // e.g. one path with two different digests
 };
 

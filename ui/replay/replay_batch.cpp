@@ -22,7 +22,9 @@ using Clock = std::chrono::steady_clock;
 
 namespace {
 
-double seconds_since(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
+double seconds_since(Clock::time_point t0) {
+  return std::chrono::duration<double>(Clock::now() - t0).count();
+}
 
 // A message that names the file (CaptureError's already does).
 std::string naming(const std::string& path, const std::string& what) {
@@ -45,7 +47,8 @@ class Sink {
     }
   }
 
-  bool finished(const std::string& key) const { return done_.count(key) > 0; }  // read-only after construction
+  // done_ is only read after construction: no lock needed.
+  bool finished(const std::string& key) const { return done_.count(key) > 0; }
 
   // A capture finished earlier: its stored line goes to this run's JSON lines.
   void skipped(const std::string& key) {
@@ -99,7 +102,8 @@ class Sink {
     const double t = seconds_since(t0_);
     counts_.rate_per_s = t > 0 ? processed_ / t : 0;
     const std::size_t left = counts_.total - counts_.done;
-    counts_.eta_s = processed_ > 0 && counts_.rate_per_s > 0 ? left / counts_.rate_per_s : (left ? -1.0 : 0.0);
+    counts_.eta_s =
+        processed_ > 0 && counts_.rate_per_s > 0 ? left / counts_.rate_per_s : (left ? -1.0 : 0.0);
     if (cb_.progress) cb_.progress(counts_);
   }
 
@@ -172,15 +176,16 @@ struct Worker {
     sink.put(ok_record(path, sha, material, result, elapsed), issue);
   }
 
-  void fail(const std::string& path, const std::string& sha, const std::string& kind, const std::string& msg,
-            Clock::time_point t0) {
+  void fail(const std::string& path, const std::string& sha, const std::string& kind,
+            const std::string& msg, Clock::time_point t0) {
     const double elapsed = seconds_since(t0);
     std::optional<ReplayIssue> issue = ReplayIssue{path, kind, msg};
     auto rec = failed_record(path, sha, kind, msg, elapsed);
     if (opt.report_dir) {
       try {
-        report::write_failed_capture_report({path, sha, "", elapsed}, msg,
-                                            *opt.report_dir / report::capture_report_folder(path, rec.key));
+        report::write_failed_capture_report(
+            {path, sha, "", elapsed}, msg,
+            *opt.report_dir / report::capture_report_folder(path, rec.key));
       } catch (const std::exception& e) {
         sink.issue({path, "report", e.what()});
       }
@@ -191,19 +196,25 @@ struct Worker {
 
 }  // namespace
 
-ReplaySummary run_replay(const ReplayOptions& opt, const ReplayCallbacks& cb, const std::atomic<bool>& cancel) {
+ReplaySummary run_replay(const ReplayOptions& opt, const ReplayCallbacks& cb,
+                         const std::atomic<bool>& cancel) {
   if (opt.jobs < 1 || opt.jobs > 256) throw std::invalid_argument("--jobs must be in 1..256");
-  if (opt.inputs.empty()) throw std::invalid_argument("replay: no input given (files or folders of captures)");
+  if (opt.inputs.empty())
+    throw std::invalid_argument("replay: no input given (files or folders of captures)");
   if (opt.out.empty()) throw std::invalid_argument("replay: --out RESULTS.h5 is required");
   const auto t0 = Clock::now();
   ReplaySummary sum;
   const auto all = find_captures(opt.inputs, {opt.out, acq::partial_path_for(opt.out)});
   sum.found = all.size();
+  if (all.empty())
+    throw std::invalid_argument("replay: no capture (*.h5, *.hdf5) found under the given paths");
   const auto mine = select_shard(all, opt.shard);
   if (opt.report_dir) {
     std::error_code ec;
     fs::create_directories(*opt.report_dir, ec);
-    if (ec) throw std::invalid_argument("--report: cannot create " + opt.report_dir->string() + ": " + ec.message());
+    if (ec)
+      throw std::invalid_argument("--report: cannot create " + opt.report_dir->string() + ": " +
+                                  ec.message());
   }
   Sink sink(opt, cb, mine.size());
   if (cb.progress) cb.progress(sink.counts());
@@ -228,11 +239,24 @@ ReplaySummary run_replay(const ReplayOptions& opt, const ReplayCallbacks& cb, co
   };
   const std::size_t n_threads = std::min(opt.jobs, std::max<std::size_t>(1, mine.size()));
   std::vector<std::thread> threads;
-  for (std::size_t k = 1; k < n_threads; ++k) threads.emplace_back(work);
+  try {
+    for (std::size_t k = 1; k < n_threads; ++k) threads.emplace_back(work);
+  } catch (...) {  // no thread to be had: stop those started, never leave one joinable
+    stop = true;
+    for (auto& t : threads) t.join();
+    throw;
+  }
   work();
   for (auto& t : threads) t.join();
+  if (fatal) {
+    try {
+      sink.close();
+    } catch (...) {
+      // The first failure is the one to report.
+    }
+    std::rethrow_exception(fatal);
+  }
   sink.close();
-  if (fatal) std::rethrow_exception(fatal);
 
   sum.counts = sink.counts();
   sum.issues = sink.issues();

@@ -29,11 +29,12 @@ namespace piezo::replay {
 
 struct ReplayOptions {
   std::vector<std::string> inputs;  // files and folders
-  std::filesystem::path out;  // the results file (created or resumed)
+  std::filesystem::path out;        // the results file (created or resumed)
   std::size_t jobs = 1;
   ShardSpec shard;
   std::optional<std::filesystem::path> report_dir;
-  std::optional<std::filesystem::path> jsonl;  // one line per capture of this run (truncated at start)
+  std::optional<std::filesystem::path>
+      jsonl;             // one line per capture of this run (truncated at start)
   std::string material;  // nominal model; empty: the capture's /setup/material, else apc850
   bool isotropic = true;
   std::string software = "piezobench replay";
@@ -41,10 +42,10 @@ struct ReplayOptions {
 
 struct ReplayProgress {
   std::size_t total = 0;  // captures of this shard
-  std::size_t done = 0;  // replayed + failed + skipped
+  std::size_t done = 0;   // replayed + failed + skipped
   std::size_t ok = 0, failed = 0, skipped = 0;
   double rate_per_s = 0;  // captures replayed (not skipped) per second of wall time
-  double eta_s = -1;  // < 0: unknown yet
+  double eta_s = -1;      // < 0: unknown yet
 };
 
 struct ReplayIssue {
@@ -62,15 +63,17 @@ struct ReplaySummary {
 
 struct ReplayCallbacks {
   std::function<void(const ReplayProgress&)> progress;  // after each capture (under the sink lock)
-  std::function<void(const ReplayIssue&)> issue;  // as it happens
+  std::function<void(const ReplayIssue&)> issue;        // as it happens
 };
 
 // Throws std::invalid_argument for bad options or inputs, acq::ResultsError for
 // a results file that cannot be used, std::runtime_error when the results file
 // cannot be written (the batch stops: every finished record is kept).
-ReplaySummary run_replay(const ReplayOptions& opt, const ReplayCallbacks& cb, const std::atomic<bool>& cancel);
+ReplaySummary run_replay(const ReplayOptions& opt, const ReplayCallbacks& cb,
+                         const std::atomic<bool>& cancel);
 
 // The batch summary of everything in a results file (report/batch_summary.hpp).
-void write_batch_summary(const std::filesystem::path& results, const std::filesystem::path& report_dir);
+void write_batch_summary(const std::filesystem::path& results,
+                         const std::filesystem::path& report_dir);
 
 }  // namespace piezo::replay

@@ -9,8 +9,9 @@ std::string record_key(const std::string& path, const std::string& sha256) {
   return sha256_bytes(path + "\n" + sha256).substr(0, 32);
 }
 
-acq::ResultRecord ok_record(const std::string& path, const std::string& sha256, const std::string& material,
-                            const ui::PipelineResult& r, double elapsed_s) {
+acq::ResultRecord ok_record(const std::string& path, const std::string& sha256,
+                            const std::string& material, const ui::PipelineResult& r,
+                            double elapsed_s) {
   acq::ResultRecord rec;
   rec.key = record_key(path, sha256);
   rec.input_path = path;
@@ -24,8 +25,9 @@ acq::ResultRecord ok_record(const std::string& path, const std::string& sha256, 
   return rec;
 }
 
-acq::ResultRecord failed_record(const std::string& path, const std::string& sha256, const std::string& kind,
-                                const std::string& message, double elapsed_s) {
+acq::ResultRecord failed_record(const std::string& path, const std::string& sha256,
+                                const std::string& kind, const std::string& message,
+                                double elapsed_s) {
   acq::ResultRecord rec;
   rec.key = record_key(path, sha256);
   rec.input_path = path;
@@ -41,8 +43,11 @@ acq::ResultRecord failed_record(const std::string& path, const std::string& sha2
 nlohmann::json record_json(const acq::ResultRecord& rec) {
   nlohmann::json j = nlohmann::json::parse(rec.result_json, nullptr, /*allow_exceptions=*/false);
   if (!j.is_object())
-    j = {{"path", rec.input_path}, {"sha256", rec.sha256}, {"status", "failed"},
-         {"error", {{"kind", "bad record"}, {"message", "stored result_json is not a JSON object"}}}};
+    j = {{"path", rec.input_path},
+         {"sha256", rec.sha256},
+         {"status", "failed"},
+         {"error",
+          {{"kind", "bad record"}, {"message", "stored result_json is not a JSON object"}}}};
   j["key"] = rec.key;
   j["elapsed_s"] = rec.elapsed_s;
   return j;

@@ -20,10 +20,12 @@ namespace piezo::replay {
 // any machine, in any shard.
 std::string record_key(const std::string& path, const std::string& sha256);
 
-acq::ResultRecord ok_record(const std::string& path, const std::string& sha256, const std::string& material,
-                            const ui::PipelineResult& r, double elapsed_s);
-acq::ResultRecord failed_record(const std::string& path, const std::string& sha256, const std::string& kind,
-                                const std::string& message, double elapsed_s);
+acq::ResultRecord ok_record(const std::string& path, const std::string& sha256,
+                            const std::string& material, const ui::PipelineResult& r,
+                            double elapsed_s);
+acq::ResultRecord failed_record(const std::string& path, const std::string& sha256,
+                                const std::string& kind, const std::string& message,
+                                double elapsed_s);
 
 // The JSON object of a stored record (its result_json plus key and elapsed_s).
 nlohmann::json record_json(const acq::ResultRecord& rec);

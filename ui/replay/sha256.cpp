@@ -27,12 +27,14 @@ class Digest {
       throw std::runtime_error("sha256: cannot initialise OpenSSL's SHA-256");
   }
   void update(const void* p, std::size_t n) {
-    if (EVP_DigestUpdate(ctx_.get(), p, n) != 1) throw std::runtime_error("sha256: digest update failed");
+    if (EVP_DigestUpdate(ctx_.get(), p, n) != 1)
+      throw std::runtime_error("sha256: digest update failed");
   }
   std::string hex() {
     unsigned char md[EVP_MAX_MD_SIZE];
     unsigned int len = 0;
-    if (EVP_DigestFinal_ex(ctx_.get(), md, &len) != 1) throw std::runtime_error("sha256: digest failed");
+    if (EVP_DigestFinal_ex(ctx_.get(), md, &len) != 1)
+      throw std::runtime_error("sha256: digest failed");
     static constexpr char kHex[] = "0123456789abcdef";
     std::string out;
     for (unsigned int i = 0; i < len; ++i) {
@@ -55,7 +57,8 @@ std::string sha256_file(const std::filesystem::path& file) {
   std::vector<char> buf(1 << 16);
   std::size_t n;
   while ((n = std::fread(buf.data(), 1, buf.size(), f.get())) > 0) d.update(buf.data(), n);
-  if (std::ferror(f.get())) throw std::runtime_error(file.string() + ": read error: " + std::strerror(errno));
+  if (std::ferror(f.get()))
+    throw std::runtime_error(file.string() + ": read error: " + std::strerror(errno));
   return d.hex();
 }
 

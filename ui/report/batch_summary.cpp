@@ -33,18 +33,23 @@ BatchEntry batch_entry(const std::string& key, const nlohmann::json& rec) {
   e.path = rec.value("path", "");
   e.sha256 = rec.value("sha256", "");
   e.status = rec.value("status", "failed");
-  if (rec.contains("error") && rec["error"].is_object()) e.error = rec["error"].value("message", "");
+  if (rec.contains("error") && rec["error"].is_object())
+    e.error = rec["error"].value("message", "");
   if (!rec.contains("result") || !rec["result"].is_object()) return e;
   const auto& r = rec["result"];
-  if (r.contains("verdict") && r["verdict"].is_string()) e.verdict = r["verdict"].get<std::string>();
+  if (r.contains("verdict") && r["verdict"].is_string())
+    e.verdict = r["verdict"].get<std::string>();
   if (r.contains("parameters") && r["parameters"].is_array())
     for (const auto& p : r["parameters"])
       if (p.contains("name") && p.contains("updated") && p["updated"].is_number())
-        e.values.push_back({p["name"].get<std::string>(), p.value("unit", ""), p["updated"].get<double>()});
-  for (const auto& [field, prefix] : {std::pair("resonances_hz", "f_r"), std::pair("antiresonances_hz", "f_a")})
+        e.values.push_back(
+            {p["name"].get<std::string>(), p.value("unit", ""), p["updated"].get<double>()});
+  for (const auto& [field, prefix] :
+       {std::pair("resonances_hz", "f_r"), std::pair("antiresonances_hz", "f_a")})
     if (r.contains(field) && r[field].is_array())
       for (std::size_t k = 0; k < r[field].size() && k < 3; ++k)
-        if (r[field][k].is_number()) e.values.push_back({prefix + std::to_string(k + 1), "Hz", r[field][k].get<double>()});
+        if (r[field][k].is_number())
+          e.values.push_back({prefix + std::to_string(k + 1), "Hz", r[field][k].get<double>()});
   return e;
 }
 
@@ -65,8 +70,10 @@ BatchSummary summarize(std::vector<BatchEntry> entries) {
   std::vector<BatchEntry::Value> qs;
   for (const auto& e : s.entries)
     for (const auto& v : e.values)
-      if (std::none_of(qs.begin(), qs.end(), [&](const auto& q) { return q.name == v.name; })) qs.push_back(v);
-  std::stable_partition(qs.begin(), qs.end(), [](const auto& q) { return q.name.rfind("f_", 0) != 0; });
+      if (std::none_of(qs.begin(), qs.end(), [&](const auto& q) { return q.name == v.name; }))
+        qs.push_back(v);
+  std::stable_partition(qs.begin(), qs.end(),
+                        [](const auto& q) { return q.name.rfind("f_", 0) != 0; });
   for (const auto& q : qs) {
     Distribution d;
     d.name = q.name;
@@ -100,26 +107,32 @@ std::string batch_summary_markdown(const BatchSummary& s, const std::string& res
   std::ostringstream o;
   o << "# Replay batch summary\n\n"
     << "- results: `" << results_file << "`\n"
-    << "- captures: " << s.entries.size() << " (" << s.ok << " replayed, " << s.failed << " failed)\n\n"
+    << "- captures: " << s.entries.size() << " (" << s.ok << " replayed, " << s.failed
+    << " failed)\n\n"
     << "## Distributions across transducers\n\n"
-    << "Outliers: modified z-score 0.6745·|x − median| / MAD above " << fmt("%.1f", kOutlierThreshold)
-    << " (Iglewicz & Hoaglin), with at least " << kMinForOutliers << " values.\n\n"
-    << "| quantity | unit | n | median | MAD | min | max | outliers |\n| --- | --- | --- | --- | --- | --- | --- | --- |\n";
+    << "Outliers: modified z-score 0.6745·|x − median| / MAD above "
+    << fmt("%.1f", kOutlierThreshold) << " (Iglewicz & Hoaglin), with at least " << kMinForOutliers
+    << " values.\n\n"
+    << "| quantity | unit | n | median | MAD | min | max | outliers |\n| --- | --- | --- | --- | "
+       "--- | --- | --- | --- |\n";
   for (const auto& d : s.distributions)
-    o << "| " << d.name << " | " << d.unit << " | " << d.stats.n << " | " << fmt("%.6g", d.stats.median) << " | "
-      << fmt("%.3g", d.stats.mad) << " | " << fmt("%.6g", d.stats.min) << " | " << fmt("%.6g", d.stats.max) << " | "
-      << d.outliers.size() << " |\n";
+    o << "| " << d.name << " | " << d.unit << " | " << d.stats.n << " | "
+      << fmt("%.6g", d.stats.median) << " | " << fmt("%.3g", d.stats.mad) << " | "
+      << fmt("%.6g", d.stats.min) << " | " << fmt("%.6g", d.stats.max) << " | " << d.outliers.size()
+      << " |\n";
   o << "\n![distributions](distributions.svg)\n";
   bool any = false;
   for (const auto& d : s.distributions)
     for (std::size_t i : d.outliers) {
-      if (!any) o << "\n## Outliers\n\n| capture | quantity | value | median | modified z |\n| --- | --- | --- | --- | --- |\n";
+      if (!any)
+        o << "\n## Outliers\n\n| capture | quantity | value | median | modified z |\n| --- | --- | "
+             "--- | --- | --- |\n";
       any = true;
       const auto& e = s.entries[i];
       const double x = e.find(d.name)->value;
-      o << "| [" << cell(e.path) << "](" << capture_report_folder(e.path, e.key) << "/summary.md) | " << d.name
-        << " | " << fmt("%.6g", x) << " | " << fmt("%.6g", d.stats.median) << " | "
-        << fmt("%+.1f", modified_z(x, d.stats)) << " |\n";
+      o << "| [" << cell(e.path) << "](" << capture_report_folder(e.path, e.key)
+        << "/summary.md) | " << d.name << " | " << fmt("%.6g", x) << " | "
+        << fmt("%.6g", d.stats.median) << " | " << fmt("%+.1f", modified_z(x, d.stats)) << " |\n";
     }
   if (!any) o << "\nNo outliers.\n";
   if (s.failed) {
@@ -154,7 +167,8 @@ Figure distributions_figure(const BatchSummary& s) {
     p.x_label = "capture";
     p.y_label = d.unit.empty() || d.unit == "-" ? d.name : d.name + " [" + d.unit + "]";
     p.x_range = std::pair(0.0, static_cast<double>(s.entries.size()) + 1.0);
-    Series in{"", {}, {}, "#1f77b4", 2.5, false, true}, out{"", {}, {}, "#d62728", 3.5, false, true};
+    Series in{"", {}, {}, "#1f77b4", 2.5, false, true},
+        out{"", {}, {}, "#d62728", 3.5, false, true};
     for (const auto& [i, x] : d.values) {
       const bool o = std::find(d.outliers.begin(), d.outliers.end(), i) != d.outliers.end();
       (o ? out : in).x.push_back(static_cast<double>(i) + 1.0);
@@ -174,7 +188,8 @@ Figure distributions_figure(const BatchSummary& s) {
   return fig;
 }
 
-void write_batch_report(const BatchSummary& s, const std::string& results_file, const fs::path& dir) {
+void write_batch_report(const BatchSummary& s, const std::string& results_file,
+                        const fs::path& dir) {
   std::error_code ec;
   fs::create_directories(dir, ec);
   if (ec) throw std::runtime_error("report: cannot create " + dir.string() + ": " + ec.message());

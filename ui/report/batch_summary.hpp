@@ -17,7 +17,7 @@ namespace piezo::report {
 
 struct BatchEntry {
   std::string key, path, sha256, status;  // status "ok" | "failed"
-  std::string error;  // failed: the message
+  std::string error;                      // failed: the message
   std::string verdict;
   struct Value {
     std::string name, unit;
@@ -36,7 +36,7 @@ struct Distribution {
   std::string name, unit;
   RobustStats stats;
   std::vector<std::pair<std::size_t, double>> values;  // (entry index, value)
-  std::vector<std::size_t> outliers;  // entry indices
+  std::vector<std::size_t> outliers;                   // entry indices
 };
 
 struct BatchSummary {
@@ -53,6 +53,7 @@ std::string capture_report_folder(const std::string& path, const std::string& ke
 std::string batch_summary_markdown(const BatchSummary& s, const std::string& results_file);
 Figure distributions_figure(const BatchSummary& s);
 // Writes DIR/summary.md and DIR/distributions.svg; throws naming a file it cannot write.
-void write_batch_report(const BatchSummary& s, const std::string& results_file, const std::filesystem::path& dir);
+void write_batch_report(const BatchSummary& s, const std::string& results_file,
+                        const std::filesystem::path& dir);
 
 }  // namespace piezo::report

@@ -36,7 +36,8 @@ void header(std::ostringstream& o, const CaptureInfo& info) {
 
 void write_text(const fs::path& file, const std::string& s) {
   std::ofstream f(file);
-  if (!f || !(f << s) || !f.flush()) throw std::runtime_error("report: cannot write " + file.string());
+  if (!f || !(f << s) || !f.flush())
+    throw std::runtime_error("report: cannot write " + file.string());
 }
 
 void make_dir(const fs::path& dir) {
@@ -50,16 +51,20 @@ void make_dir(const fs::path& dir) {
 std::string capture_summary_markdown(const ui::PipelineResult& r, const CaptureInfo& info) {
   std::ostringstream o;
   header(o, info);
-  o << "- shots: " << r.shots << " (" << r.shots_averaged << " averaged for the Prony-SS fit, order " << r.order
-    << ")\n\n";
+  o << "- shots: " << r.shots << " (" << r.shots_averaged
+    << " averaged for the Prony-SS fit, order " << r.order << ")\n\n";
   if (!r.verdict.empty()) o << "**Gap verdict:** " << cell(r.verdict) << "\n\n";
   o << "## Stages\n\n| stage | ran | note |\n| --- | --- | --- |\n";
-  for (const auto& s : r.stages) o << "| " << s.name << " | " << (s.ran ? "yes" : "no") << " | " << cell(s.note) << " |\n";
+  for (const auto& s : r.stages)
+    o << "| " << s.name << " | " << (s.ran ? "yes" : "no") << " | " << cell(s.note) << " |\n";
   if (!r.params.empty()) {
-    o << "\n## Parameters\n\n| parameter | unit | original | updated | change |\n| --- | --- | --- | --- | --- |\n";
+    o << "\n## Parameters\n\n| parameter | unit | original | updated | change |\n| --- | --- | --- "
+         "| --- | --- |\n";
     for (const auto& p : r.params)
-      o << "| " << p.name << " | " << p.unit << " | " << fmt("%.6g", p.original) << " | " << fmt("%.6g", p.updated)
-        << " | " << (p.original != 0 ? fmt("%+.2f %%", 100.0 * (p.updated - p.original) / p.original) : "-") << " |\n";
+      o << "| " << p.name << " | " << p.unit << " | " << fmt("%.6g", p.original) << " | "
+        << fmt("%.6g", p.updated) << " | "
+        << (p.original != 0 ? fmt("%+.2f %%", 100.0 * (p.updated - p.original) / p.original) : "-")
+        << " |\n";
   }
   o << "\n## Features (Prony-SS)\n\n";
   auto list = [&](const char* what, const std::vector<double>& v) {
@@ -75,7 +80,8 @@ std::string capture_summary_markdown(const ui::PipelineResult& r, const CaptureI
     for (const auto& w : r.warnings) o << "- " << w << "\n";
   }
   o << "\n## Impedance\n\n![|Z| and phase: measured, original and updated model](impedance.svg)\n\n"
-    << "Exports: [impedance.csv](impedance.csv) (f_hz,re_ohm,im_ohm), [impedance.s1p](impedance.s1p) "
+    << "Exports: [impedance.csv](impedance.csv) (f_hz,re_ohm,im_ohm), "
+       "[impedance.s1p](impedance.s1p) "
        "(Touchstone, Z, RI), [result.json](result.json) (parameters, features, stages).\n";
   return o.str();
 }
@@ -87,7 +93,8 @@ std::string failed_capture_markdown(const CaptureInfo& info, const std::string& 
   return o.str();
 }
 
-void write_capture_report(const ui::PipelineResult& r, const CaptureInfo& info, const fs::path& dir) {
+void write_capture_report(const ui::PipelineResult& r, const CaptureInfo& info,
+                          const fs::path& dir) {
   make_dir(dir);
   write_svg(impedance_figure(r, info.input_path), dir / "impedance.svg");
   if (!r.curves.empty()) {
@@ -98,7 +105,8 @@ void write_capture_report(const ui::PipelineResult& r, const CaptureInfo& info, 
   write_text(dir / "summary.md", capture_summary_markdown(r, info));
 }
 
-void write_failed_capture_report(const CaptureInfo& info, const std::string& error, const fs::path& dir) {
+void write_failed_capture_report(const CaptureInfo& info, const std::string& error,
+                                 const fs::path& dir) {
   make_dir(dir);
   write_text(dir / "summary.md", failed_capture_markdown(info, error));
 }

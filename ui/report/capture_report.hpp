@@ -24,7 +24,9 @@ std::string failed_capture_markdown(const CaptureInfo& info, const std::string& 
 
 // Creates `dir` and writes the files above. Throws std::runtime_error naming a
 // file that cannot be written.
-void write_capture_report(const ui::PipelineResult& r, const CaptureInfo& info, const std::filesystem::path& dir);
-void write_failed_capture_report(const CaptureInfo& info, const std::string& error, const std::filesystem::path& dir);
+void write_capture_report(const ui::PipelineResult& r, const CaptureInfo& info,
+                          const std::filesystem::path& dir);
+void write_failed_capture_report(const CaptureInfo& info, const std::string& error,
+                                 const std::filesystem::path& dir);
 
 }  // namespace piezo::report

@@ -23,11 +23,22 @@ Style style_for(const std::string& label) {
 
 Figure impedance_figure(const ui::PipelineResult& r, const std::string& title) {
   Panel mag{"|Z|", "frequency [Hz]", "|Z| [ohm]", Scale::Log, Scale::Log, {}, {}, {}, {}, {}};
-  Panel ph{"phase", "frequency [Hz]", "phase [deg]", Scale::Log, Scale::Linear, {}, std::pair(-95.0, 95.0), {}, {}, {}};
+  Panel ph{"phase",
+           "frequency [Hz]",
+           "phase [deg]",
+           Scale::Log,
+           Scale::Linear,
+           {},
+           std::pair(-95.0, 95.0),
+           {},
+           {},
+           {}};
   // Models first (the updated one wide, as a halo), the measurement on top.
   // The FFT and cross-spectra overlays stay out, as in the GUI's default view
   // (they are noisy on a few shots; the results file keeps them).
-  auto overlay = [](const std::string& l) { return l.find("FFT") != std::string::npos || l.find("cross") != std::string::npos; };
+  auto overlay = [](const std::string& l) {
+    return l.find("FFT") != std::string::npos || l.find("cross") != std::string::npos;
+  };
   std::vector<const ui::Curve*> order;
   for (const auto& c : r.curves)
     if (c.label.find("model") != std::string::npos) order.push_back(&c);

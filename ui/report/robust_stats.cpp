@@ -35,12 +35,15 @@ RobustStats robust_stats(const std::vector<double>& values) {
 double modified_z(double x, const RobustStats& s) {
   const double d = x - s.median;
   if (d == 0) return 0.0;
-  if (s.mad == 0) return d > 0 ? std::numeric_limits<double>::infinity() : -std::numeric_limits<double>::infinity();
+  if (s.mad == 0)
+    return d > 0 ? std::numeric_limits<double>::infinity()
+                 : -std::numeric_limits<double>::infinity();
   return 0.6745 * d / s.mad;
 }
 
 bool is_outlier(double x, const RobustStats& s) {
-  return std::isfinite(x) && s.n >= kMinForOutliers && std::abs(modified_z(x, s)) > kOutlierThreshold;
+  return std::isfinite(x) && s.n >= kMinForOutliers &&
+         std::abs(modified_z(x, s)) > kOutlierThreshold;
 }
 
 }  // namespace piezo::report

@@ -14,7 +14,7 @@ namespace piezo::report {
 enum class Scale { Linear, Log };
 
 struct Series {
-  std::string label;  // empty: not in the legend
+  std::string label;         // empty: not in the legend
   std::vector<double> x, y;  // non-finite points (or ≤ 0 on a log axis) break the line
   std::string colour = "#1f77b4";
   double width = 1.5;
