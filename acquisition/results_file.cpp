@@ -259,11 +259,12 @@ h5::Id open_existing(const std::string& file, unsigned flags) {
   h5::quiet_errors();
   if (H5Fis_hdf5(file.c_str()) <= 0) fail(file, "/", "not a readable HDF5 file");
   h5::Id f = h5::file(H5Fopen(file.c_str(), flags, H5P_DEFAULT));
-  if (!f)
-    fail(file, "/",
-         std::string("cannot open") +
-             (flags == H5F_ACC_RDWR ? " for writing (is another replay writing it?)" : "") + ": " +
-             h5::last_error());
+  if (!f) {
+    const std::string why = h5::last_error();
+    if (why.find("lock") != std::string::npos)  // HDF5's file locking: a writer holds the file
+      fail(file, "/", "in use by another process (another replay writing it?): " + why);
+    fail(file, "/", "cannot open (damaged file?): " + why);
+  }
   return f;
 }
 
