@@ -139,6 +139,7 @@ TEST(CliReplay, BatchReportsAndSkipsACorruptedCaptureWritesReportsAndResumes) {
   EXPECT_EQ(read_lines(jsonl).size(),
             5u);  // this run's lines: the stored ones for skipped captures
   test::expect_same_content(content, test::read_content(out));
+  fs::remove_all(dir);
 }
 
 TEST(CliReplay, FourMergedShardsEqualOneUnshardedRun) {
@@ -181,6 +182,7 @@ TEST(CliReplay, FourMergedShardsEqualOneUnshardedRun) {
   ASSERT_EQ(m2.exit_code, 0) << m2.err;
   EXPECT_EQ(nlohmann::json::parse(m2.out)["duplicates"], 2);
   test::expect_same_content(test::read_content(all), test::read_content(merged));
+  fs::remove_all(dir);
 }
 
 TEST(CliReplay, KilledRunResumesWithoutRedoingFinishedCaptures) {
@@ -235,6 +237,7 @@ TEST(CliReplay, KilledRunResumesWithoutRedoingFinishedCaptures) {
     std::map<std::string, test::Content> one{{key, c}}, other{{key, after.at(key)}};
     test::expect_same_content(one, other);
   }
+  fs::remove_all(dir);
 }
 
 TEST(CliReplay, BadOptionsAndFilesAreRefusedClearly) {
@@ -268,4 +271,5 @@ TEST(CliReplay, BadOptionsAndFilesAreRefusedClearly) {
   EXPECT_NE(r.err.find((dir / "T.h5").string()), std::string::npos) << r.err;
   EXPECT_FALSE(fs::exists(dir / "m.h5"));
   EXPECT_FALSE(fs::exists(dir / "m.h5.partial"));
+  fs::remove_all(dir);
 }

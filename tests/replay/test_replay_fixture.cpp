@@ -91,4 +91,5 @@ TEST(ReplayFixture, H5pyCaptureReplaysLikeTheSameDataWrittenByTheBench) {
   ASSERT_GE(res["resonances_hz"].size(), 3u) << res.dump(1);
   EXPECT_NEAR(res["resonances_hz"][0].get<double>(), 50.3e3, 0.5e3);
   EXPECT_EQ(res["parameters"].size(), 4u) << res.dump(1);
+  fs::remove_all(dir);
 }
