@@ -28,18 +28,21 @@ cd "$WORK"
 echo "replay-scale: $N captures, --jobs $JOBS, in $WORK"
 
 # ------------------------------------------------------------ 1. captures
+SOFT=$((N * 3 / 16))  # 37 of 200: a soft transducer the batch summary must flag
+BAD=$((N / 10 + 1))   # 21 of 200: truncated, must be reported and skipped
+export BAD
 if [ ! -f captures/.complete ]; then
   rm -rf captures
   for ((k = 0; k < N; k++)); do
     line=$((k % 4))
     ye=$(awk -v k="$k" 'BEGIN { printf "%.5g", 6.66e10 * (1 + 0.01 * sin(k * 1.7)) }')
-    [ "$k" -eq 37 ] && ye=6.13e10  # one soft transducer: the batch summary must flag it
+    if [ "$k" -eq "$SOFT" ]; then ye=6.13e10; fi
     mkdir -p "captures/line$line"
     "$PB" measure --instrument sim --sim-isotropic \
       --sim-set "YE11=$ye,nu12=0.3333,d31=-210e-12,epsT33_rel=2294" --noise 0.005 --seed $((1000 + k)) \
       --samples 20000 --rate 1e7 --shots 4 --overwrite --out "captures/line$line/T-$(printf %04d "$k").h5" >/dev/null
   done
-  bad="captures/line1/T-$(printf %04d 21).h5"
+  bad="captures/line$((BAD % 4))/T-$(printf %04d "$BAD").h5"
   truncate -s $(($(stat -c %s "$bad") / 2)) "$bad"
   touch captures/.complete
 fi
@@ -56,11 +59,11 @@ set -e
 rss_kb=$(awk -F': ' '/Maximum resident set size/ { print $2 }' time-full.txt)
 wall=$(awk -F': ' '/Elapsed \(wall clock\)/ { print $2 }' time-full.txt)
 "$PY" - <<'EOF'
-import json
+import json, os
 j = json.load(open("full.json"))
 print("replay-scale: replayed %d, failed %d, %.1f s, %.2f captures/s (--jobs %d)"
       % (j["replayed"], j["failed"], j["wall_s"], j["captures_per_s"], j["jobs"]))
-assert j["failed"] == 1 and j["issues"][0]["path"].endswith("T-0021.h5"), j["issues"]
+assert j["failed"] == 1 and j["issues"][0]["path"].endswith("T-%04d.h5" % int(os.environ["BAD"])), j["issues"]
 EOF
 echo "replay-scale: peak RSS $((rss_kb / 1024)) MB, wall $wall (/usr/bin/time -v)"
 echo "replay-scale: JSON lines: $(lines full.jsonl)"

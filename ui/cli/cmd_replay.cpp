@@ -111,9 +111,12 @@ void register_replay_commands(CLI::App& app, Context& ctx) {
       };
       cb.issue = [&](const replay::ReplayIssue& i) {
         if (tty) std::fprintf(stderr, "\n");
-        std::fprintf(stderr, "piezobench: replay: %s %s: %s\n",
-                     i.kind == "report" ? "report not written for" : "skipped", i.path.c_str(),
-                     i.message.c_str());
+        const char* what = i.kind == "report" ? "report not written" : "skipped";
+        if (i.message.rfind(i.path, 0) == 0)  // the message names the file already
+          std::fprintf(stderr, "piezobench: replay: %s: %s\n", what, i.message.c_str());
+        else
+          std::fprintf(stderr, "piezobench: replay: %s: %s: %s\n", what, i.path.c_str(),
+                       i.message.c_str());
       };
       auto s = as_input([&] { return replay::run_replay(opt, cb, g_stop); });
       bar.finish();
