@@ -11,7 +11,7 @@ PACKAGES=(
   libhdf5-dev hdf5-tools
   libusb-1.0-0-dev
   libglfw3-dev libimgui-dev libstb-dev libgl-dev
-  libcli11-dev nlohmann-json3-dev libtomlplusplus-dev
+  libcli11-dev nlohmann-json3-dev libtomlplusplus-dev libssl-dev
   libgtest-dev libgmock-dev libbenchmark-dev
   xvfb xauth libgl1-mesa-dri
   python3-numpy python3-h5py

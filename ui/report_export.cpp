@@ -39,7 +39,7 @@ void export_touchstone(const PipelineResult& r, const std::string& path) {
   dsp::write_touchstone_s1p(f, as_impedance(measured(r)), 50.0);
 }
 
-void export_json(const PipelineResult& r, const std::string& path) {
+nlohmann::json report_json(const PipelineResult& r) {
   nlohmann::json j;
   j["capture"] = r.capture_path;
   j["shots"] = r.shots;
@@ -60,8 +60,12 @@ void export_json(const PipelineResult& r, const std::string& path) {
   j["verdict"] = r.verdict;
   if (r.diagnosis) j["diagnosis"] = diagnosis_json(*r.diagnosis);
   j["warnings"] = r.warnings;
+  return j;
+}
+
+void export_json(const PipelineResult& r, const std::string& path) {
   auto f = open_out(path);
-  f << j.dump(2) << "\n";
+  f << report_json(r).dump(2) << "\n";
 }
 
 nlohmann::json diagnosis_json(const update::GapDiagnosis& d) {

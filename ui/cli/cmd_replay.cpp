@@ -1,0 +1,205 @@
+// `piezobench replay PATH... --out RESULTS.h5`: headless replay of recorded
+// captures (ui/replay/replay_batch.hpp) with a progress bar and ETA, and
+// `piezobench replay-merge A.h5 B.h5 ... --out ALL.h5` for sharded runs.
+// Exit codes: 0 every capture replayed; 2 some captures were refused or
+// failed (each reported, the batch went on) or bad options; 1 the batch
+// itself failed or was interrupted (rerun the same command to resume).
+#include <unistd.h>
+
+#include <csignal>
+#include <cstdio>
+#include <iostream>
+
+#include "acquisition/results_file.hpp"
+#include "ui/cli/cli_common.hpp"
+#include "ui/replay/merge.hpp"
+#include "ui/replay/replay_batch.hpp"
+#include "ui/version.hpp"
+
+namespace piezo::cli {
+
+namespace {
+
+std::atomic<bool> g_stop{false};
+void on_signal(int) { g_stop = true; }
+
+std::string duration(double s) {
+  if (s < 0) return "--:--";
+  const long t = static_cast<long>(s + 0.5);
+  char b[32];
+  if (t >= 3600)
+    std::snprintf(b, sizeof b, "%ld:%02ld:%02ld", t / 3600, (t / 60) % 60, t % 60);
+  else
+    std::snprintf(b, sizeof b, "%ld:%02ld", t / 60, t % 60);
+  return b;
+}
+
+std::string progress_text(const replay::ReplayProgress& p) {
+  char b[160];
+  std::snprintf(b, sizeof b, "%zu/%zu ok %zu failed %zu done-before %zu | %.2f/s | ETA %s", p.done,
+                p.total, p.ok, p.failed, p.skipped, p.rate_per_s, duration(p.eta_s).c_str());
+  return b;
+}
+
+// Results files given by the user are input: a wrong one is exit 2, not an internal error.
+template <class F>
+auto as_input(F&& f) {
+  try {
+    return f();
+  } catch (const acq::ResultsError& e) {
+    throw InputError(e.what());
+  }
+}
+
+}  // namespace
+
+void register_replay_commands(CLI::App& app, Context& ctx) {
+  // ------------------------------------------------------------------ replay
+  auto* r = app.add_subcommand("replay",
+                               "Replay recorded captures headless: impedance, update, diagnosis");
+  struct Args {
+    std::vector<std::string> inputs;
+    std::string out, shard = "0/1", report, jsonl, material;
+    std::size_t jobs = 1;
+    bool transverse = false;
+  };
+  auto a = std::make_shared<Args>();
+  r->add_option("PATH", a->inputs, "Capture files and folders (searched recursively for *.h5)")
+      ->required();
+  r->add_option("--out", a->out, "Results file (HDF5, piezo-replay/1); an existing one is resumed")
+      ->required();
+  r->add_option("--jobs", a->jobs, "Captures replayed in parallel (threads)")
+      ->capture_default_str();
+  r->add_option("--shard", a->shard,
+                "Replay shard I of N (0-based), e.g. $SLURM_ARRAY_TASK_ID/$SLURM_ARRAY_TASK_COUNT")
+      ->capture_default_str();
+  r->add_option("--report", a->report,
+                "Folder for per-capture reports, exports and the batch summary");
+  r->add_option("--jsonl", a->jsonl, "One JSON line per capture of this run");
+  r->add_option("--material", a->material,
+                "Nominal material (default: the capture's /setup/material, else apc850)");
+  r->add_flag("--transverse", a->transverse,
+              "Transversely isotropic class instead of the isotropic one");
+  add_json_flag(r, ctx);
+  r->callback([&ctx, a] {
+    ctx.exit_code = run_command(ctx, [&] {
+      replay::ReplayOptions opt;
+      opt.inputs = a->inputs;
+      opt.out = a->out;
+      opt.jobs = a->jobs;
+      opt.shard = replay::parse_shard(a->shard);
+      if (!a->report.empty()) opt.report_dir = a->report;
+      if (!a->jsonl.empty()) opt.jsonl = a->jsonl;
+      opt.material = a->material;
+      opt.isotropic = !a->transverse;
+      opt.software = std::string("piezobench ") + kVersion + " replay";
+      g_stop = false;
+      std::signal(SIGINT, on_signal);
+      std::signal(SIGTERM, on_signal);  // Slurm's warning before a time-limit kill
+      const bool tty = ::isatty(STDERR_FILENO);
+      ProgressBar bar("replay");
+      std::size_t last_decile = 0;
+      replay::ReplayCallbacks cb;
+      cb.progress = [&](const replay::ReplayProgress& p) {
+        if (tty) {
+          bar.update(p.total ? static_cast<double>(p.done) / p.total : 1.0, progress_text(p));
+        } else if (p.total &&
+                   p.done * 10 / p.total > last_decile) {  // logs (Slurm, parallel): every 10 %
+          last_decile = p.done * 10 / p.total;
+          std::fprintf(stderr, "replay: %s\n", progress_text(p).c_str());
+        }
+      };
+      cb.issue = [&](const replay::ReplayIssue& i) {
+        if (tty) std::fprintf(stderr, "\n");
+        const char* what = i.kind == "report" ? "report not written" : "skipped";
+        if (i.message.rfind(i.path, 0) == 0)  // the message names the file already
+          std::fprintf(stderr, "piezobench: replay: %s: %s\n", what, i.message.c_str());
+        else
+          std::fprintf(stderr, "piezobench: replay: %s: %s: %s\n", what, i.path.c_str(),
+                       i.message.c_str());
+      };
+      auto s = as_input([&] { return replay::run_replay(opt, cb, g_stop); });
+      bar.finish();
+      std::signal(SIGINT, SIG_DFL);
+      std::signal(SIGTERM, SIG_DFL);
+      const auto& c = s.counts;
+      nlohmann::json j = {{"results", opt.out.string()},
+                          {"found", s.found},
+                          {"shard", a->shard},
+                          {"total", c.total},
+                          {"replayed", c.ok},
+                          {"failed", c.failed},
+                          {"done_before", c.skipped},
+                          {"wall_s", s.wall_s},
+                          {"captures_per_s", c.ok + c.failed ? (c.ok + c.failed) / s.wall_s : 0.0},
+                          {"jobs", opt.jobs},
+                          {"interrupted", s.interrupted}};
+      j["issues"] = nlohmann::json::array();
+      for (const auto& i : s.issues)
+        j["issues"].push_back({{"path", i.path}, {"kind", i.kind}, {"message", i.message}});
+      if (ctx.json) {
+        print_json(j);
+      } else {
+        std::printf("replay: %zu capture(s) found, %zu in shard %s\n", s.found, c.total,
+                    a->shard.c_str());
+        std::printf(
+            "replay: %zu replayed, %zu failed (skipped), %zu done before; %.1f s, %.2f captures/s "
+            "with --jobs %zu\n",
+            c.ok, c.failed, c.skipped, s.wall_s, j["captures_per_s"].get<double>(), opt.jobs);
+        std::printf("results: %s%s%s\n", opt.out.string().c_str(),
+                    opt.report_dir ? ", report: " : "",
+                    opt.report_dir ? (*opt.report_dir / "summary.md").string().c_str() : "");
+        if (s.interrupted) std::printf("interrupted: run the same command again to resume\n");
+      }
+      if (s.interrupted || s.report_errors)
+        ctx.exit_code = kInternal;
+      else if (c.failed)
+        ctx.exit_code = kBadInput;
+    });
+  });
+
+  // ------------------------------------------------------------ replay-merge
+  auto* m = app.add_subcommand("replay-merge", "Merge the results files of sharded replays");
+  struct MergeArgs {
+    std::vector<std::string> inputs;
+    std::string out, report, jsonl;
+    bool overwrite = false;
+  };
+  auto ma = std::make_shared<MergeArgs>();
+  m->add_option("RESULTS", ma->inputs, "Results files of the shards")->required();
+  m->add_option("--out", ma->out, "Merged results file")->required();
+  m->add_flag("--overwrite", ma->overwrite, "Replace an existing merged file");
+  m->add_option("--report", ma->report, "Folder for the batch summary of the merged results");
+  m->add_option("--jsonl", ma->jsonl, "One JSON line per merged record");
+  add_json_flag(m, ctx);
+  m->callback([&ctx, ma] {
+    ctx.exit_code = run_command(ctx, [&] {
+      replay::MergeOptions opt;
+      for (const auto& i : ma->inputs) opt.inputs.emplace_back(i);
+      opt.out = ma->out;
+      opt.overwrite = ma->overwrite;
+      opt.software = std::string("piezobench ") + kVersion + " replay-merge";
+      if (!ma->report.empty()) opt.report_dir = ma->report;
+      if (!ma->jsonl.empty()) opt.jsonl = ma->jsonl;
+      auto s = as_input([&] { return replay::merge_results(opt); });
+      for (const auto& w : s.warnings)
+        std::cerr << "piezobench: replay-merge: warning: " << w << "\n";
+      if (ctx.json) {
+        print_json({{"results", opt.out.string()},
+                    {"inputs", ma->inputs},
+                    {"records", s.records},
+                    {"ok", s.ok},
+                    {"failed", s.failed},
+                    {"duplicates", s.duplicates},
+                    {"warnings", s.warnings}});
+      } else {
+        std::printf(
+            "replay-merge: %zu record(s) (%zu ok, %zu failed) from %zu file(s) into %s; %zu "
+            "duplicate(s) left out\n",
+            s.records, s.ok, s.failed, opt.inputs.size(), opt.out.string().c_str(), s.duplicates);
+      }
+    });
+  });
+}
+
+}  // namespace piezo::cli

@@ -1,0 +1,79 @@
+#pragma once
+// Headless replay of many captures: each goes through ui::run_pipeline (the
+// same code as the GUI and the demo) with PipelineRequest::replay_capture set;
+// its record goes to the results file (acquisition/results_file.hpp) and,
+// optionally, a JSON line and a report folder.
+//
+// Workers are threads of this process. The FE/DSP work of a capture runs
+// outside any lock; every HDF5 call (reading a capture, writing a record)
+// takes acquisition's global HDF5 lock, which Debian's non-thread-safe
+// libhdf5 needs anyway. One process owns the one results file, so records
+// are appended without inter-process locking or a merge step, and a finished
+// capture leaves nothing in memory but its counters.
+//
+// Resume: a capture whose key (path + SHA-256, replay_record.hpp) is already
+// in the results file with status "ok" is skipped; failed ones are retried;
+// a record of the same path with another digest (the file changed) is
+// replaced.
+#include <atomic>
+#include <cstddef>
+#include <filesystem>
+#include <functional>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "ui/replay/discover.hpp"
+
+namespace piezo::replay {
+
+struct ReplayOptions {
+  std::vector<std::string> inputs;  // files and folders
+  std::filesystem::path out;        // the results file (created or resumed)
+  std::size_t jobs = 1;
+  ShardSpec shard;
+  std::optional<std::filesystem::path> report_dir;
+  std::optional<std::filesystem::path>
+      jsonl;             // one line per capture of this run (truncated at start)
+  std::string material;  // nominal model; empty: the capture's /setup/material, else apc850
+  bool isotropic = true;
+  std::string software = "piezobench replay";
+};
+
+struct ReplayProgress {
+  std::size_t total = 0;  // captures of this shard
+  std::size_t done = 0;   // replayed + failed + skipped
+  std::size_t ok = 0, failed = 0, skipped = 0;
+  double rate_per_s = 0;  // captures replayed (not skipped) per second of wall time
+  double eta_s = -1;      // < 0: unknown yet
+};
+
+struct ReplayIssue {
+  std::string path, kind, message;  // kind: bad capture | bad input | failed | report
+};
+
+struct ReplaySummary {
+  std::size_t found = 0;  // captures under the inputs (all shards)
+  ReplayProgress counts;  // of this shard
+  double wall_s = 0;
+  bool interrupted = false;
+  std::vector<ReplayIssue> issues;  // failed captures and report write errors, in order
+  std::size_t report_errors = 0;
+};
+
+struct ReplayCallbacks {
+  std::function<void(const ReplayProgress&)> progress;  // after each capture (under the sink lock)
+  std::function<void(const ReplayIssue&)> issue;        // as it happens
+};
+
+// Throws std::invalid_argument for bad options or inputs, acq::ResultsError for
+// a results file that cannot be used, std::runtime_error when the results file
+// cannot be written (the batch stops: every finished record is kept).
+ReplaySummary run_replay(const ReplayOptions& opt, const ReplayCallbacks& cb,
+                         const std::atomic<bool>& cancel);
+
+// The batch summary of everything in a results file (report/batch_summary.hpp).
+void write_batch_summary(const std::filesystem::path& results,
+                         const std::filesystem::path& report_dir);
+
+}  // namespace piezo::replay

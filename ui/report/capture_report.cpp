@@ -1,0 +1,114 @@
+#include "ui/report/capture_report.hpp"
+
+#include <cstdio>
+#include <fstream>
+#include <sstream>
+
+#include "ui/report/impedance_plot.hpp"
+#include "ui/report_export.hpp"
+
+namespace piezo::report {
+
+namespace fs = std::filesystem;
+
+namespace {
+
+std::string fmt(const char* f, double v) {
+  char b[64];
+  std::snprintf(b, sizeof b, f, v);
+  return b;
+}
+
+// Markdown table cells must not break the table.
+std::string cell(std::string s) {
+  for (std::size_t i = 0; (i = s.find('|', i)) != std::string::npos; i += 2) s.replace(i, 1, "\\|");
+  for (char& c : s)
+    if (c == '\n') c = ' ';
+  return s;
+}
+
+void header(std::ostringstream& o, const CaptureInfo& info) {
+  o << "# Replay of `" << info.input_path << "`\n\n"
+    << "- SHA-256: `" << info.sha256 << "`\n";
+  if (!info.material.empty()) o << "- nominal model: " << info.material << "\n";
+  o << "- replay time: " << fmt("%.2f", info.elapsed_s) << " s\n";
+}
+
+void write_text(const fs::path& file, const std::string& s) {
+  std::ofstream f(file);
+  if (!f || !(f << s) || !f.flush())
+    throw std::runtime_error("report: cannot write " + file.string());
+}
+
+void make_dir(const fs::path& dir) {
+  std::error_code ec;
+  fs::create_directories(dir, ec);
+  if (ec) throw std::runtime_error("report: cannot create " + dir.string() + ": " + ec.message());
+}
+
+}  // namespace
+
+std::string capture_summary_markdown(const ui::PipelineResult& r, const CaptureInfo& info) {
+  std::ostringstream o;
+  header(o, info);
+  o << "- shots: " << r.shots << " (" << r.shots_averaged
+    << " averaged for the Prony-SS fit, order " << r.order << ")\n\n";
+  if (!r.verdict.empty()) o << "**Gap verdict:** " << cell(r.verdict) << "\n\n";
+  o << "## Stages\n\n| stage | ran | note |\n| --- | --- | --- |\n";
+  for (const auto& s : r.stages)
+    o << "| " << s.name << " | " << (s.ran ? "yes" : "no") << " | " << cell(s.note) << " |\n";
+  if (!r.params.empty()) {
+    o << "\n## Parameters\n\n| parameter | unit | original | updated | change |\n| --- | --- | --- "
+         "| --- | --- |\n";
+    for (const auto& p : r.params)
+      o << "| " << p.name << " | " << p.unit << " | " << fmt("%.6g", p.original) << " | "
+        << fmt("%.6g", p.updated) << " | "
+        << (p.original != 0 ? fmt("%+.2f %%", 100.0 * (p.updated - p.original) / p.original) : "-")
+        << " |\n";
+  }
+  o << "\n## Features (Prony-SS)\n\n";
+  auto list = [&](const char* what, const std::vector<double>& v) {
+    o << "- " << what << ": ";
+    if (v.empty()) o << "none";
+    for (std::size_t k = 0; k < v.size(); ++k) o << (k ? ", " : "") << fmt("%.1f", v[k]) << " Hz";
+    o << "\n";
+  };
+  list("resonances", r.resonances_hz);
+  list("anti-resonances", r.antiresonances_hz);
+  if (!r.warnings.empty()) {
+    o << "\n## Warnings\n\n";
+    for (const auto& w : r.warnings) o << "- " << w << "\n";
+  }
+  o << "\n## Impedance\n\n![|Z| and phase: measured, original and updated model](impedance.svg)\n\n"
+    << "Exports: [impedance.csv](impedance.csv) (f_hz,re_ohm,im_ohm), "
+       "[impedance.s1p](impedance.s1p) "
+       "(Touchstone, Z, RI), [result.json](result.json) (parameters, features, stages).\n";
+  return o.str();
+}
+
+std::string failed_capture_markdown(const CaptureInfo& info, const std::string& error) {
+  std::ostringstream o;
+  header(o, info);
+  o << "\n**FAILED — skipped:** " << error << "\n";
+  return o.str();
+}
+
+void write_capture_report(const ui::PipelineResult& r, const CaptureInfo& info,
+                          const fs::path& dir) {
+  make_dir(dir);
+  write_svg(impedance_figure(r, info.input_path), dir / "impedance.svg");
+  if (!r.curves.empty()) {
+    ui::export_csv(r, (dir / "impedance.csv").string());
+    ui::export_touchstone(r, (dir / "impedance.s1p").string());
+  }
+  ui::export_json(r, (dir / "result.json").string());
+  write_text(dir / "summary.md", capture_summary_markdown(r, info));
+}
+
+void write_failed_capture_report(const CaptureInfo& info, const std::string& error,
+                                 const fs::path& dir) {
+  make_dir(dir);
+  write_text(dir / "summary.md", failed_capture_markdown(info, error));
+}
+
+}  // namespace piezo::report
