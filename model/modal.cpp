@@ -50,8 +50,8 @@ void ModalOptions::validate() const {
   if (!(tolerance > 0)) throw std::invalid_argument(std::string(fn) + ": tolerance must be > 0");
   if (max_iterations < 1)
     throw std::invalid_argument(std::string(fn) + ": max_iterations must be >= 1");
-  if (!(active_coupling >= 0))
-    throw std::invalid_argument(std::string(fn) + ": active_coupling must be >= 0");
+  if (!(active_coupling >= 0) || !(active_coupling_open >= 0))
+    throw std::invalid_argument(std::string(fn) + ": active_coupling(_open) must be >= 0");
   if (!std::isfinite(end_mass_fraction) || end_mass_fraction < 0)
     throw std::invalid_argument(std::string(fn) + ": end_mass_fraction must be finite and >= 0");
 }
@@ -190,7 +190,9 @@ ModalResult ModalSolver::solve(const PiezoMaterialE& material, Electrodes electr
     m.kappa = phi.dot(k_uu * phi);
     if (m.omega > rigid_omega)
       m.coupling = m.participation * m.participation / (m.omega * m.omega * res.c_clamped);
-    m.electrically_active = m.symmetric_fraction > 0.5 && m.coupling > opt.active_coupling;
+    const double threshold =
+        electrodes == Electrodes::open_circuit ? opt.active_coupling_open : opt.active_coupling;
+    m.electrically_active = m.symmetric_fraction > 0.5 && m.coupling > threshold;
     res.shapes.col(static_cast<Eigen::Index>(j)) = phi;
     res.modes.push_back(m);
   }

@@ -27,8 +27,11 @@ struct ModalOptions {
   double tolerance = 1e-10;
   int max_iterations = 1000;
   // A mode is electrically active if it is symmetric about the mid-plane and
-  // its coupling p_k²/(ω_k² C0) exceeds this (see model/README.md).
+  // its coupling p_k²/(ω_k² C0) exceeds this (see model/README.md); in open
+  // circuit the second threshold applies (the updaters lower it: the
+  // open-circuit partner of a strongly coupled mode carries little charge).
   double active_coupling = 1e-3;
+  double active_coupling_open = 1e-3;
   // End-face mass loading (effect `mass_loading`): added mass as a fraction f of
   // the tube mass, M → M + f·ΔM (model/end_mass.hpp). ΔM is built once with the
   // TubeModel, so any f costs no re-assembly. Must be finite and >= 0.

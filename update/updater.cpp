@@ -27,8 +27,11 @@ double model_capacitance(model::ModalSolver& solver, const model::PiezoMaterialE
   const auto sc = solver.solve(m, model::Electrodes::short_circuit, opt);
   const double w2 = std::pow(2.0 * M_PI * f_hz, 2);
   double dyn = 0;
+  // Skip the rigid translation as ModalSolver::port_model does: its computed
+  // eigenvalue is round-off (~±1e-6), and p²/λ² of a round-off λ is garbage.
+  const double rigid_omega = 2.0 * M_PI * 1e-3 * opt.shift_hz;
   for (const auto& mode : sc.modes)
-    if (mode.omega > 0 && mode.eigenvalue > 0)
+    if (mode.omega > rigid_omega)
       dyn += mode.participation * mode.participation / (mode.eigenvalue * mode.eigenvalue);
   return c_static + w2 * dyn;
 }
