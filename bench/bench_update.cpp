@@ -75,7 +75,8 @@ BENCHMARK(BM_UpdateLm)->Unit(benchmark::kMillisecond);
 void BM_PortFit(benchmark::State& state) {
   pm::TubeModel tube(pm::TubeGeometry{});
   pm::ModalSolver solver(tube);
-  const auto m = pm::to_e_form(pm::to_d_form(pm::IsotropicPiezoParams{6.66e10, 0.3333, -210e-12, 2294 * pm::kEps0}));
+  const auto m = pm::to_e_form(
+      pm::to_d_form(pm::IsotropicPiezoParams{6.66e10, 0.3333, -210e-12, 2294 * pm::kEps0}));
   pm::ModalOptions o;
   o.n_modes = 24;
   const auto port = solver.port_model(m, o);

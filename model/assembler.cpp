@@ -2,8 +2,8 @@
 
 #include <algorithm>
 #include <cmath>
-#include <string>
 #include <stdexcept>
+#include <string>
 #include <vector>
 
 #include "model/element.hpp"
@@ -106,8 +106,7 @@ void SplitSystem::combine(const MaterialWeights& w, double sigma, SpMat& out,
 }
 
 void SplitSystem::combine(const std::array<std::complex<double>, kNumMaterialParams>& w,
-                          std::complex<double> w_m, SpMatC& out,
-                          double end_mass_fraction) const {
+                          std::complex<double> w_m, SpMatC& out, double end_mass_fraction) const {
   if (out.nonZeros() != pattern_.nonZeros() || out.rows() != pattern_.rows())
     out = pattern_.cast<std::complex<double>>();
   Eigen::Map<Eigen::VectorXcd> v(out.valuePtr(), out.nonZeros());
@@ -128,7 +127,8 @@ SpMat SplitSystem::with_values(const Eigen::VectorXd& v) const {
 SpMat SplitSystem::matrix(MaterialParam p) const { return with_values(values(p)); }
 SpMat SplitSystem::mass() const { return with_values(m_); }
 SpMat SplitSystem::end_mass() const {
-  return m_end_.size() == m_.size() ? with_values(m_end_) : with_values(Eigen::VectorXd::Zero(m_.size()));
+  return m_end_.size() == m_.size() ? with_values(m_end_)
+                                    : with_values(Eigen::VectorXd::Zero(m_.size()));
 }
 
 }  // namespace piezo::model

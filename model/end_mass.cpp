@@ -12,8 +12,7 @@ double tube_mass_kg(const TubeGeometry& g) {
   return g.density_kg_m3 * M_PI * (ro * ro - ri * ri) * g.length_m;
 }
 
-std::vector<Eigen::Triplet<double>> end_face_mass_triplets(const TubeMesh& mesh,
-                                                           const DofMap& dofs,
+std::vector<Eigen::Triplet<double>> end_face_mass_triplets(const TubeMesh& mesh, const DofMap& dofs,
                                                            const TubeGeometry& g) {
   const double ri = g.inner_radius(), ro = g.outer_radius();
   // Areal density for f = 1: half the tube mass on each face's annulus (= ρL/2).

@@ -27,8 +27,7 @@ double tube_mass_kg(const TubeGeometry& g);
 
 // ΔM for an added mass equal to the tube mass (f = 1), as triplets on the
 // global U DOFs (u_r, u_z of the end-face nodes; duplicates are summed).
-std::vector<Eigen::Triplet<double>> end_face_mass_triplets(const TubeMesh& mesh,
-                                                           const DofMap& dofs,
+std::vector<Eigen::Triplet<double>> end_face_mass_triplets(const TubeMesh& mesh, const DofMap& dofs,
                                                            const TubeGeometry& g);
 
 }  // namespace piezo::model

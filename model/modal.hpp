@@ -96,8 +96,7 @@ class ModalSolver {
   const SpMat& mass(double end_mass_fraction);
   // Static solve for V = 1 with the rigid translation fixed; u_static is made
   // M-orthogonal to the rigid mode for the given mass matrix.
-  double static_solve(const PiezoMaterialE& material, const SpMat& mass,
-                      Eigen::VectorXd* u_static);
+  double static_solve(const PiezoMaterialE& material, const SpMat& mass, Eigen::VectorXd* u_static);
 
   const TubeModel* model_;
   CoupledFactor factor_;

@@ -122,7 +122,8 @@ dsp::ImpedanceResult estimate(const acq::Capture& cap, PipelineResult& out) {
     const std::size_t n = std::min<std::size_t>({3, fr.size(), fa.size()});
     const std::size_t pre = avg.pretrigger_samples, nfit = std::min(post, po.prep.max_samples);
     try {
-      if (n == 0 || !(prony.features.capacitance_f > 0)) throw std::invalid_argument("no features to start from");
+      if (n == 0 || !(prony.features.capacitance_f > 0))
+        throw std::invalid_argument("no features to start from");
       update::PortFitStart st;
       for (std::size_t k = 0; k < n; ++k) {
         st.resonances_hz.push_back(fr[k].f_hz);
@@ -140,7 +141,8 @@ dsp::ImpedanceResult estimate(const acq::Capture& cap, PipelineResult& out) {
         a[i] = v1[pre + i] - m1;
         b[i] = v2[pre + i] - m2;
       }
-      const auto fit = update::fit_port_model(a, b, first.sample_rate_hz, cap.setup.divider_r1_ohm, st);
+      const auto fit =
+          update::fit_port_model(a, b, first.sample_rate_hz, cap.setup.divider_r1_ohm, st);
       if (!fit.converged) throw std::runtime_error(fit.message);
       for (std::size_t k = 0; k < n; ++k) {
         fr[k].f_hz = fit.features.resonances_hz[k];
@@ -152,7 +154,8 @@ dsp::ImpedanceResult estimate(const acq::Capture& cap, PipelineResult& out) {
       }
       prony.features.capacitance_f = fit.features.low_frequency_capacitance();
     } catch (const std::exception& e) {
-      out.warnings.push_back(std::string("port-model refinement of the features skipped (Prony's kept): ") + e.what());
+      out.warnings.push_back(
+          std::string("port-model refinement of the features skipped (Prony's kept): ") + e.what());
     }
   }
   out.curves.push_back(curve_of("measured (Prony-SS)", prony));

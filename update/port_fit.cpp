@@ -42,7 +42,8 @@ struct Layout {
     for (int i = 0; i < k; ++i)
       add(std::exp(th[1 + i]), std::exp(th[1 + k + i]), std::exp(th[1 + 2 * k + i]));
     for (std::size_t h = 0; h < w_high.size(); ++h)
-      add(w_high[h], std::exp(th[1 + 3 * k + 2 * h]), 2.0 * w_high[h] * zeta_high(th[2 + 3 * k + 2 * h]));
+      add(w_high[h], std::exp(th[1 + 3 * k + 2 * h]),
+          2.0 * w_high[h] * zeta_high(th[2 + 3 * k + 2 * h]));
     return p;
   }
 };
@@ -120,7 +121,8 @@ std::vector<double> port_antiresonances_hz(const model::ModalPortModel& port, bo
   std::sort(w2.begin(), w2.end());
   auto f = [&](double lam) {
     double s = port.c_clamped + port.c_residual;
-    for (const auto& m : port.modes) s += m.participation * m.participation / (m.omega * m.omega - lam);
+    for (const auto& m : port.modes)
+      s += m.participation * m.participation / (m.omega * m.omega - lam);
     return s;
   };
   // Q/V(s) with the modal damping c_k = kappa_k (RayleighDamping{0, 1}).
@@ -168,16 +170,16 @@ std::vector<double> port_antiresonances_hz(const model::ModalPortModel& port, bo
   return out;
 }
 
-PortFitResult fit_port_model(std::span<const double> v1, std::span<const double> v2,
-                             double fs, double r1_ohm, const PortFitStart& start,
-                             const PortFitOptions& opt) {
+PortFitResult fit_port_model(std::span<const double> v1, std::span<const double> v2, double fs,
+                             double r1_ohm, const PortFitStart& start, const PortFitOptions& opt) {
   const char* fn = "fit_port_model";
   const int k = static_cast<int>(start.resonances_hz.size());
   if (k < 1) throw std::invalid_argument(std::string(fn) + ": needs at least one resonance");
   if (start.antiresonances_hz.size() < start.resonances_hz.size())
     throw std::invalid_argument(std::string(fn) + ": needs one anti-resonance per resonance");
   if (v1.size() != v2.size() || v1.size() < static_cast<std::size_t>(8 * k + 16))
-    throw std::invalid_argument(std::string(fn) + ": v1 and v2 must have the same, sufficient length");
+    throw std::invalid_argument(std::string(fn) +
+                                ": v1 and v2 must have the same, sufficient length");
   if (!(fs > 0) || !(r1_ohm > 0) || !(start.capacitance_f > 0))
     throw std::invalid_argument(std::string(fn) + ": rate, R1 and capacitance must be > 0");
   for (std::size_t i = 0; i < v1.size(); ++i)
@@ -188,8 +190,9 @@ PortFitResult fit_port_model(std::span<const double> v1, std::span<const double>
     wr.push_back(kTwoPi * start.resonances_hz[i]);
     wa.push_back(kTwoPi * start.antiresonances_hz[i]);
     if (!(wr[i] > 0) || !(wa[i] > wr[i]) || (i > 0 && !(wr[i] > wa[i - 1])))
-      throw std::invalid_argument(std::string(fn) +
-                                  ": resonances and anti-resonances must interlace (f_r1 < f_a1 < f_r2 …)");
+      throw std::invalid_argument(
+          std::string(fn) +
+          ": resonances and anti-resonances must interlace (f_r1 < f_a1 < f_r2 …)");
   }
 
   // Start: anti-resonances → q_k/C_e, low-frequency capacitance → C_e (eqs of port_model.hpp).
@@ -212,7 +215,8 @@ PortFitResult fit_port_model(std::span<const double> v1, std::span<const double>
   th[0] = std::log(ce);
   for (int i = 0; i < k; ++i) {
     const double zeta = i < static_cast<int>(start.damping_ratios.size()) &&
-                                std::isfinite(start.damping_ratios[i]) && start.damping_ratios[i] > 0
+                                std::isfinite(start.damping_ratios[i]) &&
+                                start.damping_ratios[i] > 0
                             ? start.damping_ratios[i]
                             : 0.01;
     th[1 + i] = std::log(wr[i]);
@@ -242,7 +246,8 @@ PortFitResult fit_port_model(std::span<const double> v1, std::span<const double>
     }
   };
   // Jacobian of the filtered output error with respect to the parameters in `free`.
-  auto jacobian = [&](const Eigen::VectorXd& t, const std::vector<int>& free, Eigen::MatrixXd& j) -> bool {
+  auto jacobian = [&](const Eigen::VectorXd& t, const std::vector<int>& free,
+                      Eigen::MatrixXd& j) -> bool {
     j.resize(0, static_cast<Eigen::Index>(free.size()));
     for (std::size_t c = 0; c < free.size(); ++c) {
       const int p = free[c];
@@ -294,7 +299,8 @@ PortFitResult fit_port_model(std::span<const double> v1, std::span<const double>
         for (Eigen::Index p = 0; p < a.rows(); ++p) a(p, p) += mu * std::max(jtj(p, p), 1e-300);
         const Eigen::VectorXd step = a.ldlt().solve(-g);
         Eigen::VectorXd trial = th;
-        for (std::size_t c = 0; c < free.size(); ++c) trial[free[c]] += step[static_cast<Eigen::Index>(c)];
+        for (std::size_t c = 0; c < free.size(); ++c)
+          trial[free[c]] += step[static_cast<Eigen::Index>(c)];
         const auto rt = residual(trial);
         const double ct = rt ? 0.5 * rt->squaredNorm() : INFINITY;
         if (ct < cost) {
@@ -322,8 +328,9 @@ PortFitResult fit_port_model(std::span<const double> v1, std::span<const double>
         for (Eigen::Index p = 0; p < g.size(); ++p)
           cosine = std::max(cosine, std::abs(g[p]) / std::sqrt(jtj(p, p) * 2.0 * cost + 1e-300));
         if (cosine < 1e-4) return true;
-        res.message = "no decrease of the output error (Levenberg-Marquardt stalled, gradient cosine " +
-                      std::to_string(cosine) + ")";
+        res.message =
+            "no decrease of the output error (Levenberg-Marquardt stalled, gradient cosine " +
+            std::to_string(cosine) + ")";
         return false;
       }
       if (done) return true;
@@ -365,7 +372,8 @@ PortFitResult fit_port_model(std::span<const double> v1, std::span<const double>
   }
   if (jacobian(th, all, j)) {
     const double s2 = 2.0 * cost / static_cast<double>(std::max<Eigen::Index>(1, n_r - th.size()));
-    const Eigen::MatrixXd cov = s2 * (j.transpose() * j).ldlt().solve(Eigen::MatrixXd::Identity(th.size(), th.size()));
+    const Eigen::MatrixXd cov =
+        s2 * (j.transpose() * j).ldlt().solve(Eigen::MatrixXd::Identity(th.size(), th.size()));
     Eigen::MatrixXd df(f0.size(), th.size());
     for (Eigen::Index p = 0; p < th.size(); ++p) {
       Eigen::VectorXd tp = th, tm = th;

@@ -42,7 +42,7 @@ struct PortFitOptions {
   // the highest anti-resonance (held; their q and c are fitted).
   bool high_mode = true;
   std::vector<double> high_mode_factors = {2.5};
-  double low_f_hz = 400.0;       // frequency of the reported capacitance / |Z|
+  double low_f_hz = 400.0;  // frequency of the reported capacitance / |Z|
   // The output error is low-pass filtered (causal windowed sinc, zero before
   // t = 0 where model and tube are both at rest) and decimated before it is
   // minimised, so the ringing of the modes far above the band (the step at

@@ -23,9 +23,9 @@ using namespace piezo;
 namespace {
 
 fs::path tmp_dir() {
-  auto d = fs::temp_directory_path() /
-           ("piezobench-mass-" + std::to_string(::getpid()) + "-" +
-            ::testing::UnitTest::GetInstance()->current_test_info()->name());
+  auto d =
+      fs::temp_directory_path() / ("piezobench-mass-" + std::to_string(::getpid()) + "-" +
+                                   ::testing::UnitTest::GetInstance()->current_test_info()->name());
   fs::remove_all(d);
   fs::create_directories(d);
   return d;
@@ -64,9 +64,11 @@ std::vector<double> measured_resonances(double mass_loading, const fs::path& dir
   std::vector<double> f;
   for (const auto& r : z.features.resonances) f.push_back(r.f_hz);
   std::printf("mass %.3f: Prony order %zu; resonances", mass_loading, z.prony ? z.prony->order : 0);
-  for (const auto& r : z.features.resonances) std::printf(" %.1f (ext %.1f)", r.f_hz, r.extremum_hz);
+  for (const auto& r : z.features.resonances)
+    std::printf(" %.1f (ext %.1f)", r.f_hz, r.extremum_hz);
   std::printf("; anti-resonances");
-  for (const auto& r : z.features.antiresonances) std::printf(" %.1f (ext %.1f)", r.f_hz, r.extremum_hz);
+  for (const auto& r : z.features.antiresonances)
+    std::printf(" %.1f (ext %.1f)", r.f_hz, r.extremum_hz);
   std::printf("\n");
   return f;
 }
@@ -106,9 +108,10 @@ TEST(SimMassLoading, CaptureShowsTheLoadedModelsResonances) {
   ASSERT_GE(fe_loaded.size(), 3u);
   for (std::size_t k = 0; k < 3; ++k) {
     const double shift = fe_loaded[k] - fe_bare[k];
-    std::printf("resonance %zu: bare %.1f Hz (FE %.1f), loaded 3 %% %.1f Hz (FE %.1f), "
-                "measured shift %.1f Hz, FE shift %.1f Hz\n",
-                k + 1, bare[k], fe_bare[k], loaded[k], fe_loaded[k], loaded[k] - bare[k], shift);
+    std::printf(
+        "resonance %zu: bare %.1f Hz (FE %.1f), loaded 3 %% %.1f Hz (FE %.1f), "
+        "measured shift %.1f Hz, FE shift %.1f Hz\n",
+        k + 1, bare[k], fe_bare[k], loaded[k], fe_loaded[k], loaded[k] - bare[k], shift);
     EXPECT_LT(loaded[k], bare[k]) << k;
     ASSERT_LT(shift, 0.0) << k;
     // Prony-SS at its automatic order (10 here) carries a truncation bias of up to
@@ -123,8 +126,10 @@ TEST(SimMassLoading, CaptureShowsTheLoadedModelsResonances) {
 
 TEST(SimMassLoading, CliMeasuresALoadedTubeAndRecordsTheTruth) {
   const auto out = tmp_dir() / "loaded.h5";
-  auto r = test::run_cli("measure --instrument sim --samples 4000 --shots 1 --effect mass_loading=0.02 "
-                         "--seed 3 --overwrite --out " + out.string());
+  auto r = test::run_cli(
+      "measure --instrument sim --samples 4000 --shots 1 --effect mass_loading=0.02 "
+      "--seed 3 --overwrite --out " +
+      out.string());
   ASSERT_EQ(r.exit_code, 0) << r.err;
   EXPECT_EQ(acq::read_capture(out).shots.size(), 1u);
   EXPECT_DOUBLE_EQ(truth_attribute(out, "effect_mass_loading"), 0.02);

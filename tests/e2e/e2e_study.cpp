@@ -64,7 +64,10 @@ dsp::DividerRecord averaged_record(const acq::Capture& cap, std::vector<double>&
     v1[i] /= averaged;
     v2[i] /= averaged;
   }
-  return {v1, v2, first->sample_rate_hz, cap.setup.divider_r1_ohm,
+  return {v1,
+          v2,
+          first->sample_rate_hz,
+          cap.setup.divider_r1_ohm,
           static_cast<std::size_t>(std::max<std::int64_t>(0, first->pretrigger_samples)),
           first->daq_range_v};
 }
@@ -125,8 +128,9 @@ std::vector<E2eCase> draw_cases(int n, std::uint64_t seed, double spread) {
   return out;
 }
 
-E2eOutcome run_e2e_case(const E2eCase& c, const E2eChain& chain, const std::filesystem::path& work_dir,
-                        model::TubeModel& tube, model::ModalSolver& solver) {
+E2eOutcome run_e2e_case(const E2eCase& c, const E2eChain& chain,
+                        const std::filesystem::path& work_dir, model::TubeModel& tube,
+                        model::ModalSolver& solver) {
   E2eOutcome o;
   o.c = c;
   const auto cls = update::MaterialClass::isotropic();
@@ -211,11 +215,13 @@ E2eOutcome run_e2e_case(const E2eCase& c, const E2eChain& chain, const std::file
       update::PortFitStart st;
       st.resonances_hz = f.resonances_hz;
       st.antiresonances_hz = f.antiresonances_hz;
-      for (std::size_t k = 0; k < f.resonances_hz.size(); ++k) st.damping_ratios.push_back(fr[k].damping_ratio);
+      for (std::size_t k = 0; k < f.resonances_hz.size(); ++k)
+        st.damping_ratios.push_back(fr[k].damping_ratio);
       st.capacitance_f = z.features.capacitance_f;
       const auto pf = update::fit_port_model(a, b, rec.sample_rate_hz, rec.r1_ohm, st);
-      o.port_fit_note = (pf.converged ? "converged in " : "NOT converged (" + pf.message + ") after ") +
-                        std::to_string(pf.iterations) + " iterations";
+      o.port_fit_note =
+          (pf.converged ? "converged in " : "NOT converged (" + pf.message + ") after ") +
+          std::to_string(pf.iterations) + " iterations";
       if (!pf.converged) throw std::runtime_error("port fit: " + pf.message);
       f = pf.features;
     }
@@ -284,21 +290,23 @@ E2eCrb e2e_crb(const update::TubeParams& truth, const E2eChain& chain, model::Mo
                                    chain.damping.beta + beta0 * x[4]};
     const auto v2 = model::simulate_divider(port, d, circuit, v1, plan.sample_rate_hz);
     const std::size_t n = chain.prony_samples > 0 ? std::min(chain.prony_samples, post) : post;
-    return Eigen::VectorXd(Eigen::Map<const Eigen::VectorXd>(v2.data(), static_cast<Eigen::Index>(n)));
+    return Eigen::VectorXd(
+        Eigen::Map<const Eigen::VectorXd>(v2.data(), static_cast<Eigen::Index>(n)));
   };
   Eigen::Matrix<double, 6, 1> x0 = Eigen::Matrix<double, 6, 1>::Zero();
   const Eigen::VectorXd v20 = v2_of(x0);
   // Noise of the averaged record as the simulated DAQ sets it (std over the whole record).
   {
-    const auto full = model::simulate_divider(solver.port_model(cls.e_form(truth), mo), chain.damping,
-                                              circuit, v1, plan.sample_rate_hz);
+    const auto full = model::simulate_divider(solver.port_model(cls.e_form(truth), mo),
+                                              chain.damping, circuit, v1, plan.sample_rate_hz);
     double mean = 0, var = 0;
     const double n = static_cast<double>(plan.samples);  // pretrigger samples are 0
     for (double x : full) mean += x / n;
     for (double x : full) var += (x - mean) * (x - mean);
     var += static_cast<double>(plan.pretrigger_samples) * mean * mean;
     E2eCrb out;
-    out.noise_v2_v = chain.noise_rel * std::sqrt(var / n) / std::sqrt(static_cast<double>(plan.shots));
+    out.noise_v2_v =
+        chain.noise_rel * std::sqrt(var / n) / std::sqrt(static_cast<double>(plan.shots));
     Eigen::MatrixXd g(v20.size(), 6);
     for (int k = 0; k < 6; ++k) {
       const double h = k < 4 ? 1e-5 : 1e-3;
@@ -319,15 +327,16 @@ E2eCrb e2e_crb(const update::TubeParams& truth, const E2eChain& chain, model::Mo
 }
 
 std::string e2e_header() {
-  return "case | true YE11 (GPa) | nu12 | d31 (pC/N) | epsT33/eps0 || CMCM err % YE11 nu12 d31 epsT33 | "
+  return "case | true YE11 (GPa) | nu12 | d31 (pC/N) | epsT33/eps0 || CMCM err % YE11 nu12 d31 "
+         "epsT33 | "
          "t (s) || LM err % YE11 nu12 d31 epsT33 | t (s) || feature err % (res 1-3 | anti 1-3)";
 }
 
 std::string e2e_row(int index, const E2eOutcome& o) {
   char buf[640];
   const auto& t = o.c.truth;
-  int n = std::snprintf(buf, sizeof buf, "%2d | %.3f | %.4f | %.2f | %.0f || ", index, t.y_e11 * 1e-9,
-                        t.nu12, t.d31 * 1e12, t.eps_t33 / model::kEps0);
+  int n = std::snprintf(buf, sizeof buf, "%2d | %.3f | %.4f | %.2f | %.0f || ", index,
+                        t.y_e11 * 1e-9, t.nu12, t.d31 * 1e12, t.eps_t33 / model::kEps0);
   std::string s(buf, static_cast<std::size_t>(n));
   if (!o.failure.empty()) return s + "chain failed: " + o.failure;
   auto method = [&](const E2eMethodResult& m) {

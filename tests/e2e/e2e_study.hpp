@@ -19,8 +19,8 @@ namespace piezo::test {
 
 // How the chain measures and estimates (the knobs of the study).
 struct E2eChain {
-  double noise_rel = 0.03;  // per channel, std(noise)/std(clean channel over the record)
-  acq::MeasurementPlan plan;  // excitation, record, shots (R1 = 3140 Ω)
+  double noise_rel = 0.03;           // per channel, std(noise)/std(clean channel over the record)
+  acq::MeasurementPlan plan;         // excitation, record, shots (R1 = 3140 Ω)
   std::size_t prony_samples = 6000;  // samples from t = 0 fitted (0: all)
   double band_hz = 120e3;            // estimate / feature band
   // Refine Prony's features by the output-error fit of the modal port model
@@ -63,7 +63,8 @@ struct E2eOutcome {
   E2eCase c;
   std::string failure;  // non-empty: the chain stopped before updating (why)
   update::MeasuredFeatures features;
-  std::vector<double> true_resonances_hz, true_antiresonances_hz;  // FE model of the truth (scoring only)
+  std::vector<double> true_resonances_hz,
+      true_antiresonances_hz;  // FE model of the truth (scoring only)
   double true_capacitance_f = 0;
   int prony_order = 0;
   std::string port_fit_note;  // status of the output-error refinement (when used)
@@ -73,8 +74,9 @@ struct E2eOutcome {
 
 // Runs one case; `work_dir` receives the capture. Never throws for a chain
 // failure (it is reported in `failure`).
-E2eOutcome run_e2e_case(const E2eCase& c, const E2eChain& chain, const std::filesystem::path& work_dir,
-                        model::TubeModel& tube, model::ModalSolver& solver);
+E2eOutcome run_e2e_case(const E2eCase& c, const E2eChain& chain,
+                        const std::filesystem::path& work_dir, model::TubeModel& tube,
+                        model::ModalSolver& solver);
 
 // Cramér–Rao bound of the four parameters from the data the chain fits:
 // v2 at the first `prony_samples` samples of the averaged record (white noise

@@ -15,8 +15,7 @@ using namespace piezo;
 
 namespace {
 std::filesystem::path work_dir() {
-  return std::filesystem::temp_directory_path() /
-         ("piezobench-e2e-" + std::to_string(::getpid()));
+  return std::filesystem::temp_directory_path() / ("piezobench-e2e-" + std::to_string(::getpid()));
 }
 }  // namespace
 
@@ -36,8 +35,10 @@ TEST(E2eUpdate, TwoRandomTubesRecoveredWithinOnePercent) {
     ASSERT_EQ(o.features.resonances_hz.size(), 3u);
     ASSERT_EQ(o.features.antiresonances_hz.size(), 3u);
     for (int k = 0; k < 3; ++k) {
-      EXPECT_NEAR(o.features.resonances_hz[k] / o.true_resonances_hz[k], 1.0, 1e-3) << i << " " << k;
-      EXPECT_NEAR(o.features.antiresonances_hz[k] / o.true_antiresonances_hz[k], 1.0, 1e-3) << i << " " << k;
+      EXPECT_NEAR(o.features.resonances_hz[k] / o.true_resonances_hz[k], 1.0, 1e-3)
+          << i << " " << k;
+      EXPECT_NEAR(o.features.antiresonances_hz[k] / o.true_antiresonances_hz[k], 1.0, 1e-3)
+          << i << " " << k;
     }
     // Issue 6's acceptance per case: all four parameters within 1 %.
     EXPECT_TRUE(o.cmcm.ok) << o.cmcm.message;

@@ -56,11 +56,13 @@ Tally run_study(const test::E2eChain& chain, const char* title, bool crb) {
     t.lm += o.lm.ok && o.lm.max_abs_err() < 0.01;
     t.lm_values += o.lm.max_abs_err() < 0.01;
   }
-  std::printf("%s: within 1 %% and converged: CMCM %d/20, LM %d/20 (LM values alone %d/20)\n", title,
-              t.cmcm, t.lm, t.lm_values);
+  std::printf("%s: within 1 %% and converged: CMCM %d/20, LM %d/20 (LM values alone %d/20)\n",
+              title, t.cmcm, t.lm, t.lm_values);
   if (crb)
-    std::printf("largest CRB 1σ over the 20 tubes: YE11 %.3f %%, nu12 %.3f %%, d31 %.3f %%, epsT33 %.3f %%\n",
-                100 * worst_crb[0], 100 * worst_crb[1], 100 * worst_crb[2], 100 * worst_crb[3]);
+    std::printf(
+        "largest CRB 1σ over the 20 tubes: YE11 %.3f %%, nu12 %.3f %%, d31 %.3f %%, epsT33 %.3f "
+        "%%\n",
+        100 * worst_crb[0], 100 * worst_crb[1], 100 * worst_crb[2], 100 * worst_crb[3]);
   std::filesystem::remove_all(work_dir());
   return t;
 }
@@ -68,7 +70,8 @@ Tally run_study(const test::E2eChain& chain, const char* title, bool crb) {
 }  // namespace
 
 TEST(E2eStudy, Issue6AcceptanceTwentyRandomTubes) {
-  const auto t = run_study(test::issue6_chain(), "issue 6 chain (exp_decay 1e5 1/s, port fit)", true);
+  const auto t =
+      run_study(test::issue6_chain(), "issue 6 chain (exp_decay 1e5 1/s, port fit)", true);
   EXPECT_GE(t.cmcm, 19);
   EXPECT_GE(t.lm, 19);
 }
@@ -76,7 +79,8 @@ TEST(E2eStudy, Issue6AcceptanceTwentyRandomTubes) {
 TEST(E2eStudy, SeedChainOnTheSameTubes) {
   // The seed's drive and Prony features alone: recorded, and the issue 6 chain
   // must not do worse on any count.
-  const auto seed = run_study(test::seed_chain(), "seed chain (exp_decay 3000 1/s, Prony features)", true);
+  const auto seed =
+      run_study(test::seed_chain(), "seed chain (exp_decay 3000 1/s, Prony features)", true);
   auto fast_prony = test::issue6_chain();
   fast_prony.port_fit = false;
   const auto prony = run_study(fast_prony, "exp_decay 1e5 1/s, Prony features", false);

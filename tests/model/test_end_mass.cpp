@@ -68,7 +68,9 @@ TEST_F(EndMass, HalfOnEachFaceSpreadInProportionToArea) {
   const auto zero = [](double, double) { return 0.0; };
   const auto one = [](double, double) { return 1.0; };
   const auto top = [&](double, double z) { return z > 0.5 * len - 1e-12 ? 1.0 : 0.0; };
-  const auto interior = [&](double, double z) { return std::abs(z) < 0.5 * len - 1e-12 ? 1.0 : 0.0; };
+  const auto interior = [&](double, double z) {
+    return std::abs(z) < 0.5 * len - 1e-12 ? 1.0 : 0.0;
+  };
   const Eigen::VectorXd all = field(zero, one);
   // Only the end-face nodes carry ΔM, half of it on each face.
   EXPECT_NEAR(all.dot(dm * field(zero, top)), 0.5 * m_tube, 1e-12 * m_tube);
@@ -78,7 +80,8 @@ TEST_F(EndMass, HalfOnEachFaceSpreadInProportionToArea) {
   // per unit length of the edge (no 2πr weight) would give m(ro + ri)/2 instead.
   const double want = m_tube * 2.0 * (ro * ro * ro - ri * ri * ri) / (3.0 * (ro * ro - ri * ri));
   EXPECT_NEAR(all.dot(dm * field(zero, [](double r, double) { return r; })), want, 1e-12 * want);
-  EXPECT_GT(std::abs(want - m_tube * 0.5 * (ro + ri)), 1e-6 * want);  // the check can tell the two apart
+  EXPECT_GT(std::abs(want - m_tube * 0.5 * (ro + ri)),
+            1e-6 * want);  // the check can tell the two apart
 }
 
 TEST_F(EndMass, FirstOrderPerturbationPredictsTheShift) {
@@ -106,10 +109,11 @@ TEST_F(EndMass, FirstOrderPerturbationPredictsTheShift) {
       const double d1 = r1.modes[k].omega / base.modes[k].omega - 1.0;
       const double d2 = r2.modes[k].omega / base.modes[k].omega - 1.0;
       const double linear = 0.5 * (4.0 * d1 - d2);
-      std::printf("%s mode %zu: %.2f Hz, shift at f = 1e-3 %+.4e, predicted %+.4e "
-                  "(rel. diff %.1e; extrapolated linear part %.1e)\n",
-                  to_string(el), k, base.modes[k].frequency_hz, d1, predicted,
-                  std::abs(d1 / predicted - 1), std::abs(linear / predicted - 1));
+      std::printf(
+          "%s mode %zu: %.2f Hz, shift at f = 1e-3 %+.4e, predicted %+.4e "
+          "(rel. diff %.1e; extrapolated linear part %.1e)\n",
+          to_string(el), k, base.modes[k].frequency_hz, d1, predicted, std::abs(d1 / predicted - 1),
+          std::abs(linear / predicted - 1));
       ASSERT_LT(predicted, 0.0);
       EXPECT_LT(std::abs(linear - predicted), 1e-3 * std::abs(predicted)) << k;
       EXPECT_LT(std::abs(d1 - predicted), 2e-2 * std::abs(predicted)) << k;  // O(f) second order
@@ -183,14 +187,16 @@ TEST_F(EndMass, LoadedPortModelMatchesTheLoadedDirectSolve) {
     EXPECT_LT(e, 1e-3) << freqs[i] << " Hz";
   }
   EXPECT_GT(n_away, 50);
-  std::printf("loaded (f = %.2f) modal vs direct |Z|: max rel diff %.2e away from peaks (%d pts), "
-              "%.2e overall\n", f, worst, n_away, worst_all);
+  std::printf(
+      "loaded (f = %.2f) modal vs direct |Z|: max rel diff %.2e away from peaks (%d pts), "
+      "%.2e overall\n",
+      f, worst, n_away, worst_all);
 }
 
 TEST_F(EndMass, BadFractionIsRefused) {
   const auto m = apc850();
-  for (double bad : {-0.01, std::numeric_limits<double>::quiet_NaN(),
-                     std::numeric_limits<double>::infinity()}) {
+  for (double bad :
+       {-0.01, std::numeric_limits<double>::quiet_NaN(), std::numeric_limits<double>::infinity()}) {
     ModalOptions o;
     o.end_mass_fraction = bad;
     EXPECT_THROW(o.validate(), std::invalid_argument);

@@ -106,7 +106,8 @@ TEST_F(PortFit, RepresentableTubeIsRecoveredExactly) {
   for (const auto& m : truth.modes) res.push_back(m.omega / (2 * M_PI));
   PortFitOptions o;
   o.high_mode = false;
-  const auto r = fit_port_model(v1, v2, kFs, kR1, start(res, anti, port_capacitance(truth, 400)), o);
+  const auto r =
+      fit_port_model(v1, v2, kFs, kR1, start(res, anti, port_capacitance(truth, 400)), o);
   ASSERT_TRUE(r.converged) << r.message;
   for (int k = 0; k < 3; ++k) {
     EXPECT_NEAR(r.features.resonances_hz[k] / res[k], 1.0, 1e-9) << k;
@@ -141,10 +142,11 @@ TEST_F(PortFit, FullFeTubeGivesItsModalFrequencies) {
   for (int k = 0; k < 3; ++k) {
     const double er = r.features.resonances_hz[k] / sc_[k] - 1;
     const double ea = r.features.antiresonances_hz[k] / anti_true[k] - 1;
-    std::printf("mode %d: resonance %.2f Hz (FE %.2f, %+.1e); anti-resonance %.2f Hz (damped true %.2f, "
-                "%+.1e; FE undamped %.2f)\n",
-                k + 1, r.features.resonances_hz[k], sc_[k], er, r.features.antiresonances_hz[k],
-                anti_true[k], ea, oc_[k]);
+    std::printf(
+        "mode %d: resonance %.2f Hz (FE %.2f, %+.1e); anti-resonance %.2f Hz (damped true %.2f, "
+        "%+.1e; FE undamped %.2f)\n",
+        k + 1, r.features.resonances_hz[k], sc_[k], er, r.features.antiresonances_hz[k],
+        anti_true[k], ea, oc_[k]);
     EXPECT_LT(std::abs(er), 1e-4) << k;
     EXPECT_LT(std::abs(ea), 5e-5) << k;
     EXPECT_LT(std::abs(anti_true[k] / oc_[k] - 1), 2.5e-4) << k;
@@ -186,7 +188,8 @@ TEST_F(PortFit, ReportedSigmasMatchTheScatterOverNoiseSeeds) {
     for (double x : vals[q]) m += x / seeds;
     for (double x : vals[q]) v += (x - m) * (x - m) / (seeds - 1);
     const double ratio = std::sqrt(v) / sig[q];
-    std::printf("feature %d: scatter %.3g, reported sigma %.3g (ratio %.2f)\n", q, std::sqrt(v), sig[q], ratio);
+    std::printf("feature %d: scatter %.3g, reported sigma %.3g (ratio %.2f)\n", q, std::sqrt(v),
+                sig[q], ratio);
     EXPECT_GT(ratio, 1 / 3.0) << q;
     EXPECT_LT(ratio, 3.0) << q;
   }
