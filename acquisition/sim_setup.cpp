@@ -36,9 +36,6 @@ class FePhysics : public drivers::sim::BenchPhysics {
 std::shared_ptr<drivers::sim::SimBench> make_sim_bench(const SimSpec& spec, double nominal_r1_ohm) {
   if (!(nominal_r1_ohm > 0)) throw std::invalid_argument("make_sim_bench: R1 must be positive");
   const auto& fx = spec.effects;
-  if (fx.mass_loading != 0.0)
-    throw std::invalid_argument(
-        "effect 'mass_loading': the simulated bench does not model end-face masses yet");
   auto mat = model::resolve_material({spec.material, spec.isotropic, spec.set});
   model::TubeGeometry g = spec.geometry;
   g.density_kg_m3 = mat.density_kg_m3;
@@ -47,6 +44,7 @@ std::shared_ptr<drivers::sim::SimBench> make_sim_bench(const SimSpec& spec, doub
   model::ModalSolver solver(tube);
   model::ModalOptions mo;
   mo.n_modes = spec.modes;
+  mo.end_mass_fraction = fx.mass_loading;  // end-face masses: M + f·ΔM (model/end_mass.hpp)
   const auto e = model::to_e_form(mat.d);
   model::ModalPortModel port = solver.port_model(e, mo);
 

@@ -1,7 +1,9 @@
 #include "model/assembler.hpp"
 
 #include <algorithm>
+#include <cmath>
 #include <stdexcept>
+#include <string>
 #include <vector>
 
 #include "model/element.hpp"
@@ -73,20 +75,45 @@ int SplitSystem::position(int row, int col) const {
   return (it != end && *it == row) ? static_cast<int>(it - inner) : -1;
 }
 
-void SplitSystem::combine(const MaterialWeights& w, double sigma, SpMat& out) const {
+void SplitSystem::set_end_mass(std::span<const Eigen::Triplet<double>> unit_end_mass) {
+  m_end_.setZero(pattern_.nonZeros());
+  for (const auto& t : unit_end_mass) {
+    const int p = position(t.row(), t.col());
+    if (p < 0) throw std::invalid_argument("SplitSystem::set_end_mass: entry outside the pattern");
+    m_end_[p] += t.value();
+  }
+}
+
+Eigen::VectorXd SplitSystem::loaded_mass(double f, const char* fn) const {
+  if (f == 0.0) return m_;
+  if (!std::isfinite(f) || f < 0.0)
+    throw std::invalid_argument(std::string(fn) + ": end_mass_fraction must be finite and >= 0");
+  if (m_end_.size() != m_.size())
+    throw std::invalid_argument(std::string(fn) + ": no end-face mass set (set_end_mass)");
+  return m_ + f * m_end_;
+}
+
+void SplitSystem::combine(const MaterialWeights& w, double sigma, SpMat& out,
+                          double end_mass_fraction) const {
   if (out.nonZeros() != pattern_.nonZeros() || out.rows() != pattern_.rows()) out = pattern_;
   Eigen::Map<Eigen::VectorXd> v(out.valuePtr(), out.nonZeros());
-  v = -sigma * m_;
+  if (end_mass_fraction == 0.0)
+    v = -sigma * m_;
+  else
+    v = -sigma * loaded_mass(end_mass_fraction, "SplitSystem::combine");
   for (int q = 0; q < kNumMaterialParams; ++q)
     if (w[q] != 0.0) v += w[q] * k_[q];
 }
 
 void SplitSystem::combine(const std::array<std::complex<double>, kNumMaterialParams>& w,
-                          std::complex<double> w_m, SpMatC& out) const {
+                          std::complex<double> w_m, SpMatC& out, double end_mass_fraction) const {
   if (out.nonZeros() != pattern_.nonZeros() || out.rows() != pattern_.rows())
     out = pattern_.cast<std::complex<double>>();
   Eigen::Map<Eigen::VectorXcd> v(out.valuePtr(), out.nonZeros());
-  v = w_m * m_.cast<std::complex<double>>();
+  if (end_mass_fraction == 0.0)
+    v = w_m * m_.cast<std::complex<double>>();
+  else
+    v = w_m * loaded_mass(end_mass_fraction, "SplitSystem::combine").cast<std::complex<double>>();
   for (int q = 0; q < kNumMaterialParams; ++q)
     if (w[q] != 0.0) v += w[q] * k_[q].cast<std::complex<double>>();
 }
@@ -99,5 +126,9 @@ SpMat SplitSystem::with_values(const Eigen::VectorXd& v) const {
 
 SpMat SplitSystem::matrix(MaterialParam p) const { return with_values(values(p)); }
 SpMat SplitSystem::mass() const { return with_values(m_); }
+SpMat SplitSystem::end_mass() const {
+  return m_end_.size() == m_.size() ? with_values(m_end_)
+                                    : with_values(Eigen::VectorXd::Zero(m_.size()));
+}
 
 }  // namespace piezo::model

@@ -7,6 +7,7 @@
 #include <Eigen/SparseCore>
 #include <array>
 #include <complex>
+#include <span>
 
 #include "model/material.hpp"
 #include "model/mesh.hpp"
@@ -27,23 +28,35 @@ class SplitSystem {
   const Eigen::VectorXd& values(MaterialParam p) const { return k_[static_cast<int>(p)]; }
   const Eigen::VectorXd& mass_values() const { return m_; }
 
-  // out ← Σ_p w_p·K_p − σ·M on the shared pattern (out is given the pattern if needed).
-  void combine(const MaterialWeights& w, double sigma, SpMat& out) const;
+  // The end-face mass ΔM for an added fraction f = 1 of the tube mass
+  // (model/end_mass.hpp), scattered onto the shared pattern (it couples only
+  // DOFs of one element edge, so it fits). Throws std::invalid_argument for an
+  // entry outside the pattern.
+  void set_end_mass(std::span<const Eigen::Triplet<double>> unit_end_mass);
+  const Eigen::VectorXd& end_mass_values() const { return m_end_; }
+
+  // out ← Σ_p w_p·K_p − σ·(M + f·ΔM) on the shared pattern (out is given the
+  // pattern if needed); f = end_mass_fraction (needs set_end_mass when ≠ 0).
+  void combine(const MaterialWeights& w, double sigma, SpMat& out,
+               double end_mass_fraction = 0.0) const;
   // Same with complex weights and complex mass factor (for the direct harmonic solve):
-  // out ← Σ_p w_p·K_p + w_m·M.
+  // out ← Σ_p w_p·K_p + w_m·(M + f·ΔM).
   void combine(const std::array<std::complex<double>, kNumMaterialParams>& w,
-               std::complex<double> w_m, SpMatC& out) const;
-  // One split matrix (or the mass) as a standalone sparse matrix on the full DOFs.
+               std::complex<double> w_m, SpMatC& out, double end_mass_fraction = 0.0) const;
+  // One split matrix (or the mass, or ΔM) as a standalone sparse matrix on the full DOFs.
   SpMat matrix(MaterialParam p) const;
   SpMat mass() const;
+  SpMat end_mass() const;
   // Position of (row, col) in the value arrays; −1 if not in the pattern.
   int position(int row, int col) const;
 
  private:
   SpMat with_values(const Eigen::VectorXd& v) const;
+  // M + f·ΔM on the pattern's values.
+  Eigen::VectorXd loaded_mass(double end_mass_fraction, const char* fn) const;
   SpMat pattern_;
   std::array<Eigen::VectorXd, kNumMaterialParams> k_;
-  Eigen::VectorXd m_;
+  Eigen::VectorXd m_, m_end_;
 };
 
 }  // namespace piezo::model

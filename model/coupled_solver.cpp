@@ -22,8 +22,8 @@ void CoupledFactor::constrain(int dof, SpMat& m) const {
 }
 
 bool CoupledFactor::factorize(const MaterialWeights& w, double sigma, Electrodes electrodes,
-                              std::span<const int> clamped) {
-  model_->system().combine(w, sigma, a_);
+                              std::span<const int> clamped, double end_mass_fraction) {
+  model_->system().combine(w, sigma, a_, end_mass_fraction);
   ac_ = a_;
   if (electrodes == Electrodes::short_circuit) constrain(model_->dofs().electrode(), ac_);
   for (int d : clamped) constrain(d, ac_);

@@ -27,11 +27,12 @@ class CoupledFactor {
  public:
   explicit CoupledFactor(const TubeModel& model);
 
-  // Factorises K(w) − σM with the electrode grounded (short_circuit) or free,
-  // and the DOFs in `clamped` fixed. Returns false (status, not exception) if
-  // the matrix is numerically singular.
+  // Factorises K(w) − σ(M + f·ΔM) with the electrode grounded (short_circuit)
+  // or free, and the DOFs in `clamped` fixed; f = end_mass_fraction (end-face
+  // mass loading, model/end_mass.hpp). Returns false (status, not exception)
+  // if the matrix is numerically singular.
   bool factorize(const MaterialWeights& w, double sigma, Electrodes electrodes,
-                 std::span<const int> clamped = {});
+                 std::span<const int> clamped = {}, double end_mass_fraction = 0.0);
   // x = A_c⁻¹ rhs (A_c the constrained matrix); rhs at constrained DOFs gives x there.
   void solve(const Eigen::VectorXd& rhs, Eigen::VectorXd& x) const;
   // Charge on the electrode for V = 1 (constrained DOFs other than V at zero),

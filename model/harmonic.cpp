@@ -62,11 +62,15 @@ DirectHarmonicSolver::DirectHarmonicSolver(const TubeModel& model) : model_(&mod
 std::vector<Complex> DirectHarmonicSolver::admittance(const PiezoMaterialE& material,
                                                       std::span<const double> freq_hz,
                                                       const RayleighDamping& damping,
-                                                      const MaterialLosses& losses) {
+                                                      const MaterialLosses& losses,
+                                                      double end_mass_fraction) {
   validate(material, "DirectHarmonicSolver::admittance");
   check_freqs(freq_hz, "DirectHarmonicSolver::admittance");
   damping.validate();
   losses.validate();
+  if (!std::isfinite(end_mass_fraction) || end_mass_fraction < 0)
+    throw std::invalid_argument(
+        "DirectHarmonicSolver::admittance: end_mass_fraction must be finite and >= 0");
   const auto w = weights(material);
   const double eta = std::isfinite(losses.qm) ? 1.0 / losses.qm : 0.0;
   const int v = model_->dofs().electrode();
@@ -83,7 +87,7 @@ std::vector<Complex> DirectHarmonicSolver::admittance(const PiezoMaterialE& mate
     for (int i = 0; i < 5; ++i) cw[i] = w[i] * Complex(1.0, eta + om * damping.beta);
     for (int i = 5; i < 8; ++i) cw[i] = w[i];
     for (int i = 8; i < 10; ++i) cw[i] = w[i] * Complex(1.0, -losses.tan_delta);
-    model_->system().combine(cw, Complex(-om * om, om * damping.alpha), a_);
+    model_->system().combine(cw, Complex(-om * om, om * damping.alpha), a_, end_mass_fraction);
     // Lift V = 1: rhs = −A(:, V); then decouple the V row/column.
     col.setZero();
     Complex* val = a_.valuePtr();

@@ -36,9 +36,11 @@ std::vector<double> frequency_grid(double fmin_hz, double fmax_hz, double step_h
 class DirectHarmonicSolver {
  public:
   explicit DirectHarmonicSolver(const TubeModel& model);
+  // end_mass_fraction: end-face mass loading, M → M + f·ΔM (model/end_mass.hpp).
   std::vector<Complex> admittance(const PiezoMaterialE& material, std::span<const double> freq_hz,
                                   const RayleighDamping& damping = {},
-                                  const MaterialLosses& losses = {});
+                                  const MaterialLosses& losses = {},
+                                  double end_mass_fraction = 0.0);
 
  private:
   const TubeModel* model_;

@@ -50,8 +50,10 @@ void ModalOptions::validate() const {
   if (!(tolerance > 0)) throw std::invalid_argument(std::string(fn) + ": tolerance must be > 0");
   if (max_iterations < 1)
     throw std::invalid_argument(std::string(fn) + ": max_iterations must be >= 1");
-  if (!(active_coupling >= 0))
-    throw std::invalid_argument(std::string(fn) + ": active_coupling must be >= 0");
+  if (!(active_coupling >= 0) || !(active_coupling_open >= 0))
+    throw std::invalid_argument(std::string(fn) + ": active_coupling(_open) must be >= 0");
+  if (!std::isfinite(end_mass_fraction) || end_mass_fraction < 0)
+    throw std::invalid_argument(std::string(fn) + ": end_mass_fraction must be finite and >= 0");
 }
 
 const char* to_string(Symmetry s) {
@@ -87,9 +89,23 @@ double ModalSolver::clamped_capacitance(const PiezoMaterialE& material, Eigen::V
   return c0;
 }
 
+const SpMat& ModalSolver::mass(double f) {
+  if (f == 0.0) return m_uu_;
+  if (f != m_loaded_fraction_) {
+    m_loaded_ = model_->mass(f);
+    m_loaded_fraction_ = f;
+  }
+  return m_loaded_;
+}
+
 double ModalSolver::static_capacitance(const PiezoMaterialE& material,
                                        Eigen::VectorXd* u_static) {
   validate(material, "ModalSolver::static_capacitance");
+  return static_solve(material, m_uu_, u_static);
+}
+
+double ModalSolver::static_solve(const PiezoMaterialE& material, const SpMat& mass,
+                                 Eigen::VectorXd* u_static) {
   // The only zero-energy mode of the free tube is the rigid axial translation;
   // fixing one u_z removes it without loading the tube (the electric load is
   // self-equilibrated), so Q is that of the free tube.
@@ -100,7 +116,7 @@ double ModalSolver::static_capacitance(const PiezoMaterialE& material,
     Eigen::VectorXd u = x.head(model_->n_u());
     Eigen::VectorXd rigid = Eigen::VectorXd::Zero(model_->n_u());
     for (int n = 0; n < model_->mesh().num_nodes(); ++n) rigid[model_->dofs().u_z(n)] = 1.0;
-    const Eigen::VectorXd mr = m_uu_ * rigid;
+    const Eigen::VectorXd mr = mass * rigid;
     u -= (mr.dot(u) / mr.dot(rigid)) * rigid;  // M-orthogonal to the rigid mode
     *u_static = std::move(u);
   }
@@ -115,18 +131,20 @@ ModalResult ModalSolver::solve(const PiezoMaterialE& material, Electrodes electr
   if (opt.n_modes >= nu) throw std::invalid_argument("ModalSolver::solve: n_modes >= n_u");
   ModalResult res;
   res.electrodes = electrodes;
+  res.end_mass_fraction = opt.end_mass_fraction;
   const auto w = weights(material);
+  const SpMat& m_uu = mass(opt.end_mass_fraction);
 
   Eigen::VectorXd g;
   res.c_clamped = clamped_capacitance(material, &g);
 
   const double sigma = -std::pow(2.0 * M_PI * opt.shift_hz, 2);
-  if (!factor_.factorize(w, sigma, electrodes)) {
+  if (!factor_.factorize(w, sigma, electrodes, {}, opt.end_mass_fraction)) {
     res.message = "singular shifted system";
     return res;
   }
   CondensedShiftInvert op(factor_, nu, sigma);
-  Spectra::SparseSymMatProd<double> bop(m_uu_);
+  Spectra::SparseSymMatProd<double> bop(m_uu);
   const int ncv = std::min<int>(nu, opt.ncv > 0 ? opt.ncv : std::max(2 * opt.n_modes + 1, opt.n_modes + 20));
   Spectra::SymGEigsShiftSolver<CondensedShiftInvert, Spectra::SparseSymMatProd<double>,
                                Spectra::GEigsMode::ShiftInvert>
@@ -153,7 +171,7 @@ ModalResult ModalSolver::solve(const PiezoMaterialE& material, Electrodes electr
   const double rigid_omega = 2.0 * M_PI * 1e-3 * opt.shift_hz;
   for (std::size_t j = 0; j < order.size(); ++j) {
     Eigen::VectorXd phi = vecs.col(order[j]);
-    const double mnorm = std::sqrt(phi.dot(m_uu_ * phi));
+    const double mnorm = std::sqrt(phi.dot(m_uu * phi));
     phi /= mnorm;
     // Sign convention: largest |u_r| component positive (reproducible shapes).
     Eigen::Index imax;
@@ -164,7 +182,7 @@ ModalResult ModalSolver::solve(const PiezoMaterialE& material, Electrodes electr
     m.omega = std::sqrt(std::max(m.eigenvalue, 0.0));
     m.frequency_hz = m.omega / (2.0 * M_PI);
     const Eigen::VectorXd sym = 0.5 * (phi + model_->mirror(phi));
-    m.symmetric_fraction = sym.dot(m_uu_ * sym);
+    m.symmetric_fraction = sym.dot(m_uu * sym);
     m.symmetry = m.symmetric_fraction > 0.99   ? Symmetry::symmetric
                  : m.symmetric_fraction < 0.01 ? Symmetry::antisymmetric
                                                : Symmetry::mixed;
@@ -172,7 +190,9 @@ ModalResult ModalSolver::solve(const PiezoMaterialE& material, Electrodes electr
     m.kappa = phi.dot(k_uu * phi);
     if (m.omega > rigid_omega)
       m.coupling = m.participation * m.participation / (m.omega * m.omega * res.c_clamped);
-    m.electrically_active = m.symmetric_fraction > 0.5 && m.coupling > opt.active_coupling;
+    const double threshold =
+        electrodes == Electrodes::open_circuit ? opt.active_coupling_open : opt.active_coupling;
+    m.electrically_active = m.symmetric_fraction > 0.5 && m.coupling > threshold;
     res.shapes.col(static_cast<Eigen::Index>(j)) = phi;
     res.modes.push_back(m);
   }
@@ -185,8 +205,10 @@ ModalPortModel ModalSolver::port_model(const PiezoMaterialE& material, const Mod
   ModalPortModel p;
   p.converged = sc.converged;
   p.c_clamped = sc.c_clamped;
+  p.end_mass_fraction = opt.end_mass_fraction;
+  const SpMat& m_uu = mass(opt.end_mass_fraction);
   Eigen::VectorXd us;
-  p.c_static = static_capacitance(material, &us);
+  p.c_static = static_solve(material, m_uu, &us);
   double sum1 = 0, sum2 = 0, omega_max = 0;
   const double rigid_omega = 2.0 * M_PI * 1e-3 * opt.shift_hz;
   for (const auto& m : sc.modes) {
@@ -199,7 +221,7 @@ ModalPortModel ModalSolver::port_model(const PiezoMaterialE& material, const Mod
   }
   // Residual pseudo-mode from the two moments of the truncated modes (port_model.hpp).
   const double r1 = p.c_static - p.c_clamped - sum1;
-  const double r2 = us.dot(m_uu_ * us) - sum2;
+  const double r2 = us.dot(m_uu * us) - sum2;
   p.c_residual = r1;
   if (r1 > 0 && r2 > 0 && r1 / r2 > omega_max * omega_max) {
     const double wr = std::sqrt(r1 / r2);

@@ -27,8 +27,15 @@ struct ModalOptions {
   double tolerance = 1e-10;
   int max_iterations = 1000;
   // A mode is electrically active if it is symmetric about the mid-plane and
-  // its coupling p_k²/(ω_k² C0) exceeds this (see model/README.md).
+  // its coupling p_k²/(ω_k² C0) exceeds this (see model/README.md); in open
+  // circuit the second threshold applies (the updaters lower it: the
+  // open-circuit partner of a strongly coupled mode carries little charge).
   double active_coupling = 1e-3;
+  double active_coupling_open = 1e-3;
+  // End-face mass loading (effect `mass_loading`): added mass as a fraction f of
+  // the tube mass, M → M + f·ΔM (model/end_mass.hpp). ΔM is built once with the
+  // TubeModel, so any f costs no re-assembly. Must be finite and >= 0.
+  double end_mass_fraction = 0.0;
   void validate() const;
 };
 
@@ -54,7 +61,8 @@ struct ModalResult {
   int n_converged = 0;
   std::string message;      // why not, when !converged
   std::vector<Mode> modes;  // ascending frequency
-  Eigen::MatrixXd shapes;   // n_u × modes.size(), φᵀMφ = I
+  Eigen::MatrixXd shapes;   // n_u × modes.size(), φᵀM(f)φ = I, M(f) = M + f·ΔM
+  double end_mass_fraction = 0;  // f the modes were computed with
   double c_clamped = 0;     // C0 (F)
 
   // Electrically active modes (symmetric, coupling above threshold), ascending.
@@ -75,16 +83,26 @@ class ModalSolver {
   // Capacitance of the free tube at ω → 0 (static solve, rigid mode clamped);
   // optionally the static displacement for V = 1, rigid translation removed.
   double static_capacitance(const PiezoMaterialE& material, Eigen::VectorXd* u_static = nullptr);
-  // Short-circuit modes + C0 + C_static (+ residual mode) → the electrical port model.
+  // Short-circuit modes + C0 + C_static (+ residual mode) → the electrical port
+  // model; with options.end_mass_fraction for a mass-loaded tube (C0 and
+  // C_static do not depend on the mass; the modes and the residual mode do).
   ModalPortModel port_model(const PiezoMaterialE& material, const ModalOptions& options = {},
                             ModalResult* sc_result = nullptr);
 
   const TubeModel& model() const { return *model_; }
 
  private:
+  // M + f·ΔM (cached for the last f).
+  const SpMat& mass(double end_mass_fraction);
+  // Static solve for V = 1 with the rigid translation fixed; u_static is made
+  // M-orthogonal to the rigid mode for the given mass matrix.
+  double static_solve(const PiezoMaterialE& material, const SpMat& mass, Eigen::VectorXd* u_static);
+
   const TubeModel* model_;
   CoupledFactor factor_;
   SpMat m_uu_, k_uu_;
+  SpMat m_loaded_;
+  double m_loaded_fraction_ = -1.0;
   std::vector<int> all_u_;  // DOF list to clamp U for C0
 };
 

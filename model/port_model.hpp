@@ -44,6 +44,7 @@ struct ModalPortModel {
   double c_residual = 0;  // static share of truncated modes NOT carried by a residual mode (F)
   std::vector<PortMode> modes;  // elastic short-circuit modes, ascending (+ residual mode last)
   bool converged = true;        // the modal solve behind it converged
+  double end_mass_fraction = 0;  // end-face mass loading of the modes (model/end_mass.hpp)
 
   // Q/V at angular frequency ω (≥ 0) with Rayleigh damping and, optionally,
   // Qm / tanδ (first-order modal approximation: ω_k² → ω_k² + jκ_k/Qm,

@@ -1,6 +1,9 @@
 #include "model/tube_model.hpp"
 
 #include <cmath>
+#include <stdexcept>
+
+#include "model/end_mass.hpp"
 
 namespace piezo::model {
 
@@ -10,8 +13,10 @@ TubeModel::TubeModel(const TubeGeometry& geometry, const MeshOptions& mesh, int 
   mesh_ = std::make_unique<TubeMesh>(geometry_, mesh);
   dofs_ = std::make_unique<DofMap>(*mesh_);
   system_ = SplitSystem(*mesh_, *dofs_, geometry_.density_kg_m3, gauss_points);
+  system_.set_end_mass(end_face_mass_triplets(*mesh_, *dofs_, geometry_));
   const int nu = dofs_->n_u(), np = dofs_->n_phi();
   split_.m = system_.mass().topLeftCorner(nu, nu);
+  split_.m_end = system_.end_mass().topLeftCorner(nu, nu);
   for (int i = 0; i < 5; ++i)
     split_.k_c[i] = system_.matrix(static_cast<MaterialParam>(i)).topLeftCorner(nu, nu);
   for (int i = 0; i < 3; ++i)
@@ -19,6 +24,15 @@ TubeModel::TubeModel(const TubeGeometry& geometry, const MeshOptions& mesh, int 
   for (int i = 0; i < 2; ++i)
     split_.k_eps[i] = system_.matrix(static_cast<MaterialParam>(8 + i)).bottomRightCorner(np, np);
 }
+
+SpMat TubeModel::mass(double f) const {
+  if (f == 0.0) return split_.m;
+  if (!std::isfinite(f) || f < 0.0)
+    throw std::invalid_argument("TubeModel::mass: end_mass_fraction must be finite and >= 0");
+  return split_.m + f * split_.m_end;
+}
+
+double TubeModel::tube_mass() const { return tube_mass_kg(geometry_); }
 
 AssembledMatrices TubeModel::assemble(const PiezoMaterialE& material) const {
   validate(material, "TubeModel::assemble");

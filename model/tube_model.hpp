@@ -21,6 +21,7 @@ namespace piezo::model {
 // outer electrode DOF.
 struct SplitMatrices {
   SpMat m;                    // M, n_u × n_u (eq. 80), density of the geometry included
+  SpMat m_end;                // ΔM of the end-face mass for f = 1 (model/end_mass.hpp), n_u × n_u
   std::array<SpMat, 5> k_c;   // ∂K_UU/∂cE_ij for cE11, cE12, cE13, cE33, cE44 (eq. 234)
   std::array<SpMat, 3> k_e;   // ∂K_UΦ/∂e_k for e31, e33, e15, n_u × n_phi (eq. 242)
   std::array<SpMat, 2> k_eps; // ∂K_ΦΦ/∂εS_k for εS11, εS33, n_phi × n_phi (eq. 245)
@@ -43,6 +44,11 @@ class TubeModel {
   const SplitMatrices& split() const { return split_; }
   int n_u() const { return dofs_->n_u(); }
   int n_phi() const { return dofs_->n_phi(); }
+
+  // M(f) = M + f·ΔM: the mass matrix with an added end-face mass of f times the
+  // tube mass (effect `mass_loading`); f = 0 is the bare tube. No re-assembly.
+  SpMat mass(double end_mass_fraction = 0.0) const;
+  double tube_mass() const;  // ρπ(ro² − ri²)L, kg
 
   // K_UU = Σ c_ij K_cij, K_UΦ = Σ e_k K_ek, K_ΦΦ = Σ ε_k K_εk (eqs 234, 242, 245).
   AssembledMatrices assemble(const PiezoMaterialE& material) const;

@@ -186,7 +186,7 @@ CmcmResult extended_cmcm(const model::TubeModel& tube, model::ModalSolver& solve
     return res;
   }
   const CondensedStiffness k0(tube, mat0, phase.electrodes);
-  const model::SpMat& mass = tube.split().m;
+  const model::SpMat mass = tube.mass(opt.modal.end_mass_fraction);  // M + f·ΔM (end-face mass)
 
   Eigen::MatrixXd phi_star = phi;
   for (int it = 1; it <= opt.max_iterations; ++it) {

@@ -93,8 +93,8 @@ class Problem {
         return false;
       }
       if (el == model::Electrodes::short_circuit)
-        for (const auto& m : res.modes)
-          if (m.omega > 0 && m.eigenvalue > 0)
+        for (const auto& m : res.modes)  // not the rigid mode (see model_capacitance)
+          if (m.omega > 2.0 * M_PI * 1e-3 * opt_.modal.shift_hz)
             dyn += m.participation * m.participation / (m.eigenvalue * m.eigenvalue);
       const int n = static_cast<int>(meas.size());
       Eigen::MatrixXd phi(tube_.n_u(), n);

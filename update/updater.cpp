@@ -27,8 +27,11 @@ double model_capacitance(model::ModalSolver& solver, const model::PiezoMaterialE
   const auto sc = solver.solve(m, model::Electrodes::short_circuit, opt);
   const double w2 = std::pow(2.0 * M_PI * f_hz, 2);
   double dyn = 0;
+  // Skip the rigid translation as ModalSolver::port_model does: its computed
+  // eigenvalue is round-off (~±1e-6), and p²/λ² of a round-off λ is garbage.
+  const double rigid_omega = 2.0 * M_PI * 1e-3 * opt.shift_hz;
   for (const auto& mode : sc.modes)
-    if (mode.omega > 0 && mode.eigenvalue > 0)
+    if (mode.omega > rigid_omega)
       dyn += mode.participation * mode.participation / (mode.eigenvalue * mode.eigenvalue);
   return c_static + w2 * dyn;
 }
@@ -89,6 +92,41 @@ UpdateResult update_cmcm(const model::TubeModel& tube, model::ModalSolver& solve
   // Inexact block iterations: early sweeps need not be solved to the final
   // tolerance, their coordinates are about to change anyway.
   double last_change = 1.0;
+  // Start of the piezo coordinate: phase 2 (eq. 201 needs no stiffness) and a
+  // loose phase 3 on the original stiffnesses before the first elastic phase.
+  // Our short-circuit model depends on a = e31²/εS33 (the potentials inside
+  // the wall are condensed), so with the original a a tube 12 % off in εT33
+  // and d31 gives three resonances no (c1, c2) can match, and the lagged-shape
+  // iteration of phase 1 can diverge (tests/e2e: YE11 58 GPa, nu12 0.356,
+  // d31 −197 pC/N, εT33 1394 ε0). If this start fails, the seed's base is kept.
+  bool piezo_start = false;
+  {
+    const Coordinates q0 = q;
+    try {
+      q.eps_t33 = res.eps_t33_eq201;
+      q.a = a_from_d31(original.d31, q.c1 + q.c2, q.eps_t33);
+      CmcmPhase p0;
+      p0.name = "piezo (start)";
+      p0.electrodes = model::Electrodes::open_circuit;
+      p0.theta0 = {q.a};
+      p0.measured_hz = features.antiresonances_hz;
+      p0.material = [&, q](std::span<const double> th) {
+        Coordinates c = q;
+        c.a = th[0];
+        return material_of(c);
+      };
+      CmcmOptions c0 = opt.cmcm;
+      c0.tolerance = std::max(opt.cmcm.tolerance, 1e-3);
+      const auto r0 = extended_cmcm(tube, solver, p0, c0);
+      res.iterations_piezo += r0.iterations;
+      if (r0.ok()) {
+        q.a = r0.theta[0];
+        piezo_start = true;
+      }
+    } catch (const std::invalid_argument&) {
+    }
+    if (!piezo_start) q = q0;
+  }
   for (int sweep = 1; sweep <= opt.max_sweeps; ++sweep) {
     const Coordinates q_prev = q;
     res.sweeps = sweep;
@@ -115,9 +153,10 @@ UpdateResult update_cmcm(const model::TubeModel& tube, model::ModalSolver& solve
 
     // Phase 2: εT33 from the low-frequency impedance (eq. 201).
     if (sweep == 1) q.eps_t33 = res.eps_t33_eq201;
-    // Phase 3: a from the anti-resonances, open circuit. First sweep: the
-    // seed's base, original d31 and εT33 with the updated stiffnesses.
-    if (sweep == 1) {
+    // Phase 3: a from the anti-resonances, open circuit. First sweep without
+    // the start above: the seed's base, original d31 and εT33 with the updated
+    // stiffnesses.
+    if (sweep == 1 && !piezo_start) {
       try {
         q.a = a_from_d31(original.d31, q.c1 + q.c2, original.eps_t33);
       } catch (const std::invalid_argument& e) {
