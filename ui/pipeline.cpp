@@ -155,10 +155,15 @@ dsp::ImpedanceResult estimate(const acq::Capture& cap, PipelineResult& out) {
         m1 += v1[i] / static_cast<double>(pre);
         m2 += v2[i] / static_cast<double>(pre);
       }
+      // Start one sample before t = 0 (the idle level) when there is a
+      // pretrigger: the fit takes its input as at rest before the first sample
+      // and linear between samples, which is then the AWG's ramp onto the
+      // burst (drivers/sim/sim_bench.cpp) rather than a jump half a sample off.
+      const std::size_t lead = pre > 0 ? 1 : 0;
       std::vector<double> a(nfit), b(nfit);
       for (std::size_t i = 0; i < nfit; ++i) {
-        a[i] = v1[pre + i] - m1;
-        b[i] = v2[pre + i] - m2;
+        a[i] = v1[pre - lead + i] - m1;
+        b[i] = v2[pre - lead + i] - m2;
       }
       const auto fit =
           update::fit_port_model(a, b, first.sample_rate_hz, cap.setup.divider_r1_ohm, st);

@@ -207,10 +207,11 @@ E2eOutcome run_e2e_case(const E2eCase& c, const E2eChain& chain,
         }
       }
       const std::size_t nfit = chain.prony_samples > 0 ? std::min(chain.prony_samples, post) : post;
+      const std::size_t lead = pre > 0 ? 1 : 0;  // as ui/pipeline.cpp: from the idle sample before t = 0
       std::vector<double> a(nfit), b(nfit);
       for (std::size_t i = 0; i < nfit; ++i) {
-        a[i] = rec.v1[pre + i] - m1;
-        b[i] = rec.v2[pre + i] - m2;
+        a[i] = rec.v1[pre - lead + i] - m1;
+        b[i] = rec.v2[pre - lead + i] - m2;
       }
       update::PortFitStart st;
       st.resonances_hz = f.resonances_hz;
