@@ -10,7 +10,8 @@
 //
 // Re-solving the FE modes for every trial would make a fit cost seconds, so
 // the port model (C0, C_res, per mode ω_k, p_k², κ_k) is linearised in the
-// material coordinates (and the end-mass fraction) around a reference point
+// four material coordinates around a reference point (the end-mass fraction
+// is not a coordinate yet, so mass_loading is not a gap candidate)
 // and re-linearised by the fitter when it moves away (GapModel::relinearise).
 #include <complex>
 #include <memory>

@@ -6,26 +6,11 @@
 #include <fstream>
 #include <sstream>
 
+#include "ui/report/markdown.hpp"
+
 namespace piezo::report {
 
 namespace fs = std::filesystem;
-
-namespace {
-
-std::string fmt(const char* f, double v) {
-  char b[64];
-  std::snprintf(b, sizeof b, f, v);
-  return b;
-}
-
-std::string cell(std::string s) {
-  for (std::size_t i = 0; (i = s.find('|', i)) != std::string::npos; i += 2) s.replace(i, 1, "\\|");
-  for (char& c : s)
-    if (c == '\n') c = ' ';
-  return s;
-}
-
-}  // namespace
 
 BatchEntry batch_entry(const std::string& key, const nlohmann::json& rec) {
   BatchEntry e;

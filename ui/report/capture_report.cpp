@@ -6,26 +6,13 @@
 
 #include "ui/report/impedance_plot.hpp"
 #include "ui/report_export.hpp"
+#include "ui/report/markdown.hpp"
 
 namespace piezo::report {
 
 namespace fs = std::filesystem;
 
 namespace {
-
-std::string fmt(const char* f, double v) {
-  char b[64];
-  std::snprintf(b, sizeof b, f, v);
-  return b;
-}
-
-// Markdown table cells must not break the table.
-std::string cell(std::string s) {
-  for (std::size_t i = 0; (i = s.find('|', i)) != std::string::npos; i += 2) s.replace(i, 1, "\\|");
-  for (char& c : s)
-    if (c == '\n') c = ' ';
-  return s;
-}
 
 void header(std::ostringstream& o, const CaptureInfo& info) {
   o << "# Replay of `" << info.input_path << "`\n\n"
