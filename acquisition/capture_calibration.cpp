@@ -50,12 +50,13 @@ OwnedRecord average_shots(const Capture& cap, std::span<const Shot* const> shots
 }
 
 void deskew_record(OwnedRecord& r, double skew_s) {
-  if (skew_s == 0.0) return;
+  // Runs for a zero skew too: channel 2's sample at t = 0 is then replaced by
+  // the value just after the drive's jump, as channel 1 records it.
   r.v2 = dsp::deskew_channel(r.v2, r.sample_rate_hz, r.pretrigger_samples, skew_s);
   // The last samples of a late channel 2 would be extrapolated beyond its record
   // (noise amplified by the Lagrange weights): both channels end before them.
   const double d = skew_s * r.sample_rate_hz;
-  const std::size_t drop = d > 0 ? static_cast<std::size_t>(std::ceil(d)) + 2 : 0;
+  const std::size_t drop = static_cast<std::size_t>(std::ceil(std::max(d, 0.0))) + 2;
   if (r.v1.size() < r.pretrigger_samples + drop + 16)
     throw std::invalid_argument("deskew_record: the record is too short for a skew of " + std::to_string(skew_s * 1e9) +
                                 " ns");
@@ -172,8 +173,10 @@ std::optional<CaptureCalibration> calibrate_from_capture(const Capture& cap, con
   } else {
     out.skew_source = "not estimated (deskew off)";
   }
-  for (auto* r : {&open, &shrt, &load})
-    if (*r) deskew_record(**r, out.skew_applied_s);
+  out.deskewed = opt.deskew;
+  if (opt.deskew)
+    for (auto* r : {&open, &shrt, &load})
+      if (*r) deskew_record(**r, out.skew_applied_s);
 
   // 4. Standards, fixture quantities, smooth models.
   dsp::CalibrationStandards cs;

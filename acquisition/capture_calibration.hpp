@@ -50,9 +50,10 @@ bool same_drive(const Shot& a, const Shot& b);
 // first; throws std::invalid_argument naming the first that does not).
 OwnedRecord average_shots(const Capture& cap, std::span<const Shot* const> shots);
 
-// Removes a channel-2 delay from a record (dsp::deskew_channel, jump at t = 0);
-// for a late channel 2 the last ⌈skew·fs⌉ + 2 samples, which it never
-// recorded, are dropped from both channels.
+// Removes a channel-2 delay from a record (dsp::deskew_channel, jump at t = 0),
+// also for a zero delay (channel 2's sample on the jump is then replaced by
+// the value just after it, as channel 1 records it); the last ⌈skew·fs⌉ + 2
+// samples, which channel 2 never recorded, are dropped from both channels.
 void deskew_record(OwnedRecord& r, double skew_s);
 
 struct CaptureCalibrationOptions {
@@ -75,8 +76,12 @@ struct CaptureCalibration {
   std::vector<std::string> shots_open, shots_short, shots_load;  // shot names used
   std::vector<std::string> notes;  // e.g. shots left out and why
 
-  // A dut shot (or average) as the estimators must see it: channel 2 deskewed.
-  void prepare(OwnedRecord& r) const { deskew_record(r, skew_applied_s); }
+  bool deskewed = true;  // the standards' records went through deskew_record
+  // A dut shot (or average) as the estimators must see it: channel 2 deskewed
+  // (like the standards' records).
+  void prepare(OwnedRecord& r) const {
+    if (deskewed) deskew_record(r, skew_applied_s);
+  }
   // Compensates, in place, an estimate made from prepared records (Z and z_sigma_ohm).
   void compensate(dsp::ImpedanceResult& r) const;
   dsp::FixtureCompensation compensation() const;

@@ -136,7 +136,9 @@ ImpedanceAssessment assess_impedance(const Capture& cap, const AssessmentOptions
   for (const Shot* s : shots) {
     raw.push_back(single(cap, *s));
     ready.push_back(raw.back());
-    deskew_record(ready.back(), out.skew_applied_s);
+    // As the standards were (also for a skew near 0), or a stored skew; nothing otherwise.
+    if ((out.calibration && opt.deskew) || (!out.calibration && opt.skew_s && opt.deskew))
+      deskew_record(ready.back(), out.skew_applied_s);
   }
   // Deskewing drops the last few samples: a sample count meant for the whole
   // recorded span follows it (one beyond the recorded span stays an error).

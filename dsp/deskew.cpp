@@ -57,7 +57,9 @@ std::vector<double> deskew_channel(std::span<const double> x, double fs, std::si
   if (jump_index >= x.size()) throw std::invalid_argument("deskew_channel: jump index beyond the record");
   const double d = delay_s * fs;
   const double jump = double(jump_index) + d;  // position of t = 0 in x
-  constexpr double eps = 1e-9;
+  // A sample closer to the jump than this (in samples: 5 ns at 10 MS/s, the
+  // skew's own uncertainty) may have caught either side of it: left out.
+  constexpr double eps = 0.05;
   // Samples strictly before / after the jump; a sample on it belongs to neither.
   const long pre_hi = std::min(n - 1, static_cast<long>(std::ceil(jump - eps)) - 1);
   const long post_lo = std::max(0L, static_cast<long>(std::floor(jump + eps)) + 1);

@@ -40,7 +40,7 @@ double phase_slope_delay(const Eigen::VectorXd& f_hz, const Eigen::VectorXcd& t_
 // sub-sample position of its own, so a plain fractional delay (or a phase
 // ramp on the spectrum) would smear it over the neighbouring samples; here it
 // lands exactly on jump_index, as in channel 1. A sample that falls exactly
-// on the jump (an integer delay) is left out of both sides. Samples beyond
+// on the jump (within 0.05 sample: an integer delay, or none) is left out of both sides. Samples beyond
 // the record's ends are extrapolated from the nearest ones. Same length as x.
 std::vector<double> deskew_channel(std::span<const double> x, double sample_rate_hz, std::size_t jump_index,
                                    double delay_s);

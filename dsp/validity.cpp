@@ -68,7 +68,20 @@ ValidityReport check_shots(std::span<const DividerRecord> records, const PronyIm
       }
       rep.f_hz[q] = df * double(b);
       rep.coherence[q] = g11 > 0 && g22 > 0 ? std::norm(g12) / (g11 * g22) : 0.0;
-      h[q] = g11 > 0 ? g12 / g11 : cd(0);
+      // The ensemble transfer for the per-shot check: the median of the shots'
+      // own transfers (re, im), so that a stray shot does not pull it.
+      std::vector<double> re, im;
+      for (std::size_t k = 0; k < records.size(); ++k) {
+        const cd t = std::abs(x1[k][b]) > 0 ? x2[k][b] / x1[k][b] : cd(0);
+        re.push_back(t.real());
+        im.push_back(t.imag());
+      }
+      auto median = [](std::vector<double>& v) {
+        std::sort(v.begin(), v.end());
+        const std::size_t m = v.size() / 2;
+        return v.size() % 2 ? v[m] : 0.5 * (v[m - 1] + v[m]);
+      };
+      h[q] = cd(median(re), median(im));
       if (rep.coherence[q] < opt.min_coherence) ++low;
     }
     rep.low_coherence_fraction = double(low) / double(nb);

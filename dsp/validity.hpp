@@ -7,7 +7,7 @@
 //                   Piersol 2010 §9.2.3), and per shot the coherence of its
 //                   own v2 with the ensemble transfer applied to its own v1,
 //                       c_k = |Σ_f V2_k*·H·V1_k|² / (Σ_f |V2_k|² · Σ_f |H·V1_k|²),
-//                   H = Σ_k V1_k*·V2_k / Σ_k |V1_k|²: 1 for a shot that follows
+//                   H = the median over the shots of V2_k/V1_k: 1 for a shot that follows
 //                   the others, lower for a shot with another response
 //                   (a loose contact, a different device, an interference);
 //   reconstruction  how well a Prony-SS model of the shot's order reproduces
