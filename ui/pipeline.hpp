@@ -10,6 +10,7 @@
 #include <string>
 #include <vector>
 
+#include "acquisition/calibration_plan.hpp"
 #include "acquisition/plan.hpp"
 #include "acquisition/sim_setup.hpp"
 
@@ -25,6 +26,10 @@ struct PipelineRequest {
   std::string replay_capture;  // non-empty: skip acquisition
   std::string material = "apc850";  // nominal model to update
   bool isotropic = true;
+  // --- issue 10 hook (branch comp): fixture standards measured before the dut
+  // shots (simulator: switched by SIM:DUT; real bench: `prompt` asks the technician).
+  std::vector<acq::CalibrationStep> calibration;
+  acq::TechnicianPrompt prompt;
 };
 
 struct Curve {
