@@ -25,23 +25,29 @@ std::string num(double v) {
 std::vector<CalibrationStep> parse_calibration_list(std::string_view list, double load_ohm,
                                                     std::optional<double> load_parallel_f) {
   std::vector<CalibrationStep> out;
-  if (trim(list).empty()) throw std::invalid_argument("--calibrate: empty list (expected e.g. open,short,load)");
+  if (trim(list).empty())
+    throw std::invalid_argument("--calibrate: empty list (expected e.g. open,short,load)");
   std::size_t pos = 0;
   while (pos <= list.size()) {
     const std::size_t comma = list.find(',', pos);
-    const std::string item = trim(list.substr(pos, comma == std::string_view::npos ? list.npos : comma - pos));
+    const std::string item =
+        trim(list.substr(pos, comma == std::string_view::npos ? list.npos : comma - pos));
     const auto role = parse_role(item);
     if (!role || *role == Role::Dut)
-      throw std::invalid_argument("--calibrate: unknown standard '" + item + "' (expected open, short or load)");
+      throw std::invalid_argument("--calibrate: unknown standard '" + item +
+                                  "' (expected open, short or load)");
     for (const auto& s : out)
-      if (s.role == *role) throw std::invalid_argument("--calibrate: standard '" + item + "' listed twice");
+      if (s.role == *role)
+        throw std::invalid_argument("--calibrate: standard '" + item + "' listed twice");
     CalibrationStep st;
     st.role = *role;
     if (*role == Role::Load) {
       if (!(std::isfinite(load_ohm) && load_ohm > 0))
-        throw std::invalid_argument("--load-ohm: the load standard's resistance must be positive, got " + num(load_ohm));
+        throw std::invalid_argument(
+            "--load-ohm: the load standard's resistance must be positive, got " + num(load_ohm));
       if (load_parallel_f && !(std::isfinite(*load_parallel_f) && *load_parallel_f >= 0))
-        throw std::invalid_argument("--load-parallel-f: must be >= 0, got " + num(*load_parallel_f));
+        throw std::invalid_argument("--load-parallel-f: must be >= 0, got " +
+                                    num(*load_parallel_f));
       st.load_ohm = load_ohm;
       st.load_parallel_f = load_parallel_f;
     }
@@ -55,12 +61,15 @@ std::vector<CalibrationStep> parse_calibration_list(std::string_view list, doubl
 std::string standard_instruction(const CalibrationStep& s) {
   switch (s.role) {
     case Role::Open:
-      return "connect the OPEN standard: nothing at the transducer terminals (leads in place, unconnected)";
+      return "connect the OPEN standard: nothing at the transducer terminals (leads in place, "
+             "unconnected)";
     case Role::Short:
       return "connect the SHORT standard: join the two transducer terminals with the shorting bar";
     case Role::Load:
       return "connect the LOAD standard: the " + num(s.load_ohm) + " ohm reference resistor" +
-             (s.load_parallel_f && *s.load_parallel_f > 0 ? " (" + num(*s.load_parallel_f) + " F in parallel)" : "") +
+             (s.load_parallel_f && *s.load_parallel_f > 0
+                  ? " (" + num(*s.load_parallel_f) + " F in parallel)"
+                  : "") +
              " at the transducer terminals";
     case Role::Dut:
       break;
@@ -91,10 +100,18 @@ StandardConnector make_standard_connector(Bench& bench, TechnicianPrompt prompt)
     return [awg](const CalibrationStep& s) {
       std::string cmd = "SIMulation:DUT ";
       switch (s.role) {
-        case Role::Open: cmd += "OPEN"; break;
-        case Role::Short: cmd += "SHORT"; break;
-        case Role::Load: cmd += "LOAD," + num(s.load_ohm) + "," + num(s.load_parallel_f.value_or(0.0)); break;
-        case Role::Dut: cmd += "TUBE"; break;
+        case Role::Open:
+          cmd += "OPEN";
+          break;
+        case Role::Short:
+          cmd += "SHORT";
+          break;
+        case Role::Load:
+          cmd += "LOAD," + num(s.load_ohm) + "," + num(s.load_parallel_f.value_or(0.0));
+          break;
+        case Role::Dut:
+          cmd += "TUBE";
+          break;
       }
       awg->scpi().configure(cmd);  // *OPC? and SYST:ERR? after it: a refusal throws with its text
       return true;
@@ -102,7 +119,8 @@ StandardConnector make_standard_connector(Bench& bench, TechnicianPrompt prompt)
   }
   if (!prompt)
     throw std::invalid_argument(
-        "calibration on a real bench needs a technician to connect the standards: no prompt was given");
+        "calibration on a real bench needs a technician to connect the standards: no prompt was "
+        "given");
   return [prompt](const CalibrationStep& s) { return prompt(standard_instruction(s)); };
 }
 

@@ -15,15 +15,16 @@
 namespace piezo::acq {
 
 struct CalibrationStep {
-  Role role = Role::Open;  // Open, Short, Load; Dut = the transducer back in place
-  double load_ohm = 0.0;  // Load: the standard's resistance
+  Role role = Role::Open;                 // Open, Short, Load; Dut = the transducer back in place
+  double load_ohm = 0.0;                  // Load: the standard's resistance
   std::optional<double> load_parallel_f;  // Load: its parallel capacitance (absent = 0)
 };
 
 // "open,short,load" (any subset, any order, no repeats) → steps. Throws
 // std::invalid_argument naming the bad item.
-std::vector<CalibrationStep> parse_calibration_list(std::string_view list, double load_ohm = 1000.0,
-                                                    std::optional<double> load_parallel_f = std::nullopt);
+std::vector<CalibrationStep> parse_calibration_list(
+    std::string_view list, double load_ohm = 1000.0,
+    std::optional<double> load_parallel_f = std::nullopt);
 
 // What the technician must do for a step, e.g. "connect the SHORT standard (terminals joined)".
 std::string standard_instruction(const CalibrationStep& step);

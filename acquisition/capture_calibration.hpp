@@ -40,7 +40,9 @@ struct OwnedRecord {
   std::size_t pretrigger_samples = 0;
   std::optional<double> daq_range_v;
   std::vector<std::string> shots;  // names of the shots in it
-  dsp::DividerRecord view() const { return {v1, v2, sample_rate_hz, r1_ohm, pretrigger_samples, daq_range_v}; }
+  dsp::DividerRecord view() const {
+    return {v1, v2, sample_rate_hz, r1_ohm, pretrigger_samples, daq_range_v};
+  }
 };
 
 // True when two shots can be averaged sample by sample (same record and drive).
@@ -57,24 +59,25 @@ OwnedRecord average_shots(const Capture& cap, std::span<const Shot* const> shots
 void deskew_record(OwnedRecord& r, double skew_s);
 
 struct CaptureCalibrationOptions {
-  double fmin_hz = 0.0;  // band of the standards; must cover the band the estimates are corrected over
-  double fmax_hz = 0.0;  // 0: fs/4
-  int degree = 4;        // of the standards' smoothing polynomials
+  double fmin_hz =
+      0.0;  // band of the standards; must cover the band the estimates are corrected over
+  double fmax_hz = 0.0;                    // 0: fs/4
+  int degree = 4;                          // of the standards' smoothing polynomials
   std::optional<dsp::FixtureModel> model;  // empty: the most complete the standards allow
-  bool deskew = true;    // estimate and remove the channel skew
+  bool deskew = true;                      // estimate and remove the channel skew
 };
 
 struct CaptureCalibration {
   dsp::FixtureCalibration fixture;  // measured quantities (for the report and the gap diagnosis)
   dsp::FixtureModel model = dsp::FixtureModel::None;
-  std::string model_description;  // dsp::describe(model)
+  std::string model_description;                       // dsp::describe(model)
   std::optional<dsp::StandardModel> open, shrt, load;  // deskewed, smoothed standards
   dsp::LoadStandard load_value;
-  double skew_applied_s = 0.0;     // removed from channel 2 of every record (deskew_record)
-  std::string skew_source;         // "open standard (fixture fit)", "cross-correlation of the short", ...
+  double skew_applied_s = 0.0;  // removed from channel 2 of every record (deskew_record)
+  std::string skew_source;  // "open standard (fixture fit)", "cross-correlation of the short", ...
   double r1_nominal_ohm = 0.0;
   std::vector<std::string> shots_open, shots_short, shots_load;  // shot names used
-  std::vector<std::string> notes;  // e.g. shots left out and why
+  std::vector<std::string> notes;                                // e.g. shots left out and why
 
   bool deskewed = true;  // the standards' records went through deskew_record
   // A dut shot (or average) as the estimators must see it: channel 2 deskewed
@@ -91,6 +94,7 @@ struct CaptureCalibration {
 // std::invalid_argument naming the shot and the problem for unusable
 // calibration shots (all clipped, a load without load_ohm, two different
 // load standards, a model the shots present do not support).
-std::optional<CaptureCalibration> calibrate_from_capture(const Capture& cap, const CaptureCalibrationOptions& opt);
+std::optional<CaptureCalibration> calibrate_from_capture(const Capture& cap,
+                                                         const CaptureCalibrationOptions& opt);
 
 }  // namespace piezo::acq

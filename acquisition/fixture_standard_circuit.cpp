@@ -19,10 +19,12 @@ namespace piezo::acq {
 void DividerStateSpace::build_standard(const BenchCircuit& k) {
   using K = drivers::sim::DutSelection::Kind;
   const auto& dut = k.dut;
-  if (dut.kind == K::Load && !(dut.load_ohm > 0 && std::isfinite(dut.load_ohm) && dut.load_parallel_f >= 0))
+  if (dut.kind == K::Load &&
+      !(dut.load_ohm > 0 && std::isfinite(dut.load_ohm) && dut.load_parallel_f >= 0))
     throw std::invalid_argument("DividerStateSpace: the load standard needs R > 0 and C >= 0");
   const double g1 = 1.0 / k.r1_ohm;
-  const double gd = std::isfinite(k.daq_input_resistance_ohm) ? 1.0 / k.daq_input_resistance_ohm : 0.0;
+  const double gd =
+      std::isfinite(k.daq_input_resistance_ohm) ? 1.0 / k.daq_input_resistance_ohm : 0.0;
   const double rs = k.series_resistance_ohm;
 
   if (dut.kind == K::Short && rs == 0.0) {  // v2 is held at ground: no dynamics, no output
@@ -62,7 +64,8 @@ void DividerStateSpace::build_standard(const BenchCircuit& k) {
   auto sub = [&](const std::vector<int>& r, const std::vector<int>& c) {
     Eigen::MatrixXd m(r.size(), c.size());
     for (std::size_t i = 0; i < r.size(); ++i)
-      for (std::size_t j = 0; j < c.size(); ++j) m(static_cast<int>(i), static_cast<int>(j)) = g(r[i], c[j]);
+      for (std::size_t j = 0; j < c.size(); ++j)
+        m(static_cast<int>(i), static_cast<int>(j)) = g(r[i], c[j]);
     return m;
   };
   auto part = [&](const std::vector<int>& r) {
@@ -74,7 +77,8 @@ void DividerStateSpace::build_standard(const BenchCircuit& k) {
   Eigen::MatrixXd m_ad = Eigen::MatrixXd::Zero(na, nd);
   Eigen::VectorXd m_u = Eigen::VectorXd::Zero(na);
   if (na > 0) {
-    const auto lu = sub(alg, alg).partialPivLu();  // every node reaches ground or v1 through a conductance
+    const auto lu =
+        sub(alg, alg).partialPivLu();  // every node reaches ground or v1 through a conductance
     m_ad = -lu.solve(sub(alg, dyn));
     m_u = lu.solve(part(alg));
   }

@@ -19,11 +19,13 @@ struct Band {
 std::vector<const Shot*> dut_shots(const Capture& cap, const AssessmentOptions& opt) {
   if (opt.shot) {
     if (*opt.shot >= cap.shots.size())
-      throw std::invalid_argument("shot " + std::to_string(*opt.shot) + " does not exist (the capture has " +
+      throw std::invalid_argument("shot " + std::to_string(*opt.shot) +
+                                  " does not exist (the capture has " +
                                   std::to_string(cap.shots.size()) + ")");
     const Shot& s = cap.shots[*opt.shot];
     if (s.role != Role::Dut)
-      throw std::invalid_argument("shot " + s.name + " is a calibration shot (role \"" + std::string(to_string(s.role)) +
+      throw std::invalid_argument("shot " + s.name + " is a calibration shot (role \"" +
+                                  std::string(to_string(s.role)) +
                                   "\"), not the device under test");
     return {&s};
   }
@@ -61,8 +63,9 @@ OwnedRecord mean_of(const std::vector<OwnedRecord>& recs) {
 }
 
 // One estimate from owned records (averaged for prony/fft, segments for xspec).
-dsp::ImpedanceResult estimate(const std::string& method, const std::vector<OwnedRecord>& recs, const Band& b,
-                              const AssessmentOptions& opt, std::optional<std::size_t> order, std::size_t bootstrap) {
+dsp::ImpedanceResult estimate(const std::string& method, const std::vector<OwnedRecord>& recs,
+                              const Band& b, const AssessmentOptions& opt,
+                              std::optional<std::size_t> order, std::size_t bootstrap) {
   if (method == "xspec") {
     std::vector<dsp::DividerRecord> v;
     for (const auto& r : recs) v.push_back(r.view());
@@ -95,14 +98,17 @@ OwnedRecord single(const Capture& cap, const Shot& s) {
 
 ImpedanceAssessment assess_impedance(const Capture& cap, const AssessmentOptions& opt) {
   if (opt.method != "prony" && opt.method != "fft" && opt.method != "xspec")
-    throw std::invalid_argument("assess_impedance: method '" + opt.method + "' (expected prony, fft or xspec)");
+    throw std::invalid_argument("assess_impedance: method '" + opt.method +
+                                "' (expected prony, fft or xspec)");
   ImpedanceAssessment out;
   const auto shots = dut_shots(cap, opt);
   for (const Shot* s : shots) out.shots.push_back(s->name);
   const double fs = shots.front()->sample_rate_hz;
   Band b;
   b.fmax = opt.fmax_hz > 0 ? opt.fmax_hz : fs / 4;
-  if (!(b.fmax <= fs / 2)) throw std::invalid_argument("fmax above the Nyquist frequency (" + std::to_string(fs / 2) + " Hz)");
+  if (!(b.fmax <= fs / 2))
+    throw std::invalid_argument("fmax above the Nyquist frequency (" + std::to_string(fs / 2) +
+                                " Hz)");
   b.step = opt.step_hz > 0 ? opt.step_hz : b.fmax / 2000;
   b.fmin = opt.fmin_hz > 0 ? opt.fmin_hz : b.step;
   if (!(b.fmin < b.fmax)) throw std::invalid_argument("fmin must lie below fmax");
@@ -122,8 +128,9 @@ ImpedanceAssessment assess_impedance(const Capture& cap, const AssessmentOptions
       out.model = out.calibration->model;
       for (const auto& n : out.calibration->notes) out.notes.push_back(n);
     } else if (opt.model && *opt.model != dsp::FixtureModel::None) {
-      throw std::invalid_argument("fixture compensation '" + std::string(dsp::to_string(*opt.model)) +
-                                  "' asked for, but the capture holds no calibration shot (role open/short/load)");
+      throw std::invalid_argument(
+          "fixture compensation '" + std::string(dsp::to_string(*opt.model)) +
+          "' asked for, but the capture holds no calibration shot (role open/short/load)");
     }
   }
   if (!out.calibration && opt.skew_s && opt.deskew) {
@@ -163,30 +170,37 @@ ImpedanceAssessment assess_impedance(const Capture& cap, const AssessmentOptions
     comp->apply(out.result);
     dsp::FeatureOptions fo = opt.prony.features;
     fo.fmin_hz = b.fmin;
-    out.result.features = dsp::find_features(out.result.f_hz, out.result.z_ohm, out.result.z_sigma_ohm, fo);
-    out.notes.push_back("features of the compensated estimate are |Z| extrema on the grid (not Prony zeros/poles)");
+    out.result.features =
+        dsp::find_features(out.result.f_hz, out.result.z_ohm, out.result.z_sigma_ohm, fo);
+    out.notes.push_back(
+        "features of the compensated estimate are |Z| extrema on the grid (not Prony zeros/poles)");
   }
 
   // Uncertainty band.
   UncertaintySource src = opt.uncertainty;
-  if (src == UncertaintySource::Auto) src = ready.size() >= 3 ? UncertaintySource::Shots : UncertaintySource::Noise;
+  if (src == UncertaintySource::Auto)
+    src = ready.size() >= 3 ? UncertaintySource::Shots : UncertaintySource::Noise;
   if (src == UncertaintySource::Shots && ready.size() < 2) {
-    out.notes.push_back("uncertainty: a bootstrap over shots needs >= 2 shots; noise propagation used");
+    out.notes.push_back(
+        "uncertainty: a bootstrap over shots needs >= 2 shots; noise propagation used");
     src = UncertaintySource::Noise;
   }
   if (src == UncertaintySource::Shots) {
-    auto reps = dsp::bootstrap_over_shots(ready.size(), opt.bootstrap, opt.seed, [&](const std::vector<std::size_t>& idx) {
-      std::vector<OwnedRecord> pick;
-      for (auto i : idx) pick.push_back(ready[i]);
-      auto r = estimate(opt.method, pick, b, o2, order, 0);
-      if (comp)
-        for (Eigen::Index k = 0; k < r.f_hz.size(); ++k) r.z_ohm[k] = comp->correct(r.f_hz[k], r.z_ohm[k]);
-      return Eigen::VectorXcd(r.z_ohm);
-    });
+    auto reps = dsp::bootstrap_over_shots(ready.size(), opt.bootstrap, opt.seed,
+                                          [&](const std::vector<std::size_t>& idx) {
+                                            std::vector<OwnedRecord> pick;
+                                            for (auto i : idx) pick.push_back(ready[i]);
+                                            auto r = estimate(opt.method, pick, b, o2, order, 0);
+                                            if (comp)
+                                              for (Eigen::Index k = 0; k < r.f_hz.size(); ++k)
+                                                r.z_ohm[k] = comp->correct(r.f_hz[k], r.z_ohm[k]);
+                                            return Eigen::VectorXcd(r.z_ohm);
+                                          });
     if (reps.size() >= 2) {
-      out.band = dsp::band_from_replicates(out.result.f_hz, out.result.z_ohm, reps, ready.size(), opt.coverage_factor,
-                                           "bootstrap over " + std::to_string(ready.size()) + " shots (" +
-                                               std::to_string(reps.size()) + " replicates)");
+      out.band = dsp::band_from_replicates(
+          out.result.f_hz, out.result.z_ohm, reps, ready.size(), opt.coverage_factor,
+          "bootstrap over " + std::to_string(ready.size()) + " shots (" +
+              std::to_string(reps.size()) + " replicates)");
       if (comp) {
         dsp::add_in_quadrature(*out.band, sigma_std);
         out.band->source += " + fixture standards";
@@ -198,11 +212,14 @@ ImpedanceAssessment assess_impedance(const Capture& cap, const AssessmentOptions
   }
   if (src == UncertaintySource::Noise) {
     const bool have = out.result.z_sigma_ohm.size() == out.result.f_hz.size();
-    out.band = dsp::band_from_sigma(out.result.f_hz, out.result.z_ohm, have ? out.result.z_sigma_ohm : Eigen::VectorXd(),
-                                    opt.coverage_factor,
-                                    std::string(opt.method == "prony" ? "Prony parametric bootstrap" : "noise propagation") +
-                                        (comp ? " + fixture standards" : ""));
-    if (!have) out.notes.push_back("uncertainty: the estimate carries no per-point sigma (Prony bootstrap 0?)");
+    out.band = dsp::band_from_sigma(
+        out.result.f_hz, out.result.z_ohm, have ? out.result.z_sigma_ohm : Eigen::VectorXd(),
+        opt.coverage_factor,
+        std::string(opt.method == "prony" ? "Prony parametric bootstrap" : "noise propagation") +
+            (comp ? " + fixture standards" : ""));
+    if (!have)
+      out.notes.push_back(
+          "uncertainty: the estimate carries no per-point sigma (Prony bootstrap 0?)");
   }
 
   // The band's random part (circular σ), for the KK thresholds: the model-order
@@ -212,7 +229,8 @@ ImpedanceAssessment assess_impedance(const Capture& cap, const AssessmentOptions
     noise_sigma.resize(out.band->size());
     for (Eigen::Index k = 0; k < noise_sigma.size(); ++k)
       noise_sigma[k] =
-          std::sqrt(2.0) * std::hypot(out.band->abs_sigma_ohm[k], out.band->abs_ohm[k] * out.band->phase_sigma_rad[k]);
+          std::sqrt(2.0) * std::hypot(out.band->abs_sigma_ohm[k],
+                                      out.band->abs_ohm[k] * out.band->phase_sigma_rad[k]);
   }
   // Model-order part (Prony): how much the estimate moves one order step up or down.
   if (out.band && opt.order_spread && order && opt.method == "prony") {
@@ -227,7 +245,8 @@ ImpedanceAssessment assess_impedance(const Capture& cap, const AssessmentOptions
         if (comp)
           for (Eigen::Index k = 0; k < n; ++k) r.z_ohm[k] = comp->correct(r.f_hz[k], r.z_ohm[k]);
         for (Eigen::Index k = 0; k < n; ++k) {
-          dl[k] = std::max(dl[k], std::abs(std::log(std::abs(r.z_ohm[k]) / std::abs(out.result.z_ohm[k]))));
+          dl[k] = std::max(
+              dl[k], std::abs(std::log(std::abs(r.z_ohm[k]) / std::abs(out.result.z_ohm[k]))));
           dp[k] = std::max(dp[k], std::abs(std::arg(r.z_ohm[k] / out.result.z_ohm[k])));
         }
         ++used;
@@ -237,7 +256,8 @@ ImpedanceAssessment assess_impedance(const Capture& cap, const AssessmentOptions
     }
     if (used) {
       for (Eigen::Index k = 0; k < n; ++k) {
-        out.band->abs_sigma_ohm[k] = std::hypot(out.band->abs_sigma_ohm[k], dl[k] * out.band->abs_ohm[k]);
+        out.band->abs_sigma_ohm[k] =
+            std::hypot(out.band->abs_sigma_ohm[k], dl[k] * out.band->abs_ohm[k]);
         out.band->phase_sigma_rad[k] = std::hypot(out.band->phase_sigma_rad[k], dp[k]);
       }
       out.band->source += " + model order (orders " + std::to_string(*order) + " +- " +
@@ -248,7 +268,8 @@ ImpedanceAssessment assess_impedance(const Capture& cap, const AssessmentOptions
   // Kramers–Kronig / passivity of the result.
   if (opt.kk) {
     try {
-      out.kk = dsp::kramers_kronig_check(out.result.f_hz, out.result.z_ohm, noise_sigma, opt.kk_options);
+      out.kk =
+          dsp::kramers_kronig_check(out.result.f_hz, out.result.z_ohm, noise_sigma, opt.kk_options);
     } catch (const std::invalid_argument& e) {
       out.notes.push_back(std::string("Kramers-Kronig check not run: ") + e.what());
     }

@@ -16,10 +16,12 @@ constexpr double kTwoPi = 2.0 * std::numbers::pi;
 using cd = std::complex<double>;
 }  // namespace
 
-double xcorr_delay(std::span<const double> v1, std::span<const double> v2, double fs, double max_delay_s) {
+double xcorr_delay(std::span<const double> v1, std::span<const double> v2, double fs,
+                   double max_delay_s) {
   if (v1.size() != v2.size() || v1.size() < 16)
     throw std::invalid_argument("xcorr_delay: v1 and v2 need the same length, at least 16 samples");
-  if (!(fs > 0) || !(max_delay_s > 0)) throw std::invalid_argument("xcorr_delay: rate and max delay must be positive");
+  if (!(fs > 0) || !(max_delay_s > 0))
+    throw std::invalid_argument("xcorr_delay: rate and max delay must be positive");
   const std::size_t n = v1.size();
   std::vector<double> d1(n), d2(n);
   for (std::size_t k = 1; k < n; ++k) {
@@ -38,7 +40,8 @@ double xcorr_delay(std::span<const double> v1, std::span<const double> v2, doubl
   std::vector<double> r(nfft * up);
   inv.inverse(c.data(), r.data(), r.size());
   // r[m] is the correlation at lag m/(up·fs); negative lags wrap to the end.
-  const auto lag_max = static_cast<long>(std::min<double>(max_delay_s * fs * double(up), double(n * up / 2)));
+  const auto lag_max =
+      static_cast<long>(std::min<double>(max_delay_s * fs * double(up), double(n * up / 2)));
   const long len = static_cast<long>(r.size());
   auto at = [&](long m) { return r[static_cast<std::size_t>((m % len + len) % len)]; };
   long best = 0;
@@ -50,11 +53,14 @@ double xcorr_delay(std::span<const double> v1, std::span<const double> v2, doubl
   return (double(best) + frac) / (double(up) * fs);
 }
 
-std::vector<double> deskew_channel(std::span<const double> x, double fs, std::size_t jump_index, double delay_s) {
+std::vector<double> deskew_channel(std::span<const double> x, double fs, std::size_t jump_index,
+                                   double delay_s) {
   const auto n = static_cast<long>(x.size());
   if (n < 4) throw std::invalid_argument("deskew_channel: need at least 4 samples");
-  if (!(fs > 0) || !std::isfinite(delay_s)) throw std::invalid_argument("deskew_channel: bad rate or delay");
-  if (jump_index >= x.size()) throw std::invalid_argument("deskew_channel: jump index beyond the record");
+  if (!(fs > 0) || !std::isfinite(delay_s))
+    throw std::invalid_argument("deskew_channel: bad rate or delay");
+  if (jump_index >= x.size())
+    throw std::invalid_argument("deskew_channel: jump index beyond the record");
   const double d = delay_s * fs;
   const double jump = double(jump_index) + d;  // position of t = 0 in x
   // A sample closer to the jump than this (in samples: 5 ns at 10 MS/s, the
@@ -88,7 +94,8 @@ std::vector<double> deskew_channel(std::span<const double> x, double fs, std::si
 }
 
 double phase_slope_delay(const Eigen::VectorXd& f, const Eigen::VectorXcd& t) {
-  if (f.size() != t.size() || f.size() < 2) throw std::invalid_argument("phase_slope_delay: need >= 2 points of f and T");
+  if (f.size() != t.size() || f.size() < 2)
+    throw std::invalid_argument("phase_slope_delay: need >= 2 points of f and T");
   double num = 0, den = 0, prev = 0, unwrap = 0;
   for (Eigen::Index k = 0; k < f.size(); ++k) {
     double ph = std::arg(t[k]);
@@ -115,8 +122,10 @@ Eigen::VectorXcd divider_impedance(const Eigen::VectorXcd& t, double r1) {
   return r1 * t.array() / (1.0 - t.array());
 }
 
-Eigen::VectorXcd deskew_impedance(const Eigen::VectorXd& f, const Eigen::VectorXcd& z, double r1, double skew_s) {
-  if (f.size() != z.size()) throw std::invalid_argument("deskew_impedance: f and Z differ in length");
+Eigen::VectorXcd deskew_impedance(const Eigen::VectorXd& f, const Eigen::VectorXcd& z, double r1,
+                                  double skew_s) {
+  if (f.size() != z.size())
+    throw std::invalid_argument("deskew_impedance: f and Z differ in length");
   if (!(r1 > 0)) throw std::invalid_argument("deskew_impedance: R1 must be positive");
   Eigen::VectorXcd t = divider_transfer(z, r1);
   for (Eigen::Index k = 0; k < f.size(); ++k) t[k] *= std::exp(cd(0.0, kTwoPi * f[k] * skew_s));

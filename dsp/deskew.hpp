@@ -40,10 +40,10 @@ double phase_slope_delay(const Eigen::VectorXd& f_hz, const Eigen::VectorXcd& t_
 // sub-sample position of its own, so a plain fractional delay (or a phase
 // ramp on the spectrum) would smear it over the neighbouring samples; here it
 // lands exactly on jump_index, as in channel 1. A sample that falls exactly
-// on the jump (within 0.05 sample: an integer delay, or none) is left out of both sides. Samples beyond
-// the record's ends are extrapolated from the nearest ones. Same length as x.
-std::vector<double> deskew_channel(std::span<const double> x, double sample_rate_hz, std::size_t jump_index,
-                                   double delay_s);
+// on the jump (within 0.05 sample: an integer delay, or none) is left out of both sides. Samples
+// beyond the record's ends are extrapolated from the nearest ones. Same length as x.
+std::vector<double> deskew_channel(std::span<const double> x, double sample_rate_hz,
+                                   std::size_t jump_index, double delay_s);
 
 // Z → T = Z/(Z + R1) and back.
 Eigen::VectorXcd divider_transfer(const Eigen::VectorXcd& z_ohm, double r1_ohm);
@@ -52,7 +52,7 @@ Eigen::VectorXcd divider_impedance(const Eigen::VectorXcd& t, double r1_ohm);
 // Removes a channel-2 delay `skew_s` from an impedance estimated with nominal
 // R1 `r1_ohm`: Z(f) and (first order) the per-point σ. Positive skew: v2 sampled late.
 void deskew_impedance(ImpedanceResult& r, double r1_ohm, double skew_s);
-Eigen::VectorXcd deskew_impedance(const Eigen::VectorXd& f_hz, const Eigen::VectorXcd& z_ohm, double r1_ohm,
-                                  double skew_s);
+Eigen::VectorXcd deskew_impedance(const Eigen::VectorXd& f_hz, const Eigen::VectorXcd& z_ohm,
+                                  double r1_ohm, double skew_s);
 
 }  // namespace piezo::dsp

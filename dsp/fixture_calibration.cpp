@@ -14,9 +14,9 @@ constexpr double kTwoPi = 2.0 * std::numbers::pi;
 enum P { kU, kBeta, kTau, kRho, kRs, kParams };
 
 struct Point {
-  int standard;  // 0 open, 1 short, 2 load
-  double w;      // rad/s
-  cd t;          // measured transfer
+  int standard;      // 0 open, 1 short, 2 load
+  double w;          // rad/s
+  cd t;              // measured transfer
   double inv_sigma;  // 1/σ per real component
 };
 
@@ -27,23 +27,29 @@ struct Model {
     cd yb = 0.0;
     if (p.standard == 1) yb = 1.0 / th[kRs];
     if (p.standard == 2) yb = 1.0 / (th[kRs] + load.impedance(p.w / kTwoPi));
-    return std::exp(cd(0.0, -p.w * th[kTau])) / (th[kU] + cd(0.0, p.w * th[kBeta]) + th[kRho] * r1n * yb);
+    return std::exp(cd(0.0, -p.w * th[kTau])) /
+           (th[kU] + cd(0.0, p.w * th[kBeta]) + th[kRho] * r1n * yb);
   }
 };
 }  // namespace
 
 FixtureCalibration fit_fixture(const CalibrationStandards& s) {
   const char* who = "fit_fixture";
-  if (!s.open && !s.shrt && !s.load) throw std::invalid_argument(std::string(who) + ": no calibration standard");
-  if (!(s.r1_nominal_ohm > 0)) throw std::invalid_argument(std::string(who) + ": nominal R1 must be positive");
-  if (s.load && !(s.load_value.ohm > 0)) throw std::invalid_argument(std::string(who) + ": load value must be positive");
+  if (!s.open && !s.shrt && !s.load)
+    throw std::invalid_argument(std::string(who) + ": no calibration standard");
+  if (!(s.r1_nominal_ohm > 0))
+    throw std::invalid_argument(std::string(who) + ": nominal R1 must be positive");
+  if (s.load && !(s.load_value.ohm > 0))
+    throw std::invalid_argument(std::string(who) + ": load value must be positive");
   const double r1 = s.r1_nominal_ohm;
   std::vector<Point> pts;
   auto add = [&](const std::optional<MeasuredStandard>& m, int id) {
     if (!m) return;
-    if (m->f_hz.size() != m->z_ohm.size()) throw std::invalid_argument(std::string(who) + ": f and Z differ in length");
+    if (m->f_hz.size() != m->z_ohm.size())
+      throw std::invalid_argument(std::string(who) + ": f and Z differ in length");
     double tscale = 0;
-    for (Eigen::Index k = 0; k < m->f_hz.size(); ++k) tscale += std::abs(m->z_ohm[k] / (m->z_ohm[k] + r1));
+    for (Eigen::Index k = 0; k < m->f_hz.size(); ++k)
+      tscale += std::abs(m->z_ohm[k] / (m->z_ohm[k] + r1));
     tscale /= std::max<double>(1.0, double(m->f_hz.size()));
     for (Eigen::Index k = 0; k < m->f_hz.size(); ++k) {
       if (!(m->f_hz[k] > 0)) continue;
@@ -51,7 +57,8 @@ FixtureCalibration fit_fixture(const CalibrationStandards& s) {
       if (!std::isfinite(z.real()) || !std::isfinite(z.imag())) continue;
       const cd t = z / (z + r1);
       double sigma_t = 1e-3 * tscale;  // equal weights without σ
-      if (m->z_sigma_ohm.size() == m->f_hz.size()) sigma_t = r1 / std::norm(z + r1) * m->z_sigma_ohm[k] / std::sqrt(2.0);
+      if (m->z_sigma_ohm.size() == m->f_hz.size())
+        sigma_t = r1 / std::norm(z + r1) * m->z_sigma_ohm[k] / std::sqrt(2.0);
       if (!(sigma_t > 0) || !std::isfinite(sigma_t)) continue;
       pts.push_back({id, kTwoPi * m->f_hz[k], t, 1.0 / sigma_t});
     }
@@ -59,7 +66,8 @@ FixtureCalibration fit_fixture(const CalibrationStandards& s) {
   add(s.open, 0);
   add(s.shrt, 1);
   add(s.load, 2);
-  if (pts.size() < 8) throw std::invalid_argument(std::string(who) + ": fewer than 8 usable frequency points");
+  if (pts.size() < 8)
+    throw std::invalid_argument(std::string(who) + ": fewer than 8 usable frequency points");
   const Model model{r1, s.load_value};
 
   FixtureCalibration out;
@@ -68,8 +76,11 @@ FixtureCalibration fit_fixture(const CalibrationStandards& s) {
   free[kU] = free[kBeta] = s.open.has_value();
   free[kRs] = s.shrt.has_value();
   free[kRho] = s.load.has_value();
-  if (!s.open) out.assumptions.push_back("no open standard: DAQ input and fixture capacitance taken as absent (u = 1, beta = 0)");
-  if (!s.shrt && s.load) out.assumptions.push_back("no short standard: lead resistance taken as 0 in the R1 error");
+  if (!s.open)
+    out.assumptions.push_back(
+        "no open standard: DAQ input and fixture capacitance taken as absent (u = 1, beta = 0)");
+  if (!s.shrt && s.load)
+    out.assumptions.push_back("no short standard: lead resistance taken as 0 in the R1 error");
   if (!s.load) out.assumptions.push_back("no load standard: R1 taken as nominal (rho = 1)");
 
   // Start values from the raw standards: 1/T_m ≈ u + jω(β + τ) + ρ·R1·Y_b.
@@ -119,7 +130,8 @@ FixtureCalibration fit_fixture(const CalibrationStandards& s) {
       const double h = 1e-6 * scale[i];
       tp[i] += h;
       tm[i] -= h;
-      j.col(c) = (residual(tp) - residual(tm)) / (2 * h) * scale[i];  // per unit of scaled parameter
+      j.col(c) =
+          (residual(tp) - residual(tm)) / (2 * h) * scale[i];  // per unit of scaled parameter
     }
     return j;
   };
@@ -136,7 +148,8 @@ FixtureCalibration fit_fixture(const CalibrationStandards& s) {
       a.diagonal() += lambda * jtj.diagonal().cwiseMax(1e-30);
       const Eigen::VectorXd step = a.ldlt().solve(-g);
       auto tn = th;
-      for (Eigen::Index c = 0; c < np; ++c) tn[idx[static_cast<std::size_t>(c)]] += step[c] * scale[idx[static_cast<std::size_t>(c)]];
+      for (Eigen::Index c = 0; c < np; ++c)
+        tn[idx[static_cast<std::size_t>(c)]] += step[c] * scale[idx[static_cast<std::size_t>(c)]];
       if (tn[kRs] < 0 || tn[kRho] <= 0 || tn[kU] <= 0) {
         lambda *= 10;
         continue;

@@ -34,10 +34,12 @@ struct CalibrationStandards {
 };
 
 struct FixtureCalibration {
-  std::optional<double> fixture_capacitance_f, lead_resistance_ohm, r1_error, skew_s, open_dc_transfer;
-  std::optional<double> fixture_capacitance_sigma_f, lead_resistance_sigma_ohm, r1_error_sigma, skew_sigma_s,
-      open_dc_transfer_sigma;
-  double chi2_reduced = 0.0;  // of the physical fit: ~1 when the fixture model explains the standards
+  std::optional<double> fixture_capacitance_f, lead_resistance_ohm, r1_error, skew_s,
+      open_dc_transfer;
+  std::optional<double> fixture_capacitance_sigma_f, lead_resistance_sigma_ohm, r1_error_sigma,
+      skew_sigma_s, open_dc_transfer_sigma;
+  double chi2_reduced =
+      0.0;  // of the physical fit: ~1 when the fixture model explains the standards
   double residual_rel_rms = 0.0;  // rms |T_m − T_fit|/|T_fit|
   bool converged = false;
   int iterations = 0;

@@ -36,7 +36,8 @@ namespace piezo::dsp {
 
 enum class FixtureModel { None, Open, Short, OpenShort, OpenShortLoad };
 
-std::string_view to_string(FixtureModel m);  // "none", "open", "short", "open-short", "open-short-load"
+std::string_view to_string(
+    FixtureModel m);  // "none", "open", "short", "open-short", "open-short-load"
 std::optional<FixtureModel> parse_fixture_model(std::string_view s);
 // One sentence: which model of the fixture the correction assumes.
 std::string describe(FixtureModel m);
@@ -52,8 +53,9 @@ class FixtureCompensation {
  public:
   // `model` must be supported by the standards given (throws std::invalid_argument
   // naming the missing standard); model None corrects nothing.
-  FixtureCompensation(FixtureModel model, std::optional<StandardModel> open, std::optional<StandardModel> shrt,
-                      std::optional<StandardModel> load, LoadStandard load_value = {});
+  FixtureCompensation(FixtureModel model, std::optional<StandardModel> open,
+                      std::optional<StandardModel> shrt, std::optional<StandardModel> load,
+                      LoadStandard load_value = {});
 
   // The most complete model the present standards support (None if none).
   static FixtureModel best_model(bool open, bool shrt, bool load);

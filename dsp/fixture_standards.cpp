@@ -22,7 +22,8 @@ cd StandardModel::impedance(double f) const {
   // Below the lowest bin the polynomial extends smoothly to DC; above the band it is unknown.
   if (!(f >= 0.0 && f <= 1.000001 * fmax_hz))
     throw std::invalid_argument("calibration standard evaluated at " + std::to_string(f) +
-                                " Hz, above the band it was measured over (up to " + std::to_string(fmax_hz) +
+                                " Hz, above the band it was measured over (up to " +
+                                std::to_string(fmax_hz) +
                                 " Hz): measure the standards over the whole band of the estimate");
   const double x = kTwoPi * f / omega_scale;
   cd v = 0;
@@ -45,28 +46,33 @@ double StandardModel::impedance_sigma(double f) const {
   return admittance ? sx / std::norm(v) : sx;  // δZ = −δY/Y²
 }
 
-StandardModel fit_standard(const MeasuredStandard& m, bool as_admittance, int degree, const std::string& what) {
+StandardModel fit_standard(const MeasuredStandard& m, bool as_admittance, int degree,
+                           const std::string& what) {
   const std::string who = "fit_standard (" + what + ")";
   if (degree < 1 || degree > 8) throw std::invalid_argument(who + ": degree must be 1..8");
-  if (m.f_hz.size() != m.z_ohm.size() || (m.z_sigma_ohm.size() && m.z_sigma_ohm.size() != m.f_hz.size()))
+  if (m.f_hz.size() != m.z_ohm.size() ||
+      (m.z_sigma_ohm.size() && m.z_sigma_ohm.size() != m.f_hz.size()))
     throw std::invalid_argument(who + ": f, Z and sigma differ in length");
   std::vector<Eigen::Index> idx;
   for (Eigen::Index k = 0; k < m.f_hz.size(); ++k) {
     if (!(m.f_hz[k] > 0)) continue;
     if (!std::isfinite(m.z_ohm[k].real()) || !std::isfinite(m.z_ohm[k].imag()) || m.z_ohm[k] == 0.0)
-      throw std::invalid_argument(who + ": impedance at " + std::to_string(m.f_hz[k]) + " Hz is not finite/non-zero");
+      throw std::invalid_argument(who + ": impedance at " + std::to_string(m.f_hz[k]) +
+                                  " Hz is not finite/non-zero");
     idx.push_back(k);
   }
   const auto n = static_cast<Eigen::Index>(idx.size());
   const int p = degree + 1;
   if (n < 2 * p)
-    throw std::invalid_argument(who + ": " + std::to_string(n) + " frequency points for " + std::to_string(p) +
-                                " coefficients (need at least " + std::to_string(2 * p) + ")");
+    throw std::invalid_argument(who + ": " + std::to_string(n) + " frequency points for " +
+                                std::to_string(p) + " coefficients (need at least " +
+                                std::to_string(2 * p) + ")");
   StandardModel sm;
   sm.admittance = as_admittance;
   sm.fmin_hz = m.f_hz[idx.front()];
   sm.fmax_hz = m.f_hz[idx.back()];
-  for (auto k : idx) sm.fmin_hz = std::min(sm.fmin_hz, m.f_hz[k]), sm.fmax_hz = std::max(sm.fmax_hz, m.f_hz[k]);
+  for (auto k : idx)
+    sm.fmin_hz = std::min(sm.fmin_hz, m.f_hz[k]), sm.fmax_hz = std::max(sm.fmax_hz, m.f_hz[k]);
   sm.omega_scale = kTwoPi * sm.fmax_hz;
   // Rows: real and imaginary parts of every point, weighted by 1/σ of X.
   Eigen::MatrixXd a(2 * n, p);
@@ -86,11 +92,12 @@ StandardModel fit_standard(const MeasuredStandard& m, bool as_admittance, int de
     if (m.z_sigma_ohm.size()) {
       const double sz = m.z_sigma_ohm[k];
       sigma = as_admittance ? sz / std::norm(m.z_ohm[k]) : sz;  // δY = −δZ/Z²
-      sigma /= std::sqrt(2.0);  // per real component
+      sigma /= std::sqrt(2.0);                                  // per real component
     } else {
       sigma = 1e-3 * std::max(std::abs(x), 1e-9 * xscale);  // relative weights
     }
-    if (!(sigma > 0) || !std::isfinite(sigma)) throw std::invalid_argument(who + ": non-positive sigma");
+    if (!(sigma > 0) || !std::isfinite(sigma))
+      throw std::invalid_argument(who + ": non-positive sigma");
     w[i] = 1.0 / sigma;
     const double xf = kTwoPi * m.f_hz[k] / sm.omega_scale;
     for (int j = 0; j < p; ++j) {
@@ -104,10 +111,12 @@ StandardModel fit_standard(const MeasuredStandard& m, bool as_admittance, int de
   // Column scaling for conditioning, then QR.
   Eigen::VectorXd cs = a.colwise().norm().transpose();
   for (int j = 0; j < p; ++j)
-    if (!(cs[j] > 0)) throw std::invalid_argument(who + ": degenerate fit (a basis function vanishes)");
+    if (!(cs[j] > 0))
+      throw std::invalid_argument(who + ": degenerate fit (a basis function vanishes)");
   const Eigen::MatrixXd as = a * cs.cwiseInverse().asDiagonal();
   Eigen::ColPivHouseholderQR<Eigen::MatrixXd> qr(as);
-  if (qr.rank() < p) throw std::invalid_argument(who + ": degenerate fit (rank " + std::to_string(qr.rank()) + ")");
+  if (qr.rank() < p)
+    throw std::invalid_argument(who + ": degenerate fit (rank " + std::to_string(qr.rank()) + ")");
   sm.c = qr.solve(y).cwiseQuotient(cs);
   const Eigen::VectorXd r = a * sm.c - y;
   const double dof = double(2 * n - p);

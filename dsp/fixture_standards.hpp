@@ -26,11 +26,12 @@ struct MeasuredStandard {
 };
 
 struct StandardModel {
-  bool admittance = false;      // the polynomial is Y (open) or Z (short, load)
-  double omega_scale = 1.0;     // ω_s, rad/s
-  double fmin_hz = 0, fmax_hz = 0;  // fitted range (evaluation above fmax throws; below fmin it extends to DC)
-  Eigen::VectorXd c;            // real coefficients c_0..c_deg
-  Eigen::MatrixXd cov;          // their covariance (from the weights, scaled by the reduced χ² when > 1)
+  bool admittance = false;   // the polynomial is Y (open) or Z (short, load)
+  double omega_scale = 1.0;  // ω_s, rad/s
+  double fmin_hz = 0,
+         fmax_hz = 0;   // fitted range (evaluation above fmax throws; below fmin it extends to DC)
+  Eigen::VectorXd c;    // real coefficients c_0..c_deg
+  Eigen::MatrixXd cov;  // their covariance (from the weights, scaled by the reduced χ² when > 1)
   double residual_rel_rms = 0;  // rms of |X_meas − X_fit|/|X_fit| over the points
   double chi2_reduced = 0;      // Σ(|r|/σ)²/(2n − p); ~1 when the model fits to the noise
   std::size_t points = 0;
@@ -44,6 +45,7 @@ struct StandardModel {
 // Weighted LS fit of a standard, `degree` ≤ 8 (≥ 1), over the points with f > 0.
 // Throws std::invalid_argument naming the standard (`what`) for too few points,
 // non-finite values or a degenerate fit.
-StandardModel fit_standard(const MeasuredStandard& m, bool as_admittance, int degree, const std::string& what);
+StandardModel fit_standard(const MeasuredStandard& m, bool as_admittance, int degree,
+                           const std::string& what);
 
 }  // namespace piezo::dsp

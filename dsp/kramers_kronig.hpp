@@ -31,11 +31,11 @@
 namespace piezo::dsp {
 
 struct KramersKronigOptions {
-  int pole_pairs = 0;       // 0: automatic, 2 + the |Z| extrema found in the band, at least 4
+  int pole_pairs = 0;  // 0: automatic, 2 + the |Z| extrema found in the band, at least 4
   int iterations = 15;
   double threshold_rel = 0.005;  // rms relative residual for a pass without σ
-  double noise_factor = 3.0;     // with σ: also pass while the residual is within this × the noise
-  double max_pole_ratio = 0.0;   // 0: poles anywhere (see VectorFitOptions)
+  double noise_factor = 3.0;    // with σ: also pass while the residual is within this × the noise
+  double max_pole_ratio = 0.0;  // 0: poles anywhere (see VectorFitOptions)
 };
 
 struct KramersKronigResult {
@@ -44,9 +44,9 @@ struct KramersKronigResult {
   double rms_residual = 0.0, max_residual = 0.0, max_residual_f_hz = 0.0;
   double rms_residual_z = 0.0, rms_residual_y = 0.0;
   Eigen::VectorXd f_hz;
-  Eigen::VectorXd residual;    // per f: the largest of the Z-, Y-form and passivity residuals
+  Eigen::VectorXd residual;  // per f: the largest of the Z-, Y-form and passivity residuals
   Eigen::VectorXd residual_z, residual_y;
-  Eigen::VectorXd passivity;   // per f: max(0, −Re Z)/|Z|
+  Eigen::VectorXd passivity;  // per f: max(0, −Re Z)/|Z|
   double max_passivity = 0.0, max_passivity_f_hz = 0.0;
   bool causal = false, passive = false;
   int pole_pairs = 0;
@@ -56,6 +56,7 @@ struct KramersKronigResult {
 // z_sigma (same length or empty): sqrt(E|δZ|²) per point. Throws
 // std::invalid_argument for mismatched lengths, < 16 points, non-finite Z.
 KramersKronigResult kramers_kronig_check(const Eigen::VectorXd& f_hz, const Eigen::VectorXcd& z_ohm,
-                                         const Eigen::VectorXd& z_sigma_ohm, const KramersKronigOptions& opt = {});
+                                         const Eigen::VectorXd& z_sigma_ohm,
+                                         const KramersKronigOptions& opt = {});
 
 }  // namespace piezo::dsp

@@ -8,9 +8,12 @@ namespace piezo::dsp {
 
 const char* to_string(PoleStability s) {
   switch (s) {
-    case PoleStability::New: return "new";
-    case PoleStability::StableFrequency: return "stable_freq";
-    case PoleStability::Stable: return "stable";
+    case PoleStability::New:
+      return "new";
+    case PoleStability::StableFrequency:
+      return "stable_freq";
+    case PoleStability::Stable:
+      return "stable";
   }
   return "new";
 }
@@ -18,7 +21,8 @@ const char* to_string(PoleStability s) {
 StabilizationChart stabilization_chart(const DividerRecord& rec, const PronyImpedanceOptions& opt,
                                        const StabilizationOptions& s) {
   if (s.min_order < 1 || s.max_order < s.min_order || s.step < 1)
-    throw std::invalid_argument("stabilization_chart: need 1 <= min_order <= max_order and step >= 1");
+    throw std::invalid_argument(
+        "stabilization_chart: need 1 <= min_order <= max_order and step >= 1");
   if (!(s.freq_tol > 0) || !(s.damping_tol > 0))
     throw std::invalid_argument("stabilization_chart: tolerances must be positive");
   StabilizationChart chart;
@@ -51,7 +55,8 @@ StabilizationChart stabilization_chart(const DividerRecord& rec, const PronyImpe
         for (const auto& r : previous) {
           const double df = std::abs(q.freq_hz - r.freq_hz) / std::max(r.freq_hz, 1e-300);
           if (df > s.freq_tol) continue;
-          const double dz = std::abs(q.damping_ratio - r.damping_ratio) / std::max(std::abs(r.damping_ratio), 1e-300);
+          const double dz = std::abs(q.damping_ratio - r.damping_ratio) /
+                            std::max(std::abs(r.damping_ratio), 1e-300);
           if (dz <= s.damping_tol) {
             sp.stability = PoleStability::Stable;
             break;

@@ -32,9 +32,10 @@ struct StabilizationPole {
 };
 
 struct StabilizationChart {
-  std::vector<std::size_t> orders;      // the orders fitted (an order the data cannot carry is left out)
+  std::vector<std::size_t>
+      orders;  // the orders fitted (an order the data cannot carry is left out)
   std::vector<StabilizationPole> poles;  // Im λ ≥ 0, f ≤ fmax, every order
-  std::size_t selected_order = 0;        // the order the automatic rule picks (eqs 162-163), 0 if not run
+  std::size_t selected_order = 0;  // the order the automatic rule picks (eqs 162-163), 0 if not run
 };
 
 // The chart for the impedance fit of `rec` with `opt` (its order overridden

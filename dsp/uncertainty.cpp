@@ -13,11 +13,12 @@ using cd = std::complex<double>;
 bool ImpedanceBand::covers(Eigen::Index k, cd z) const {
   const double da = std::abs(std::abs(z) - abs_ohm[k]);
   double dp = std::remainder(std::arg(z) - phase_rad[k], 2.0 * M_PI);
-  return da <= coverage_factor * abs_sigma_ohm[k] && std::abs(dp) <= coverage_factor * phase_sigma_rad[k];
+  return da <= coverage_factor * abs_sigma_ohm[k] &&
+         std::abs(dp) <= coverage_factor * phase_sigma_rad[k];
 }
 
-ImpedanceBand band_from_sigma(const Eigen::VectorXd& f, const Eigen::VectorXcd& z, const Eigen::VectorXd& sigma,
-                              double k, std::string source) {
+ImpedanceBand band_from_sigma(const Eigen::VectorXd& f, const Eigen::VectorXcd& z,
+                              const Eigen::VectorXd& sigma, double k, std::string source) {
   if (z.size() != f.size() || (sigma.size() && sigma.size() != f.size()))
     throw std::invalid_argument("band_from_sigma: f, Z and sigma differ in length");
   ImpedanceBand b;
@@ -39,11 +40,13 @@ ImpedanceBand band_from_sigma(const Eigen::VectorXd& f, const Eigen::VectorXcd& 
 }
 
 ImpedanceBand band_from_replicates(const Eigen::VectorXd& f, const Eigen::VectorXcd& z,
-                                   const std::vector<Eigen::VectorXcd>& reps, std::size_t shots, double k,
-                                   std::string source) {
-  if (reps.size() < 2) throw std::invalid_argument("band_from_replicates: need at least 2 replicates");
+                                   const std::vector<Eigen::VectorXcd>& reps, std::size_t shots,
+                                   double k, std::string source) {
+  if (reps.size() < 2)
+    throw std::invalid_argument("band_from_replicates: need at least 2 replicates");
   for (const auto& r : reps)
-    if (r.size() != f.size()) throw std::invalid_argument("band_from_replicates: a replicate has another grid");
+    if (r.size() != f.size())
+      throw std::invalid_argument("band_from_replicates: a replicate has another grid");
   ImpedanceBand b = band_from_sigma(f, z, Eigen::VectorXd(), k, std::move(source));
   const double n = double(reps.size());
   const double inflate = shots > 1 ? std::sqrt(double(shots) / double(shots - 1)) : 1.0;
@@ -67,7 +70,8 @@ ImpedanceBand band_from_replicates(const Eigen::VectorXd& f, const Eigen::Vector
 }
 
 void add_in_quadrature(ImpedanceBand& b, const Eigen::VectorXd& sigma) {
-  if (sigma.size() != b.size()) throw std::invalid_argument("add_in_quadrature: sigma has another length");
+  if (sigma.size() != b.size())
+    throw std::invalid_argument("add_in_quadrature: sigma has another length");
   for (Eigen::Index i = 0; i < b.size(); ++i) {
     const double sa = sigma[i] / std::sqrt(2.0), sp = sigma[i] / (std::sqrt(2.0) * b.abs_ohm[i]);
     b.abs_sigma_ohm[i] = std::hypot(b.abs_sigma_ohm[i], sa);

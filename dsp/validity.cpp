@@ -21,8 +21,8 @@ bool is_clipped(const DividerRecord& r) {
 }
 }  // namespace
 
-ValidityReport check_shots(std::span<const DividerRecord> records, const PronyImpedanceOptions& prony,
-                           const ShotValidityOptions& opt) {
+ValidityReport check_shots(std::span<const DividerRecord> records,
+                           const PronyImpedanceOptions& prony, const ShotValidityOptions& opt) {
   if (records.empty()) throw std::invalid_argument("check_shots: no shot");
   ValidityReport rep;
   rep.shots.resize(records.size());
@@ -32,7 +32,8 @@ ValidityReport check_shots(std::span<const DividerRecord> records, const PronyIm
   std::vector<Eigen::VectorXcd> x1, x2;
   std::size_t n = 0;
   for (const auto& r : records) {
-    const std::size_t avail = r.v1.size() > r.pretrigger_samples ? r.v1.size() - r.pretrigger_samples : 0;
+    const std::size_t avail =
+        r.v1.size() > r.pretrigger_samples ? r.v1.size() - r.pretrigger_samples : 0;
     n = n == 0 ? avail : std::min(n, avail);
   }
   prep.max_samples = n;
@@ -110,14 +111,18 @@ ValidityReport check_shots(std::span<const DividerRecord> records, const PronyIm
       const auto m = fit_prony_impedance(records[k], po);
       const DividerSignals s = prepare_divider(records[k], "check_shots", po.prep);
       const double n1 = estimate_noise_std(s.v1), n2 = estimate_noise_std(s.v2);
-      auto ratio = [](double res, double noise) { return noise > 0 ? res / noise : (res > 0 ? INFINITY : 1.0); };
-      sv.reconstruction_ratio = std::max(ratio(m.fit.residual_rms[0], n1), ratio(m.fit.residual_rms[1], n2));
+      auto ratio = [](double res, double noise) {
+        return noise > 0 ? res / noise : (res > 0 ? INFINITY : 1.0);
+      };
+      sv.reconstruction_ratio =
+          std::max(ratio(m.fit.residual_rms[0], n1), ratio(m.fit.residual_rms[1], n2));
     } catch (const std::invalid_argument&) {
       sv.reconstruction_ratio = kNaN;
       sv.flags.emplace_back("Prony fit failed");
       continue;
     }
-    if (!(sv.reconstruction_ratio <= opt.max_reconstruction_ratio)) sv.flags.emplace_back("poor Prony reconstruction");
+    if (!(sv.reconstruction_ratio <= opt.max_reconstruction_ratio))
+      sv.flags.emplace_back("poor Prony reconstruction");
   }
   return rep;
 }

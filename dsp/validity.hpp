@@ -27,15 +27,18 @@ struct ShotValidityOptions {
   double fmin_hz = 0.0, fmax_hz = 0.0;  // band of the coherence (fmax 0: fs/4)
   double min_shot_coherence = 0.98;     // c_k below: flagged "low coherence"
   double min_coherence = 0.9;           // γ²(f) below: that frequency is listed as low
-  double max_reconstruction_ratio = 3.0;  // residual/noise above: flagged "poor Prony reconstruction"
-  std::size_t prony_samples = 0;        // samples from t = 0 for the reconstruction (0: as many as opt.prep says)
+  double max_reconstruction_ratio =
+      3.0;  // residual/noise above: flagged "poor Prony reconstruction"
+  std::size_t prony_samples =
+      0;  // samples from t = 0 for the reconstruction (0: as many as opt.prep says)
 };
 
 struct ShotValidity {
   bool clipped = false;
-  double coherence = kNaN;            // c_k (NaN with a single shot)
-  double reconstruction_ratio = kNaN; // max over v1, v2 of residual rms / noise std (NaN: not fitted)
-  std::vector<std::string> flags;     // "clipped", "low coherence", "poor Prony reconstruction"
+  double coherence = kNaN;  // c_k (NaN with a single shot)
+  double reconstruction_ratio =
+      kNaN;                        // max over v1, v2 of residual rms / noise std (NaN: not fitted)
+  std::vector<std::string> flags;  // "clipped", "low coherence", "poor Prony reconstruction"
 };
 
 struct ValidityReport {
@@ -46,7 +49,7 @@ struct ValidityReport {
 
 // `records` are repeated shots of one drive; `prony` the estimate's options
 // (its order, if set, is used for the reconstruction; else the automatic one).
-ValidityReport check_shots(std::span<const DividerRecord> records, const PronyImpedanceOptions& prony,
-                           const ShotValidityOptions& opt = {});
+ValidityReport check_shots(std::span<const DividerRecord> records,
+                           const PronyImpedanceOptions& prony, const ShotValidityOptions& opt = {});
 
 }  // namespace piezo::dsp

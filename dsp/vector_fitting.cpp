@@ -68,9 +68,12 @@ PoleSet relocate(const PoleSet& p, const Eigen::VectorXd& ct, double rmax) {
     cd z = es.eigenvalues()[k];
     if (z.real() > 0) z = cd(-z.real(), z.imag());  // reflect into the left half-plane
     if (z.real() == 0) z = cd(-1e-9, z.imag());
-    if (rmax > 0 && std::abs(z) > rmax) z *= rmax / std::abs(z);  // normalised units: ω_s = 2π·f_max
-    if (std::abs(z.imag()) < 1e-12 * std::max(1.0, std::abs(z))) out.real.push_back(z.real());
-    else if (z.imag() > 0) out.pairs.push_back(z);
+    if (rmax > 0 && std::abs(z) > rmax)
+      z *= rmax / std::abs(z);  // normalised units: ω_s = 2π·f_max
+    if (std::abs(z.imag()) < 1e-12 * std::max(1.0, std::abs(z)))
+      out.real.push_back(z.real());
+    else if (z.imag() > 0)
+      out.pairs.push_back(z);
   }
   // A lone complex eigenvalue without its conjugate cannot happen for a real matrix,
   // but rounding may split a near-real pair: keep the count.
@@ -85,23 +88,27 @@ cd VectorFit::eval(cd s) const {
   return v;
 }
 
-VectorFit vector_fit(const Eigen::VectorXd& f, const Eigen::VectorXcd& h, const Eigen::VectorXd& weights,
-                     const VectorFitOptions& opt) {
+VectorFit vector_fit(const Eigen::VectorXd& f, const Eigen::VectorXcd& h,
+                     const Eigen::VectorXd& weights, const VectorFitOptions& opt) {
   const char* who = "vector_fit";
   const Eigen::Index n = f.size();
   if (h.size() != n || (weights.size() && weights.size() != n))
     throw std::invalid_argument(std::string(who) + ": f, H and weights differ in length");
-  if (opt.pole_pairs < 1 || opt.iterations < 1) throw std::invalid_argument(std::string(who) + ": need >= 1 pole pair and iteration");
+  if (opt.pole_pairs < 1 || opt.iterations < 1)
+    throw std::invalid_argument(std::string(who) + ": need >= 1 pole pair and iteration");
   const int np = 2 * opt.pole_pairs;
   const int nextra = int(opt.proper_term) + int(opt.slope_term);
   if (2 * n < 2 * np + nextra + 2)
-    throw std::invalid_argument(std::string(who) + ": " + std::to_string(n) + " samples are too few for " +
-                                std::to_string(opt.pole_pairs) + " pole pairs");
+    throw std::invalid_argument(std::string(who) + ": " + std::to_string(n) +
+                                " samples are too few for " + std::to_string(opt.pole_pairs) +
+                                " pole pairs");
   double fmin = f.minCoeff(), fmax = f.maxCoeff();
-  if (!(fmin >= 0) || !(fmax > 0)) throw std::invalid_argument(std::string(who) + ": frequencies must be >= 0, not all 0");
+  if (!(fmin >= 0) || !(fmax > 0))
+    throw std::invalid_argument(std::string(who) + ": frequencies must be >= 0, not all 0");
   for (Eigen::Index k = 0; k < n; ++k)
     if (!std::isfinite(h[k].real()) || !std::isfinite(h[k].imag()))
-      throw std::invalid_argument(std::string(who) + ": non-finite sample at " + std::to_string(f[k]) + " Hz");
+      throw std::invalid_argument(std::string(who) + ": non-finite sample at " +
+                                  std::to_string(f[k]) + " Hz");
   const double ws = kTwoPi * fmax;
   std::vector<cd> s(static_cast<std::size_t>(n));
   Eigen::VectorXd w(n);
@@ -113,7 +120,8 @@ VectorFit vector_fit(const Eigen::VectorXd& f, const Eigen::VectorXcd& h, const 
   PoleSet poles;
   const double lo = std::max(fmin, fmax / 100.0) / fmax;
   for (int i = 0; i < opt.pole_pairs; ++i) {
-    const double b = lo + (1.0 - lo) * (opt.pole_pairs == 1 ? 0.5 : double(i) / (opt.pole_pairs - 1));
+    const double b =
+        lo + (1.0 - lo) * (opt.pole_pairs == 1 ? 0.5 : double(i) / (opt.pole_pairs - 1));
     poles.pairs.push_back(cd(-b / 100.0, b));
   }
   std::vector<cd> phi;
@@ -126,11 +134,13 @@ VectorFit vector_fit(const Eigen::VectorXd& f, const Eigen::VectorXcd& h, const 
       const cd sk = s[static_cast<std::size_t>(k)];
       basis_row(poles, sk, phi);
       std::vector<cd> row(static_cast<std::size_t>(nu));
-      for (int j = 0; j < nc; ++j) row[static_cast<std::size_t>(j)] = phi[static_cast<std::size_t>(j)];
+      for (int j = 0; j < nc; ++j)
+        row[static_cast<std::size_t>(j)] = phi[static_cast<std::size_t>(j)];
       int c = nc;
       if (opt.proper_term) row[static_cast<std::size_t>(c++)] = 1.0;
       if (opt.slope_term) row[static_cast<std::size_t>(c++)] = sk;
-      for (int j = 0; j < nc; ++j) row[static_cast<std::size_t>(c + j)] = -h[k] * phi[static_cast<std::size_t>(j)];
+      for (int j = 0; j < nc; ++j)
+        row[static_cast<std::size_t>(c + j)] = -h[k] * phi[static_cast<std::size_t>(j)];
       for (int j = 0; j < nu; ++j) {
         a(2 * k, j) = row[static_cast<std::size_t>(j)].real() * w[k];
         a(2 * k + 1, j) = row[static_cast<std::size_t>(j)].imag() * w[k];

@@ -33,7 +33,7 @@ struct VectorFit {
 
 // Samples H(j2πf_k), weights w_k (1/σ; empty: 1/|H|). Throws std::invalid_argument
 // for fewer samples than unknowns or non-finite data.
-VectorFit vector_fit(const Eigen::VectorXd& f_hz, const Eigen::VectorXcd& h, const Eigen::VectorXd& weights,
-                     const VectorFitOptions& opt = {});
+VectorFit vector_fit(const Eigen::VectorXd& f_hz, const Eigen::VectorXcd& h,
+                     const Eigen::VectorXd& weights, const VectorFitOptions& opt = {});
 
 }  // namespace piezo::dsp

@@ -18,7 +18,8 @@ void put(json& j, const char* key, const std::optional<T>& v) {
   if (v) j[key] = *v;
 }
 
-json standard_json(const std::optional<dsp::StandardModel>& m, const std::vector<std::string>& shots) {
+json standard_json(const std::optional<dsp::StandardModel>& m,
+                   const std::vector<std::string>& shots) {
   json j;
   j["shots"] = shots;
   if (m) {
@@ -117,7 +118,8 @@ json assessment_json(const acq::ImpedanceAssessment& a) {
                 {"clipped", s.clipped},
                 {"flags", s.flags}};
       o["coherence"] = std::isfinite(s.coherence) ? json(s.coherence) : json(nullptr);
-      o["reconstruction_ratio"] = std::isfinite(s.reconstruction_ratio) ? json(s.reconstruction_ratio) : json(nullptr);
+      o["reconstruction_ratio"] =
+          std::isfinite(s.reconstruction_ratio) ? json(s.reconstruction_ratio) : json(nullptr);
       shots.push_back(o);
     }
     j["validity"] = {{"shots", shots},

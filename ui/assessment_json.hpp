@@ -7,8 +7,9 @@
 //                  load_ohm, load_parallel_f, notes[]}
 //   deskew        {applied, skew_s, skew_ns, source}
 //   uncompensated {re_ohm[], im_ohm[]}      (the estimator on the records as recorded)
-//   uncertainty   {source, coverage_factor, abs_ohm[], abs_sigma_ohm[], phase_deg[], phase_sigma_deg[]}
-//   kramers_kronig{pass, causal, passive, threshold, rms_residual, max_residual, max_residual_f_hz,
+//   uncertainty   {source, coverage_factor, abs_ohm[], abs_sigma_ohm[], phase_deg[],
+//   phase_sigma_deg[]} kramers_kronig{pass, causal, passive, threshold, rms_residual, max_residual,
+//   max_residual_f_hz,
 //                  max_passivity, residual[], note}
 //   validity      {shots[{name, clipped, coherence, reconstruction_ratio, flags[]}],
 //                  low_coherence_fraction, coherence_f_hz[], coherence[]}

@@ -22,11 +22,13 @@ acq::SimSpec fixture_spec(const FixtureSetting& s, std::uint64_t seed, double no
   return spec;
 }
 
-acq::Capture measure_capture(const acq::SimSpec& spec, int shots, bool calibrate, const std::filesystem::path& file) {
+acq::Capture measure_capture(const acq::SimSpec& spec, int shots, bool calibrate,
+                             const std::filesystem::path& file) {
   acq::MeasurementPlan plan;
   plan.setup.divider_r1_ohm = 3140.0;
   plan.shots = shots;
-  auto bench = acq::open_bench({"sim", std::nullopt}, acq::make_sim_bench(spec, plan.setup.divider_r1_ohm));
+  auto bench =
+      acq::open_bench({"sim", std::nullopt}, acq::make_sim_bench(spec, plan.setup.divider_r1_ohm));
   acq::RunnerOptions ro;
   ro.overwrite = true;
   if (calibrate) {
@@ -37,7 +39,8 @@ acq::Capture measure_capture(const acq::SimSpec& spec, int shots, bool calibrate
   return acq::read_capture(file);
 }
 
-std::vector<double> true_peaks(const std::function<std::complex<double>(double)>& truth, double fmax) {
+std::vector<double> true_peaks(const std::function<std::complex<double>(double)>& truth,
+                               double fmax) {
   const auto ft = dsp::find_features(truth, 500.0, 1.05 * fmax, 10.0);
   std::vector<double> p;
   for (const auto& f : ft.resonances) p.push_back(f.f_hz);
@@ -52,7 +55,8 @@ bool near_peak(double f, const std::vector<double>& peaks) {
 }
 
 MaxError max_error(const std::vector<double>& f, const std::vector<std::complex<double>>& z,
-                   const std::function<std::complex<double>(double)>& truth, const std::vector<double>& peaks) {
+                   const std::function<std::complex<double>(double)>& truth,
+                   const std::vector<double>& peaks) {
   MaxError e;
   for (std::size_t k = 0; k < f.size(); ++k) {
     if (near_peak(f[k], peaks)) continue;

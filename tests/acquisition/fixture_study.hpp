@@ -25,7 +25,8 @@ acq::SimSpec fixture_spec(const FixtureSetting& s, std::uint64_t seed, double no
 // The seed's lab drive (1 V exp_decay, 3000 1/s, 20000 samples at 10 MS/s),
 // `shots` per standard and for the dut; standards open, short, load 1000 ohm
 // when `calibrate`. Written to `file` and read back.
-acq::Capture measure_capture(const acq::SimSpec& spec, int shots, bool calibrate, const std::filesystem::path& file);
+acq::Capture measure_capture(const acq::SimSpec& spec, int shots, bool calibrate,
+                             const std::filesystem::path& file);
 
 struct MaxError {
   double mag_pct = 0, mag_f_hz = 0;  // max | |Z|/|Z_true| − 1 | in %
@@ -34,10 +35,12 @@ struct MaxError {
 };
 
 // Frequencies within ±1.5 % of a true resonance or anti-resonance ("the peaks").
-std::vector<double> true_peaks(const std::function<std::complex<double>(double)>& truth, double fmax_hz);
+std::vector<double> true_peaks(const std::function<std::complex<double>(double)>& truth,
+                               double fmax_hz);
 bool near_peak(double f, const std::vector<double>& peaks);
 
 MaxError max_error(const std::vector<double>& f, const std::vector<std::complex<double>>& z,
-                   const std::function<std::complex<double>(double)>& truth, const std::vector<double>& peaks);
+                   const std::function<std::complex<double>(double)>& truth,
+                   const std::vector<double>& peaks);
 
 }  // namespace piezo::test

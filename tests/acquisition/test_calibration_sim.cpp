@@ -40,28 +40,35 @@ acq::BenchCircuit fixture(double rs, double cp, double rd) {
 cd expected(const acq::BenchCircuit& c, double w) {
   const auto& d = c.dut;
   cd yb = 0;  // the branch from v2 through the lead
-  if (d.kind == K::Short) yb = c.series_resistance_ohm > 0 ? 1.0 / c.series_resistance_ohm : cd(INFINITY);
-  if (d.kind == K::Load) yb = 1.0 / (c.series_resistance_ohm + d.load_ohm / cd(1.0, w * d.load_ohm * d.load_parallel_f));
+  if (d.kind == K::Short)
+    yb = c.series_resistance_ohm > 0 ? 1.0 / c.series_resistance_ohm : cd(INFINITY);
+  if (d.kind == K::Load)
+    yb = 1.0 / (c.series_resistance_ohm + d.load_ohm / cd(1.0, w * d.load_ohm * d.load_parallel_f));
   if (std::isinf(yb.real())) return 0.0;
-  const cd y = cd(std::isfinite(c.daq_input_resistance_ohm) ? 1.0 / c.daq_input_resistance_ohm : 0.0,
-                  w * c.parallel_capacitance_f) + yb;
+  const cd y =
+      cd(std::isfinite(c.daq_input_resistance_ohm) ? 1.0 / c.daq_input_resistance_ohm : 0.0,
+         w * c.parallel_capacitance_f) +
+      yb;
   return 1.0 / (1.0 + c.r1_ohm * y);
 }
 
 TEST(CalibrationStandards, CircuitsFollowCircuitAlgebra) {
-  const drivers::sim::DutSelection duts[] = {{K::Open, 0, 0}, {K::Short, 0, 0}, {K::Load, 1000, 0}, {K::Load, 470, 1e-9}};
-  for (const auto& c0 : {fixture(10, 150e-12, 1e6), fixture(0, 150e-12, INFINITY), fixture(12, 0, INFINITY),
-                         fixture(0, 0, 1e6)}) {
+  const drivers::sim::DutSelection duts[] = {
+      {K::Open, 0, 0}, {K::Short, 0, 0}, {K::Load, 1000, 0}, {K::Load, 470, 1e-9}};
+  for (const auto& c0 : {fixture(10, 150e-12, 1e6), fixture(0, 150e-12, INFINITY),
+                         fixture(12, 0, INFINITY), fixture(0, 0, 1e6)}) {
     for (const auto& d : duts) {
       auto c = c0;
       c.dut = d;
-      if (d.kind == K::Short && c.series_resistance_ohm == 0 && c.parallel_capacitance_f == 0) continue;
+      if (d.kind == K::Short && c.series_resistance_ohm == 0 && c.parallel_capacitance_f == 0)
+        continue;
       acq::DividerStateSpace ss(empty_port(), c);
       for (double f : {1e3, 50e3, 2e6}) {
         const double w = 2 * M_PI * f;
         const cd want = expected(c, w), got = ss.transfer(w);
         EXPECT_LT(std::abs(got - want), 1e-9 * std::max(1.0, std::abs(want)))
-            << int(d.kind) << " Rs " << c.series_resistance_ohm << " Cp " << c.parallel_capacitance_f << " f " << f;
+            << int(d.kind) << " Rs " << c.series_resistance_ohm << " Cp "
+            << c.parallel_capacitance_f << " f " << f;
       }
     }
   }
@@ -111,9 +118,9 @@ void exercise_sim_dut(drivers::keysight33500::Driver& awg, drivers::sim::SimBenc
   } catch (const drivers::InstrumentError& e) {
     EXPECT_NE(std::string(e.what()).find("-224"), std::string::npos) << e.what();
   }
-  EXPECT_THROW(awg.scpi().configure("SIM:DUT LOAD"), drivers::InstrumentError);      // -109
-  EXPECT_THROW(awg.scpi().configure("SIM:DUT LOAD,-3"), drivers::InstrumentError);   // -222
-  EXPECT_THROW(awg.scpi().configure("SIM:DUT SHORT,5"), drivers::InstrumentError);   // -109
+  EXPECT_THROW(awg.scpi().configure("SIM:DUT LOAD"), drivers::InstrumentError);     // -109
+  EXPECT_THROW(awg.scpi().configure("SIM:DUT LOAD,-3"), drivers::InstrumentError);  // -222
+  EXPECT_THROW(awg.scpi().configure("SIM:DUT SHORT,5"), drivers::InstrumentError);  // -109
   EXPECT_EQ(bench.dut().kind, K::Open);  // refused commands change nothing
   awg.scpi().configure("SIM:DUT TUBE");
   EXPECT_EQ(bench.dut().kind, K::Tube);
@@ -145,8 +152,9 @@ TEST(CalibrationStandards, SimDutInProcessAndOverTcp) {
 }
 
 fs::path tmp_dir() {
-  auto d = fs::temp_directory_path() / ("piezobench-calsim-" + std::to_string(::getpid()) + "-" +
-                                        ::testing::UnitTest::GetInstance()->current_test_info()->name());
+  auto d =
+      fs::temp_directory_path() / ("piezobench-calsim-" + std::to_string(::getpid()) + "-" +
+                                   ::testing::UnitTest::GetInstance()->current_test_info()->name());
   fs::remove_all(d);
   fs::create_directories(d);
   return d;

@@ -71,9 +71,11 @@ TEST_P(FixtureAcceptance, CompensationMeetsTheTargetAndTheFixtureIsMeasured) {
 
   // Measured fixture quantities (what the gap diagnosis reports).
   ASSERT_TRUE(fx.fixture_capacitance_f && fx.lead_resistance_ohm && fx.r1_error && fx.skew_s);
-  std::printf("[%s] measured: Cp %.2f pF (true %.0f), Rs %.3f ohm (true %.1f), R1 error %+.3f %% (true %+.1f), skew %.1f ns (true %.0f)\n",
-              s.name, *fx.fixture_capacitance_f * 1e12, s.cp_f * 1e12, *fx.lead_resistance_ohm, s.rs_ohm, *fx.r1_error * 100,
-              s.r1_tolerance * 100, *fx.skew_s * 1e9, s.skew_s * 1e9);
+  std::printf(
+      "[%s] measured: Cp %.2f pF (true %.0f), Rs %.3f ohm (true %.1f), R1 error %+.3f %% (true "
+      "%+.1f), skew %.1f ns (true %.0f)\n",
+      s.name, *fx.fixture_capacitance_f * 1e12, s.cp_f * 1e12, *fx.lead_resistance_ohm, s.rs_ohm,
+      *fx.r1_error * 100, s.r1_tolerance * 100, *fx.skew_s * 1e9, s.skew_s * 1e9);
   // The skew and the open's R1·Cp lag both delay v2; only the open's magnitude
   // roll-off, (ω·R1·Cp)² — 1.4 % at 120 kHz for 50 pF — tells them apart, so a
   // small Cp trades a few pF against a few ns (measured: 53.4 pF, −5.3 ns at 50 pF).
@@ -96,10 +98,13 @@ TEST_P(FixtureAcceptance, CompensationMeetsTheTargetAndTheFixtureIsMeasured) {
     raw.push_back(zv[k]);
     fixed.push_back(comp.correct(fv[k], zd[k]));
   }
-  const auto e_raw = test::max_error(f, raw, truth, peaks), e_fix = test::max_error(f, fixed, truth, peaks);
-  std::printf("[%s] exact Z_m: uncompensated %.2f %% / %.2f deg, compensated %.3f %% (%.1f kHz) / %.3f deg (%.1f kHz)\n",
-              s.name, e_raw.mag_pct, e_raw.phase_deg, e_fix.mag_pct, e_fix.mag_f_hz / 1e3, e_fix.phase_deg,
-              e_fix.phase_f_hz / 1e3);
+  const auto e_raw = test::max_error(f, raw, truth, peaks),
+             e_fix = test::max_error(f, fixed, truth, peaks);
+  std::printf(
+      "[%s] exact Z_m: uncompensated %.2f %% / %.2f deg, compensated %.3f %% (%.1f kHz) / %.3f deg "
+      "(%.1f kHz)\n",
+      s.name, e_raw.mag_pct, e_raw.phase_deg, e_fix.mag_pct, e_fix.mag_f_hz / 1e3, e_fix.phase_deg,
+      e_fix.phase_f_hz / 1e3);
   EXPECT_LT(e_fix.mag_pct, 0.5);
   EXPECT_LT(e_fix.phase_deg, 0.5);
   EXPECT_GT(e_raw.mag_pct, 2.0);  // the fixture matters: the comparison is not trivial
@@ -109,13 +114,16 @@ TEST_P(FixtureAcceptance, CompensationMeetsTheTargetAndTheFixtureIsMeasured) {
   const auto e_unc = test::max_error(grid_of(a.uncompensated), z_of(a.uncompensated), truth, peaks);
   acq::SimSpec ideal = spec;
   ideal.effects = model::EffectSet{};
-  const auto cap0 = test::measure_capture(ideal, 8, false, tmp_file(std::string(s.name) + "-ideal.h5"));
+  const auto cap0 =
+      test::measure_capture(ideal, 8, false, tmp_file(std::string(s.name) + "-ideal.h5"));
   const auto a0 = acq::assess_impedance(cap0, options());
   const auto e_ideal = test::max_error(grid_of(a0.result), z_of(a0.result), truth, peaks);
-  std::printf("[%s] Prony end to end: uncompensated %.2f %% / %.2f deg, compensated %.2f %% (%.1f kHz) / %.2f deg; "
-              "fixture-free bench %.2f %% / %.2f deg\n",
-              s.name, e_unc.mag_pct, e_unc.phase_deg, e_comp.mag_pct, e_comp.mag_f_hz / 1e3, e_comp.phase_deg,
-              e_ideal.mag_pct, e_ideal.phase_deg);
+  std::printf(
+      "[%s] Prony end to end: uncompensated %.2f %% / %.2f deg, compensated %.2f %% (%.1f kHz) / "
+      "%.2f deg; "
+      "fixture-free bench %.2f %% / %.2f deg\n",
+      s.name, e_unc.mag_pct, e_unc.phase_deg, e_comp.mag_pct, e_comp.mag_f_hz / 1e3,
+      e_comp.phase_deg, e_ideal.mag_pct, e_ideal.phase_deg);
   // Prony's own error near the 82 kHz resonance (|Z| ≈ 25 Ω behind R1 = 3140 Ω)
   // dominates both; the fixture costs v2 signal there, hence the margin.
   EXPECT_LT(e_comp.mag_pct, e_ideal.mag_pct + 1.5);

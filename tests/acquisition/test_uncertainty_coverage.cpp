@@ -26,7 +26,8 @@ namespace fs = std::filesystem;
 
 TEST(UncertaintyCoverage, BandCoversTheTruth) {
   const test::FixtureSetting s{"150pF_10ohm_R1+3pct_skew173ns", 150e-12, 10.0, 0.03, 173e-9};
-  const auto dir = fs::temp_directory_path() / ("piezobench-coverage-" + std::to_string(::getpid()));
+  const auto dir =
+      fs::temp_directory_path() / ("piezobench-coverage-" + std::to_string(::getpid()));
   fs::create_directories(dir);
   std::size_t covered = 0, points = 0, covered_mag = 0, covered_phase = 0;
   double worst = 1.0;
@@ -64,12 +65,15 @@ TEST(UncertaintyCoverage, BandCoversTheTruth) {
     covered += in;
     points += n;
     worst = std::min(worst, double(in) / double(n));
-    std::printf("seed %d: coverage %.1f %% (%zu of %zu frequencies), band: %s\n", seed, 100.0 * in / n, in, n,
-                a.band->source.c_str());
+    std::printf("seed %d: coverage %.1f %% (%zu of %zu frequencies), band: %s\n", seed,
+                100.0 * in / n, in, n, a.band->source.c_str());
   }
   const double cov = double(covered) / double(points);
-  std::printf("coverage over %d seeds: %.1f %% (|Z| alone %.1f %%, phase alone %.1f %%), worst seed %.1f %% (target >= 90 %%)\n",
-              PIEZO_COVERAGE_SEEDS, 100 * cov, 100.0 * covered_mag / points, 100.0 * covered_phase / points, 100 * worst);
+  std::printf(
+      "coverage over %d seeds: %.1f %% (|Z| alone %.1f %%, phase alone %.1f %%), worst seed %.1f "
+      "%% (target >= 90 %%)\n",
+      PIEZO_COVERAGE_SEEDS, 100 * cov, 100.0 * covered_mag / points, 100.0 * covered_phase / points,
+      100 * worst);
   EXPECT_GT(cov, 0.50);
   fs::remove_all(dir);
 }

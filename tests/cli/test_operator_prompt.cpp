@@ -40,7 +40,8 @@ TEST(OperatorPrompt, WorkerWaitsForTheAnswer) {
 TEST(OperatorPrompt, CancelAndCloseReleaseTheWorker) {
   OperatorPrompt p;
   std::atomic<bool> cancel{false};
-  auto a = std::async(std::launch::async, [&] { return p.ask("connect the LOAD standard", &cancel); });
+  auto a =
+      std::async(std::launch::async, [&] { return p.ask("connect the LOAD standard", &cancel); });
   ASSERT_TRUE(wait_question(p));
   cancel = true;
   EXPECT_FALSE(a.get());

@@ -17,7 +17,9 @@ constexpr double kFs = 1e7, kTwoPi = 2.0 * std::numbers::pi;
 
 // A channel that jumps at t = 0 by 0.3 V and rises through a 485 ns RC (a
 // fixture's v2), then decays with the drive.
-double v(double t) { return t < 0 ? 0.0 : 0.3 * std::exp(-3000 * t) + 0.7 * (1 - std::exp(-t / 485e-9)); }
+double v(double t) {
+  return t < 0 ? 0.0 : 0.3 * std::exp(-3000 * t) + 0.7 * (1 - std::exp(-t / 485e-9));
+}
 
 TEST(Deskew, ChannelResamplingKeepsTheJumpOnSampleZero) {
   const int n = 3000, pre = 200;
@@ -29,15 +31,18 @@ TEST(Deskew, ChannelResamplingKeepsTheJumpOnSampleZero) {
     double worst = 0, at_jump = 0;
     for (int k = 3; k < n - 5; ++k) {  // the ends are extrapolated
       const double e = std::abs(y[k] - v((k - pre) / kFs));
-      if (k == pre) at_jump = e;
-      else worst = std::max(worst, e);
+      if (k == pre)
+        at_jump = e;
+      else
+        worst = std::max(worst, e);
     }
-    EXPECT_LT(worst, 5e-5) << delay;  // 4-point Lagrange on a 4.85-sample RC rise
+    EXPECT_LT(worst, 5e-5) << delay;    // 4-point Lagrange on a 4.85-sample RC rise
     EXPECT_LT(at_jump, 2e-3) << delay;  // the right limit, extrapolated from after the jump
     EXPECT_LT(std::abs(y[pre - 1]), 1e-12) << delay;  // before the jump: the pre-jump side only
   }
   EXPECT_THROW(dsp::deskew_channel(std::vector<double>(3), kFs, 0, 1e-7), std::invalid_argument);
-  EXPECT_THROW(dsp::deskew_channel(std::vector<double>(100), kFs, 100, 1e-7), std::invalid_argument);
+  EXPECT_THROW(dsp::deskew_channel(std::vector<double>(100), kFs, 100, 1e-7),
+               std::invalid_argument);
 }
 
 TEST(Deskew, CrossCorrelationFindsASubSampleDelay) {
@@ -60,7 +65,7 @@ TEST(Deskew, ImpedanceCorrectionUndoesAKnownDelay) {
   Eigen::VectorXcd z(50), zm(50), t(50);
   for (int k = 0; k < 50; ++k) {
     f[k] = 2.4e3 * (k + 1);
-    z[k] = 1.0 / cd(1e-5, kTwoPi * f[k] * 15e-9);  // a lossy capacitor
+    z[k] = 1.0 / cd(1e-5, kTwoPi * f[k] * 15e-9);                              // a lossy capacitor
     const cd tt = z[k] / (z[k] + r1) * std::exp(cd(0, -kTwoPi * f[k] * tau));  // channel 2 late
     zm[k] = r1 * tt / (1.0 - tt);
     t[k] = tt;

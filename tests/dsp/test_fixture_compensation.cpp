@@ -32,12 +32,14 @@ dsp::StandardModel poly(std::vector<double> c, bool admittance) {
 // A DUT: a capacitor with one lossy resonance.
 cd dut(double f) {
   const cd s(0, kTwoPi * f);
-  const cd y = s * 2e-9 + s * 1e-9 / (s * s / std::pow(kTwoPi * 60e3, 2) + s * 0.02 / (kTwoPi * 60e3) + 1.0);
+  const cd y =
+      s * 2e-9 + s * 1e-9 / (s * s / std::pow(kTwoPi * 60e3, 2) + s * 0.02 / (kTwoPi * 60e3) + 1.0);
   return 1.0 / y;
 }
 
 TEST(FixtureCompensation, OpenShortLoadInvertsAnyBilinearErrorBox) {
-  // Measured standards: open Y = G + jωC (+ a j(ω)^3 term), short Z = R + jωL, load Y ≈ 1/1000 + jωC.
+  // Measured standards: open Y = G + jωC (+ a j(ω)^3 term), short Z = R + jωL, load Y ≈ 1/1000 +
+  // jωC.
   const auto open = poly({2e-6, 5e-5, 1e-6, -3e-6}, true);
   const auto shrt = poly({11.0, 0.8}, false);
   const auto load = poly({9.7e-4, 4e-5, 2e-7}, true);
@@ -45,7 +47,8 @@ TEST(FixtureCompensation, OpenShortLoadInvertsAnyBilinearErrorBox) {
   const dsp::FixtureCompensation comp(dsp::FixtureModel::OpenShortLoad, open, shrt, load, lv);
   for (double f : {500.0, 3e3, 20e3, 59e3, 60e3, 61e3, 119e3}) {
     // The unique bilinear map M with M(∞) = Z_o, M(0) = Z_s, M(Z_L) = Z_l, applied to the DUT.
-    const cd zo = open.impedance(f), zs = shrt.impedance(f), zl = load.impedance(f), zL = lv.impedance(f);
+    const cd zo = open.impedance(f), zs = shrt.impedance(f), zl = load.impedance(f),
+             zL = lv.impedance(f);
     const cd c = (zl - zs) / (zL * (zo - zl)), a = zo * c;
     const cd zx = dut(f), zm = (a * zx + zs) / (c * zx + 1.0);
     EXPECT_LT(std::abs(comp.correct(f, zm) / zx - 1.0), 1e-10) << f;
@@ -67,7 +70,8 @@ TEST(FixtureCompensation, PartialModelsAreExactForTheirTopologies) {
     const cd zlead(3.0, kTwoPi * f * 2e-7);
     const cd zsm = 1.0 / (yo + 1.0 / zlead);  // the short, measured through the shunt
     const cd zm = 1.0 / (yo + 1.0 / (zlead + zx));
-    // a short model that is exactly Z_sm at this f: a constant (complex values need two coefficients: R + jωL)
+    // a short model that is exactly Z_sm at this f: a constant (complex values need two
+    // coefficients: R + jωL)
     const double w = kTwoPi * f / (kTwoPi * kFmax);
     const auto shrt_at_f = poly({zsm.real(), zsm.imag() / w}, false);
     dsp::FixtureCompensation os(dsp::FixtureModel::OpenShort, open, shrt_at_f, std::nullopt);
@@ -85,11 +89,12 @@ TEST(FixtureCompensation, MissingStandardsAreNamed) {
   }
   EXPECT_THROW(dsp::FixtureCompensation(dsp::FixtureModel::Short, open, std::nullopt, std::nullopt),
                std::invalid_argument);
-  EXPECT_EQ(dsp::FixtureCompensation::best_model(true, true, true), dsp::FixtureModel::OpenShortLoad);
+  EXPECT_EQ(dsp::FixtureCompensation::best_model(true, true, true),
+            dsp::FixtureModel::OpenShortLoad);
   EXPECT_EQ(dsp::FixtureCompensation::best_model(true, false, true), dsp::FixtureModel::Open);
   EXPECT_EQ(dsp::FixtureCompensation::best_model(false, false, true), dsp::FixtureModel::None);
-  for (auto m : {dsp::FixtureModel::None, dsp::FixtureModel::Open, dsp::FixtureModel::Short, dsp::FixtureModel::OpenShort,
-                 dsp::FixtureModel::OpenShortLoad}) {
+  for (auto m : {dsp::FixtureModel::None, dsp::FixtureModel::Open, dsp::FixtureModel::Short,
+                 dsp::FixtureModel::OpenShort, dsp::FixtureModel::OpenShortLoad}) {
     EXPECT_EQ(dsp::parse_fixture_model(dsp::to_string(m)), m);
     EXPECT_FALSE(dsp::describe(m).empty());
   }
@@ -103,13 +108,14 @@ TEST(FixtureStandards, PolynomialFitRecoversTheStandardAndItsSpread) {
   m.z_ohm.resize(n);
   m.z_sigma_ohm = Eigen::VectorXd::Constant(n, 1e-3);
   std::uint64_t state = 12345;
-  auto gauss = [&] {  // Box–Muller on a small LCG: reproducible, no <random> distribution differences
-    auto u = [&] {
-      state = state * 6364136223846793005ULL + 1442695040888963407ULL;
-      return (double((state >> 11) & ((1ULL << 53) - 1)) + 0.5) / double(1ULL << 53);
-    };
-    return std::sqrt(-2 * std::log(u())) * std::cos(kTwoPi * u());
-  };
+  auto gauss =
+      [&] {  // Box–Muller on a small LCG: reproducible, no <random> distribution differences
+        auto u = [&] {
+          state = state * 6364136223846793005ULL + 1442695040888963407ULL;
+          return (double((state >> 11) & ((1ULL << 53) - 1)) + 0.5) / double(1ULL << 53);
+        };
+        return std::sqrt(-2 * std::log(u())) * std::cos(kTwoPi * u());
+      };
   for (int k = 0; k < n; ++k) {
     const double f = 600.0 * (k + 1);
     m.f_hz[k] = f;
@@ -119,8 +125,8 @@ TEST(FixtureStandards, PolynomialFitRecoversTheStandardAndItsSpread) {
   const auto s = dsp::fit_standard(m, false, 3, "short");
   EXPECT_NEAR(s.impedance(50e3).real(), 10.0, 5e-4);
   EXPECT_NEAR(s.impedance(50e3).imag(), kTwoPi * 50e3 * 1e-6, 5e-4);
-  EXPECT_NEAR(s.chi2_reduced, 1.0, 0.2);          // the model fits to the noise
-  EXPECT_LT(s.impedance_sigma(50e3), 2e-4);        // averaged over 200 points of σ 1e-3
+  EXPECT_NEAR(s.chi2_reduced, 1.0, 0.2);     // the model fits to the noise
+  EXPECT_LT(s.impedance_sigma(50e3), 2e-4);  // averaged over 200 points of σ 1e-3
   EXPECT_GT(s.impedance_sigma(50e3), 2e-5);
   EXPECT_THROW(s.impedance(130e3), std::invalid_argument);  // above the measured band
   EXPECT_NO_THROW(s.impedance(100.0));                      // below: extends to DC
@@ -135,7 +141,8 @@ TEST(FixtureStandards, PolynomialFitRecoversTheStandardAndItsSpread) {
 }
 
 TEST(FixtureCalibration, PhysicalFitRecoversTheFixture) {
-  // T_m = e^{−jωτ}/(u + jωβ + ρ·R1·Y_b): u = 1 (ideal DAQ), Cp = 120 pF, R1 off by +2 %, Rs = 7 Ω, τ = 90 ns.
+  // T_m = e^{−jωτ}/(u + jωβ + ρ·R1·Y_b): u = 1 (ideal DAQ), Cp = 120 pF, R1 off by +2 %, Rs = 7 Ω,
+  // τ = 90 ns.
   const double r1 = 3140.0, rho = 1.02, cp = 120e-12, rs = 7.0, tau = 90e-9;
   const double beta = rho * r1 * cp;
   const dsp::LoadStandard lv{1000.0, 0.0};

@@ -27,8 +27,8 @@ TEST(VectorFitting, FitsAStableRationalFunctionExactly) {
   // H(s) = 0.5 + s·1e-6 + Σ over two resonant pairs and one real pole.
   const cd p1(-2e3, kTwoPi * 30e3), p2(-5e3, kTwoPi * 80e3);
   auto h = [&](cd s) {
-    return 0.5 + s * 1e-6 + cd(2e3, 1e3) / (s - p1) + cd(2e3, -1e3) / (s - std::conj(p1)) + cd(5e3, 0) / (s - p2) +
-           cd(5e3, 0) / (s - std::conj(p2)) + 4e4 / (s + 2e5);
+    return 0.5 + s * 1e-6 + cd(2e3, 1e3) / (s - p1) + cd(2e3, -1e3) / (s - std::conj(p1)) +
+           cd(5e3, 0) / (s - p2) + cd(5e3, 0) / (s - std::conj(p2)) + 4e4 / (s + 2e5);
   };
   const Eigen::VectorXd f = grid();
   Eigen::VectorXcd y(f.size());
@@ -37,7 +37,8 @@ TEST(VectorFitting, FitsAStableRationalFunctionExactly) {
   o.pole_pairs = 3;
   const auto fit = dsp::vector_fit(f, y, Eigen::VectorXd(), o);
   double worst = 0;
-  for (Eigen::Index k = 0; k < f.size(); ++k) worst = std::max(worst, std::abs(fit.eval(cd(0, kTwoPi * f[k])) / y[k] - 1.0));
+  for (Eigen::Index k = 0; k < f.size(); ++k)
+    worst = std::max(worst, std::abs(fit.eval(cd(0, kTwoPi * f[k])) / y[k] - 1.0));
   EXPECT_LT(worst, 1e-6);
   for (Eigen::Index k = 0; k < fit.poles.size(); ++k) EXPECT_LT(fit.poles[k].real(), 0.0);
   EXPECT_THROW(dsp::vector_fit(f.head(5), y.head(5), Eigen::VectorXd(), o), std::invalid_argument);
@@ -75,7 +76,8 @@ TEST(KramersKronig, TimeReversedResponseFailsCausality) {
   const auto m = bvd::tube_bvd_q(150);
   const Eigen::VectorXd f = grid();
   Eigen::VectorXcd z(f.size());
-  for (Eigen::Index k = 0; k < f.size(); ++k) z[k] = std::conj(m.impedance_at(f[k]));  // h(−t): anti-causal, still Re Z ≥ 0
+  for (Eigen::Index k = 0; k < f.size(); ++k)
+    z[k] = std::conj(m.impedance_at(f[k]));  // h(−t): anti-causal, still Re Z ≥ 0
   const auto r = dsp::kramers_kronig_check(f, z, Eigen::VectorXd());
   EXPECT_TRUE(r.passive);
   EXPECT_FALSE(r.causal) << r.note;
@@ -85,7 +87,8 @@ TEST(KramersKronig, TimeReversedResponseFailsCausality) {
 TEST(KramersKronig, BadInputIsRefused) {
   const Eigen::VectorXd f = grid();
   Eigen::VectorXcd z = Eigen::VectorXcd::Ones(f.size());
-  EXPECT_THROW(dsp::kramers_kronig_check(f.head(10), z.head(10), Eigen::VectorXd()), std::invalid_argument);
+  EXPECT_THROW(dsp::kramers_kronig_check(f.head(10), z.head(10), Eigen::VectorXd()),
+               std::invalid_argument);
   EXPECT_THROW(dsp::kramers_kronig_check(f, z.head(20), Eigen::VectorXd()), std::invalid_argument);
   z[3] = cd(NAN, 0);
   EXPECT_THROW(dsp::kramers_kronig_check(f, z, Eigen::VectorXd()), std::invalid_argument);

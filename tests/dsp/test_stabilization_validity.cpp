@@ -18,7 +18,8 @@ struct Shots {
   std::vector<std::vector<double>> v1, v2;
   std::vector<dsp::DividerRecord> records() const {
     std::vector<dsp::DividerRecord> r;
-    for (std::size_t k = 0; k < v1.size(); ++k) r.push_back({v1[k], v2[k], 1e7, 3140.0, 200, std::nullopt});
+    for (std::size_t k = 0; k < v1.size(); ++k)
+      r.push_back({v1[k], v2[k], 1e7, 3140.0, 200, std::nullopt});
     return r;
   }
 };
@@ -57,9 +58,10 @@ TEST(Stabilization, CircuitPolesAreStableAcrossOrders) {
     const double f = p.imag() / (2 * M_PI);
     if (f < 1e3) continue;  // the drive's and the divider's real poles
     for (std::size_t order = 10; order <= 16; order += 2) {
-      const auto it = std::find_if(chart.poles.begin(), chart.poles.end(), [&](const dsp::StabilizationPole& q) {
-        return q.order == order && std::abs(q.freq_hz - f) < 0.002 * f;
-      });
+      const auto it = std::find_if(chart.poles.begin(), chart.poles.end(),
+                                   [&](const dsp::StabilizationPole& q) {
+                                     return q.order == order && std::abs(q.freq_hz - f) < 0.002 * f;
+                                   });
       ASSERT_NE(it, chart.poles.end()) << f << " Hz at order " << order;
       EXPECT_EQ(it->stability, dsp::PoleStability::Stable) << f << " Hz at order " << order;
     }
@@ -73,7 +75,8 @@ TEST(Stabilization, CircuitPolesAreStableAcrossOrders) {
 TEST(ShotValidity, AStrangerAndAClippedShotAreFlagged) {
   auto s = shots_of(bvd::tube_bvd_q(150), 5, 2e-3, 11);
   // Shot 3 comes from another transducer (its modes 3 % higher), shot 4 is clipped.
-  const auto other = shots_of(bvd::make_bvd({51.8e3, 55.0e3, 81.8e3}, {52.6e3, 55.6e3, 98.0e3}, 2.5e-9, {0.005, 0.005, 0.005}),
+  const auto other = shots_of(bvd::make_bvd({51.8e3, 55.0e3, 81.8e3}, {52.6e3, 55.6e3, 98.0e3},
+                                            2.5e-9, {0.005, 0.005, 0.005}),
                               1, 2e-3, 99);
   s.v2[3] = other.v2[0];
   for (auto& x : s.v1[4]) x = std::min(x, 0.8);
@@ -83,12 +86,14 @@ TEST(ShotValidity, AStrangerAndAClippedShotAreFlagged) {
   const auto rep = dsp::check_shots(s.records(), prony(), vo);
   ASSERT_EQ(rep.shots.size(), 5u);
   for (int k : {0, 1, 2}) {
-    EXPECT_TRUE(rep.shots[k].flags.empty()) << k << ": " << (rep.shots[k].flags.empty() ? "" : rep.shots[k].flags[0]);
+    EXPECT_TRUE(rep.shots[k].flags.empty())
+        << k << ": " << (rep.shots[k].flags.empty() ? "" : rep.shots[k].flags[0]);
     EXPECT_GT(rep.shots[k].coherence, 0.99);
     EXPECT_LT(rep.shots[k].reconstruction_ratio, 1.5);
   }
   auto has = [&](int k, const char* flag) {
-    return std::find(rep.shots[k].flags.begin(), rep.shots[k].flags.end(), flag) != rep.shots[k].flags.end();
+    return std::find(rep.shots[k].flags.begin(), rep.shots[k].flags.end(), flag) !=
+           rep.shots[k].flags.end();
   };
   EXPECT_TRUE(has(3, "low coherence")) << rep.shots[3].coherence;
   EXPECT_TRUE(has(4, "clipped"));

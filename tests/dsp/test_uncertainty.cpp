@@ -39,7 +39,8 @@ TEST(Uncertainty, ReplicatesGiveTheirSpreadAndCoverAbout95Percent) {
   const double rel = 0.01, ph = 0.005;
   auto draw = [&] {
     Eigen::VectorXcd z(n);
-    for (int k = 0; k < n; ++k) z[k] = truth[k] * (1 + rel * nd(rng)) * std::exp(cd(0, ph * nd(rng)));
+    for (int k = 0; k < n; ++k)
+      z[k] = truth[k] * (1 + rel * nd(rng)) * std::exp(cd(0, ph * nd(rng)));
     return z;
   };
   std::vector<Eigen::VectorXcd> reps;
@@ -82,7 +83,8 @@ TEST(Uncertainty, BootstrapResamplesWithReplacementAndSkipsRefusals) {
     return Eigen::VectorXcd::Constant(1, cd(double(idx[0] * 10 + idx[1]), 0));
   });
   for (int b = 0; b < 3; ++b) EXPECT_EQ(again[b][0], twice[b][0]);  // seeded
-  EXPECT_THROW(dsp::bootstrap_over_shots(1, 3, 9, [](const std::vector<std::size_t>&) { return Eigen::VectorXcd(); }),
+  EXPECT_THROW(dsp::bootstrap_over_shots(
+                   1, 3, 9, [](const std::vector<std::size_t>&) { return Eigen::VectorXcd(); }),
                std::invalid_argument);
 }
 

@@ -44,8 +44,8 @@ inline std::function<std::complex<double>(double)> true_tube_impedance(const acq
 // nominal R1: Z_m = R1_nom·T_m/(1 − T_m), T_m = (1 + g)·e^{−jωτ}·V2/V1 of the
 // bench with every fixture effect (lead R, fixture C, DAQ input, R1 error,
 // channel gain and skew) — free of any estimator's error.
-inline std::function<std::complex<double>(double)> exact_measured_impedance(const acq::SimSpec& spec,
-                                                                             double r1_nominal) {
+inline std::function<std::complex<double>(double)> exact_measured_impedance(
+    const acq::SimSpec& spec, double r1_nominal) {
   const auto& e = spec.effects;
   acq::BenchCircuit c;
   c.r1_ohm = r1_nominal * (1.0 + e.r1_tolerance);
@@ -59,7 +59,8 @@ inline std::function<std::complex<double>(double)> exact_measured_impedance(cons
   const double g = e.channel_gain, tau = e.channel_skew_s;
   return [ss, g, tau, r1_nominal](double f) {
     const double w = 2 * M_PI * f;
-    const std::complex<double> t = (1.0 + g) * std::exp(std::complex<double>(0, -w * tau)) * ss->transfer(w);
+    const std::complex<double> t =
+        (1.0 + g) * std::exp(std::complex<double>(0, -w * tau)) * ss->transfer(w);
     return r1_nominal * t / (1.0 - t);
   };
 }

@@ -25,18 +25,21 @@ void render_calibration_controls(CalibrationForm& f, bool busy) {
   ImGui::EndDisabled();
 }
 
-void attach_calibration(const CalibrationForm& f, ui::OperatorPrompt& prompt, ui::PipelineRequest& req) {
+void attach_calibration(const CalibrationForm& f, ui::OperatorPrompt& prompt,
+                        ui::PipelineRequest& req) {
   req.calibration.clear();
   if (!f.enabled) return;
   std::string list;
-  for (auto [on, name] : {std::pair{f.open, "open"}, std::pair{f.shrt, "short"}, std::pair{f.load, "load"}})
+  for (auto [on, name] :
+       {std::pair{f.open, "open"}, std::pair{f.shrt, "short"}, std::pair{f.load, "load"}})
     if (on) {
       if (!list.empty()) list += ',';
       list += name;
     }
   if (list.empty()) return;
   req.calibration = acq::parse_calibration_list(
-      list, f.load_ohm, f.load_parallel_pf > 0 ? std::optional<double>(f.load_parallel_pf * 1e-12) : std::nullopt);
+      list, f.load_ohm,
+      f.load_parallel_pf > 0 ? std::optional<double>(f.load_parallel_pf * 1e-12) : std::nullopt);
   req.prompt = [&prompt](const std::string& text) { return prompt.ask(text); };
 }
 

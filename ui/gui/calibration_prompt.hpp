@@ -22,7 +22,8 @@ struct CalibrationForm {
 void render_calibration_controls(CalibrationForm& form, bool busy);
 
 // Puts the chosen standards and the prompt into a pipeline request.
-void attach_calibration(const CalibrationForm& form, ui::OperatorPrompt& prompt, ui::PipelineRequest& req);
+void attach_calibration(const CalibrationForm& form, ui::OperatorPrompt& prompt,
+                        ui::PipelineRequest& req);
 
 // Frame loop: the modal "Connect the standard" dialog while the worker waits.
 void render_calibration_prompt(ui::OperatorPrompt& prompt);
