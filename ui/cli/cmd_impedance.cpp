@@ -221,6 +221,7 @@ void run(const ImpedanceArgs& a, Context& ctx) {
   dsp::ImpedanceResult r;
   std::optional<acq::ImpedanceAssessment> assessed;
   std::optional<dsp::ImpedanceBand> band;
+  std::optional<acq::CaptureCalibration> sine_cal;  // stepped sine: compensated here, not by assess_impedance
   double band_hz = a.fmax;
   if (a.method == "sine") {
     std::vector<dsp::SineShot> shots;
@@ -234,9 +235,27 @@ void run(const ImpedanceArgs& a, Context& ctx) {
     o.features.fmin_hz = a.fmin;
     if (a.fmax > 0) o.features.fmax_hz = a.fmax;
     r = dsp::impedance_stepped_sine(shots, o);
-    if (trust.skew_s && trust.deskew) dsp::deskew_impedance(r, cap.setup.divider_r1_ohm, *trust.skew_s);
+    // Standards measured with a transient drive apply to a stepped-sine estimate
+    // too (steady state: the skew is exactly the phase ramp e^{jωτ}).
+    bool transient_standards = false;
+    for (const auto& sh : cap.shots)
+      transient_standards = transient_standards || (sh.role != acq::Role::Dut && sh.excitation != acq::Excitation::Sine);
+    if (trust.compensate && transient_standards) {
+      acq::CaptureCalibrationOptions co;
+      co.fmax_hz = r.f_hz.maxCoeff();
+      co.model = trust.model;
+      co.deskew = trust.deskew;
+      sine_cal = acq::calibrate_from_capture(cap, co);
+    } else if (trust.model && *trust.model != dsp::FixtureModel::None) {
+      throw InputError("--compensation " + a.compensation +
+                       ": the capture holds no transient calibration shot (stepped-sine standards are not supported)");
+    }
+    const double skew = sine_cal ? sine_cal->skew_applied_s : (trust.skew_s && trust.deskew ? *trust.skew_s : 0.0);
+    if (skew != 0.0) dsp::deskew_impedance(r, cap.setup.divider_r1_ohm, skew);
+    if (sine_cal) sine_cal->compensate(r);
     if (r.z_sigma_ohm.size() == r.f_hz.size() && trust.uncertainty != acq::UncertaintySource::None)
-      band = dsp::band_from_sigma(r.f_hz, r.z_ohm, r.z_sigma_ohm, trust.coverage_factor, "lock-in fit covariance");
+      band = dsp::band_from_sigma(r.f_hz, r.z_ohm, r.z_sigma_ohm, trust.coverage_factor,
+                                  sine_cal ? "lock-in fit covariance + fixture standards" : "lock-in fit covariance");
   } else {
     const acq::Shot& shot = pick_shot(cap, a);
     const double fs = shot.sample_rate_hz;
@@ -282,13 +301,23 @@ void run(const ImpedanceArgs& a, Context& ctx) {
     auto j = result_json(r, a.file, names, band_hz > 0 ? band_hz : 1e300);
     if (assessed) {
       j.update(ui::assessment_json(*assessed));  // fields added, none renamed
-    } else {
-      j["compensation"] = {{"applied", false}, {"model", "none"}, {"description", dsp::describe(dsp::FixtureModel::None)}};
-      j["deskew"] = {{"applied", trust.skew_s.has_value() && trust.deskew},
-                     {"skew_s", trust.skew_s.value_or(0.0)},
-                     {"skew_ns", trust.skew_s.value_or(0.0) * 1e9},
-                     {"source", trust.skew_s ? "given (a stored skew)" : ""}};
-      j["notes"] = {"stepped sine: fixture compensation from the capture's standards is not implemented for sine shots"};
+    } else {  // stepped sine
+      const auto model = sine_cal ? sine_cal->model : dsp::FixtureModel::None;
+      j["compensation"] = {{"applied", model != dsp::FixtureModel::None},
+                           {"model", std::string(dsp::to_string(model))},
+                           {"description", dsp::describe(model)}};
+      if (sine_cal) j["compensation"]["fixture"] = ui::fixture_json(sine_cal->fixture);
+      const double skew = sine_cal ? sine_cal->skew_applied_s : (trust.skew_s && trust.deskew ? *trust.skew_s : 0.0);
+      j["deskew"] = {{"applied", skew != 0.0},
+                     {"skew_s", skew},
+                     {"skew_ns", skew * 1e9},
+                     {"source", sine_cal ? sine_cal->skew_source : (trust.skew_s ? "given (a stored skew)" : "")}};
+      j["notes"] = nlohmann::json::array();
+      bool sine_standards = false;
+      for (const auto& sh : cap.shots)
+        sine_standards = sine_standards || (sh.role != acq::Role::Dut && sh.excitation == acq::Excitation::Sine);
+      if (sine_standards && !sine_cal)
+        j["notes"].push_back("the capture's calibration shots are stepped-sine shots: not supported yet, Z is not compensated");
       if (band)
         j["uncertainty"] = {{"source", band->source}, {"coverage_factor", band->coverage_factor},
                             {"abs_sigma_ohm", std::vector<double>(band->abs_sigma_ohm.data(), band->abs_sigma_ohm.data() + band->size())}};
