@@ -202,6 +202,7 @@ TEST(CalibrationRun, StandardsFirstWithRolesAndARangedChannelTwo) {
   EXPECT_NE(std::find(stages.begin(), stages.end(), "connect short"), stages.end());
   EXPECT_NE(std::find(stages.begin(), stages.end(), "range short"), stages.end());
   EXPECT_NE(std::find(stages.begin(), stages.end(), "connect dut"), stages.end());
+  fs::remove_all(dir);
 }
 
 // A real bench: the technician is asked; declining cancels, the shots so far stay.
@@ -241,6 +242,7 @@ TEST(CalibrationRun, RealBenchAsksTheTechnician) {
   const auto res = acq::run_measurement(bench, short_plan(), dir / "c.h5", ro);
   EXPECT_TRUE(res.cancelled);
   EXPECT_EQ(res.shots_written, 2);  // the open's shots
+  fs::remove_all(dir);
 }
 
 TEST(CalibrationRun, BadListsAreRefusedByName) {

@@ -131,6 +131,7 @@ TEST_P(FixtureAcceptance, CompensationMeetsTheTargetAndTheFixtureIsMeasured) {
   EXPECT_LT(e_comp.mag_pct, e_unc.mag_pct);
   ASSERT_TRUE(a.kk);
   EXPECT_TRUE(a.kk->pass) << a.kk->note;
+  fs::remove_all(tmp_file("").parent_path());
 }
 
 INSTANTIATE_TEST_SUITE_P(Settings, FixtureAcceptance, ::testing::ValuesIn(kSettings),
@@ -165,6 +166,7 @@ TEST(FixtureKramersKronig, WrongSkewSignFails) {
   std::printf("KK right sign: %s\nKK wrong sign: %s\n", good.kk->note.c_str(), kk.note.c_str());
   EXPECT_FALSE(kk.pass);
   EXPECT_FALSE(kk.passive);
+  fs::remove_all(tmp_file("").parent_path());
 }
 
 }  // namespace
