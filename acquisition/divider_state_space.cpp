@@ -75,6 +75,10 @@ DividerStateSpace::DividerStateSpace(const model::ModalPortModel& port, const Be
   if (!(k.r1_ohm > 0)) throw std::invalid_argument("DividerStateSpace: R1 must be positive");
   if (k.series_resistance_ohm < 0 || k.parallel_capacitance_f < 0 || !(k.daq_input_resistance_ohm > 0))
     throw std::invalid_argument("DividerStateSpace: circuit values out of range");
+  if (k.dut.kind != drivers::sim::DutSelection::Kind::Tube) {  // a calibration standard
+    build_standard(k);
+    return;
+  }
   const double ce = port.c_clamped + port.c_residual;
   if (!(ce > 0)) throw std::invalid_argument("DividerStateSpace: non-positive port capacitance");
   std::vector<const model::PortMode*> modes;
@@ -203,6 +207,7 @@ std::vector<double> DividerStateSpace::simulate(const drivers::sim::PiecewiseLin
 
 std::complex<double> DividerStateSpace::transfer(double omega) const {
   const int n = static_cast<int>(a_.rows());
+  if (n == 0) return d_;  // a purely resistive standard: no state
   Eigen::MatrixXcd m = std::complex<double>(0, omega) * Eigen::MatrixXcd::Identity(n, n) - a_.cast<std::complex<double>>();
   Eigen::VectorXcd xs = m.partialPivLu().solve(b_.cast<std::complex<double>>());
   return c_.cast<std::complex<double>>().dot(xs) + d_;

@@ -30,6 +30,13 @@ struct BenchCircuit {
   double dielectric_loss = 0.0;  // tan δ, realised by a Debye network on Ce
   model::RayleighDamping damping;
   double extra_damping_ratio = 0.0;  // mechanical_damping effect: c_k += 2 ξ_m ω_k
+  // What sits at the terminals: the tube (the port model), or a calibration
+  // standard in the same fixture (fixture_standard_circuit.cpp): open
+  // (nothing), short (the terminals joined) or a load R ∥ C. The fixture is
+  //   v1 ──[R1]──● v2 ──[series_resistance]──● terminals ── DUT ── GND
+  //              ├─ parallel_capacitance ─ GND
+  //              └─ daq_input_resistance ─ GND
+  drivers::sim::DutSelection dut;
 };
 
 class DividerStateSpace {
@@ -46,6 +53,9 @@ class DividerStateSpace {
   int order() const { return static_cast<int>(a_.rows()); }
 
  private:
+  // Open/short/load instead of the tube (fixture_standard_circuit.cpp).
+  void build_standard(const BenchCircuit& circuit);
+
   struct Step {
     Eigen::MatrixXd phi;
     Eigen::VectorXd g0, g1;  // response to the input value and to its slope

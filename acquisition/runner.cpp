@@ -17,7 +17,22 @@ RunResult run_measurement(Bench& bench, const MeasurementPlan& plan, const std::
                           const std::atomic<bool>* cancel) {
   plan.validate();
   if (!bench.awg || !bench.daq) throw std::invalid_argument("run_measurement: bench has no AWG or DAQ");
-  const auto steps = plan.steps();
+  if (!opt.calibration.empty() && !opt.connect_standard)
+    throw std::invalid_argument("run_measurement: calibration standards given without a way to connect them");
+  // Calibration: every excitation step for each standard, then for the
+  // transducer (role Dut); `connect` marks where a standard is connected.
+  struct PhaseStep {
+    CalibrationStep phase;
+    ExcitationSpec step;
+    bool connect = false;
+  };
+  const auto plan_steps = plan.steps();
+  std::vector<CalibrationStep> phases = opt.calibration;
+  phases.push_back(CalibrationStep{Role::Dut, 0.0, std::nullopt});
+  std::vector<PhaseStep> steps;
+  for (const auto& ph : phases)
+    for (std::size_t i = 0; i < plan_steps.size(); ++i)
+      steps.push_back({ph, plan_steps[i], !opt.calibration.empty() && i == 0});
   RunResult res;
   res.capture = out;
   res.shots_planned = static_cast<int>(steps.size()) * plan.shots;
@@ -45,11 +60,18 @@ RunResult run_measurement(Bench& bench, const MeasurementPlan& plan, const std::
   const std::size_t post = plan.samples - plan.pretrigger_samples;
 
   int k = 0;
-  auto report = [&](const char* stage) {
+  auto report = [&](const std::string& stage) {
     if (progress) progress(Progress{k, res.shots_planned, stage});
   };
   try {
-    for (const auto& step : steps) {
+    for (const auto& [phase, step, connect] : steps) {
+      if (connect) {  // the standard (or the transducer again) goes to the terminals
+        report("connect " + std::string(to_string(phase.role)));
+        if (!opt.connect_standard(phase)) {
+          res.cancelled = true;
+          break;
+        }
+      }
       drivers::ArbWaveform w;
       w.samples = synthesize(step, plan.sample_rate_hz, post);
       w.sample_rate_hz = plan.sample_rate_hz;
@@ -64,6 +86,18 @@ RunResult run_measurement(Bench& bench, const MeasurementPlan& plan, const std::
         if (!loaded) {
           bench.awg->load(w);
           loaded = true;
+        }
+        if (connect && rep == 0) {  // a standard was just connected: range channel 2 for it
+          dc.range_v[1] = dc.range_v[0];
+          if (opt.autorange_standards && phase.role != Role::Dut) {
+            report("range " + std::string(to_string(phase.role)));
+            bench.daq->configure(dc);
+            bench.daq->arm();
+            bench.awg->output(true);
+            bench.awg->trigger();
+            const drivers::DaqRecord probe = bench.daq->fetch(opt.fetch_timeout_s);
+            dc.range_v[1] = channel_range_for(probe.v2, dc.range_v[0]);
+          }
         }
         bench.daq->configure(dc);
         report("acquire");
@@ -84,12 +118,20 @@ RunResult run_measurement(Bench& bench, const MeasurementPlan& plan, const std::
           s.f_stop_hz = step.f_stop_hz;
         }
         s.pretrigger_samples = static_cast<std::int64_t>(r.pretrigger_samples);
-        s.daq_range_v = r.range_v[0];
+        s.role = phase.role;
+        if (phase.role == Role::Load) {
+          s.load_ohm = phase.load_ohm;
+          s.load_parallel_f = phase.load_parallel_f;
+        }
+        // daq_range_v is one full scale for both channels: written only when they agree
+        // (an autoranged standard's channel 2 differs; readers then use the flat-run test).
+        if (r.range_v[0] == r.range_v[1]) s.daq_range_v = r.range_v[0];
         s.v1 = std::move(r.v1);
         s.v2 = std::move(r.v2);
-        dsp::ClipDetection clip;
-        clip.range_v = s.daq_range_v;
-        bool clipped = dsp::compute_stats(s.v1, clip).clipped || dsp::compute_stats(s.v2, clip).clipped;
+        dsp::ClipDetection clip1, clip2;
+        clip1.range_v = r.range_v[0];
+        clip2.range_v = r.range_v[1];
+        bool clipped = dsp::compute_stats(s.v1, clip1).clipped || dsp::compute_stats(s.v2, clip2).clipped;
         report("write");
         writer.append(s);
         ++res.shots_written;

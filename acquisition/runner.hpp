@@ -9,6 +9,7 @@
 #include <string>
 
 #include "acquisition/bench.hpp"
+#include "acquisition/calibration_plan.hpp"
 #include "acquisition/plan.hpp"
 
 namespace piezo::acq {
@@ -20,12 +21,23 @@ struct RunnerOptions {
   bool overwrite = false;
   // Ground truth of a simulated bench, written under /truth (tests only).
   bool record_truth = true;
+  // Fixture calibration (calibration_plan.hpp): before the DUT shots, each
+  // standard is connected through `connect_standard` and measured with the
+  // plan's excitation steps and shots, its shots carrying the standard's
+  // `role` (and load values); then the transducer is connected again (a step
+  // of role Dut). Empty: DUT shots only. connect_standard returning false cancels.
+  std::vector<CalibrationStep> calibration;
+  StandardConnector connect_standard;
+  // Before a standard's shots, one unrecorded shot sets channel 2's range to
+  // its signal (a short gives millivolts: at the drive's range the ADC would
+  // resolve it in a few codes). Channel 1 keeps the plan's range.
+  bool autorange_standards = true;
 };
 
 struct Progress {
   int shot = 0;  // 0-based, the shot being worked on
   int total = 0;
-  std::string stage;  // "configure", "acquire", "fetch", "write"
+  std::string stage;  // "configure", "acquire", "fetch", "write"; "connect open|short|load|dut"
 };
 
 struct RunResult {

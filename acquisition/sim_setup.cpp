@@ -16,7 +16,8 @@ class FePhysics : public drivers::sim::BenchPhysics {
  public:
   FePhysics(const model::ModalPortModel& port, const BenchCircuit& circuit,
             std::vector<std::pair<std::string, double>> truth, std::string description)
-      : ss_(port, circuit), truth_(std::move(truth)), description_(std::move(description)) {}
+      : port_(port), circuit_(circuit), ss_(port, circuit), truth_(std::move(truth)),
+        description_(std::move(description)) {}
 
   std::vector<double> respond(const drivers::sim::PiecewiseLinear& v1,
                               std::span<const double> times) override {
@@ -24,8 +25,21 @@ class FePhysics : public drivers::sim::BenchPhysics {
   }
   std::vector<std::pair<std::string, double>> truth() const override { return truth_; }
   std::string description() const override { return description_; }
+  // Calibration standards (SIM:DUT): same fixture, another device at the terminals.
+  std::string select_dut(const drivers::sim::DutSelection& d) override {
+    BenchCircuit c = circuit_;
+    c.dut = d;
+    try {
+      ss_ = DividerStateSpace(port_, c);
+    } catch (const std::exception& e) {
+      return e.what();
+    }
+    return {};
+  }
 
  private:
+  model::ModalPortModel port_;
+  BenchCircuit circuit_;
   DividerStateSpace ss_;
   std::vector<std::pair<std::string, double>> truth_;
   std::string description_;

@@ -38,8 +38,13 @@ SignalStats compute_stats(std::span<const double> x, const ClipDetection& clip) 
         std::count_if(x.begin(), x.end(), [lim](double s) { return std::fabs(s) >= lim; }));
     st.clipped = st.samples_at_limit > 0;
   } else {
-    const std::size_t run_hi = st.max != 0.0 ? longest_run_at(x, st.max) : 0;
-    const std::size_t run_lo = st.min != 0.0 ? longest_run_at(x, st.min) : 0;
+    // A pinned converter sits at the signal's largest magnitude (the range is
+    // symmetric); a slow tail sitting on one code at the other extreme (an
+    // exp_decay ending near 0 V) is not clipping.
+    const double peak = std::max(std::fabs(st.max), std::fabs(st.min));
+    const bool hi_is_peak = std::fabs(st.max) >= 0.99 * peak, lo_is_peak = std::fabs(st.min) >= 0.99 * peak;
+    const std::size_t run_hi = st.max != 0.0 && hi_is_peak ? longest_run_at(x, st.max) : 0;
+    const std::size_t run_lo = st.min != 0.0 && lo_is_peak ? longest_run_at(x, st.min) : 0;
     st.clipped = std::max(run_hi, run_lo) >= clip.min_flat_run;
     if (st.clipped) {
       st.samples_at_limit = static_cast<std::size_t>(std::count_if(

@@ -24,8 +24,8 @@ struct ClipDetection {
   std::optional<double> range_v;
   double rel_margin = 1.0 / 256.0;
   // Without a known range: the signal is clipped when it holds a run of at
-  // least `min_flat_run` consecutive samples equal to its own extreme value
-  // (a converter pinned at full scale). ADC quantization of a smooth peak
+  // least `min_flat_run` consecutive samples equal to its own extreme value of
+  // largest magnitude (a converter pinned at full scale; the range is symmetric). ADC quantization of a smooth peak
   // gives runs of a few samples at most, see tests/dsp/test_signal_stats.cpp.
   std::size_t min_flat_run = 8;
 };

@@ -49,6 +49,10 @@ acq::Capture acquire(const PipelineRequest& req, PipelineResult& out, const Stag
   acq::RunnerOptions ro;
   ro.overwrite = true;
   ro.software = "piezobench";
+  if (!req.calibration.empty()) {  // --- issue 10 hook (branch comp): standards first
+    ro.calibration = req.calibration;
+    ro.connect_standard = acq::make_standard_connector(bench, req.prompt);
+  }
   auto res = acq::run_measurement(
       bench, req.plan, req.capture_out, ro,
       [&](const acq::Progress& p) {

@@ -10,6 +10,7 @@
 #include <string>
 #include <vector>
 
+#include "acquisition/calibration_plan.hpp"
 #include "acquisition/plan.hpp"
 #include "acquisition/sim_setup.hpp"
 #include "update/gap_diagnosis.hpp"
@@ -38,6 +39,10 @@ struct PipelineRequest {
   // Relative floor added in quadrature to the measured noise of ln Z (model
   // and estimator systematics that repeated shots cannot see).
   double gap_floor = 2e-3;
+  // Fixture standards measured before the dut shots (simulator: switched by
+  // SIM:DUT; real bench: `prompt` asks the technician).
+  std::vector<acq::CalibrationStep> calibration;
+  acq::TechnicianPrompt prompt;
 };
 
 struct Curve {

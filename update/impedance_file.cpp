@@ -87,7 +87,7 @@ ImpedanceCurve read_impedance_csv(const std::string& path) {
       throw std::invalid_argument(std::string(fn) + ": line " + std::to_string(lineno) +
                                   " is not f_hz,re_ohm,im_ohm");
     }
-    if (v.size() != 3)
+    if (v.size() < 3)  // further columns (the uncertainty band of `impedance --csv`) are not needed here
       throw std::invalid_argument(std::string(fn) + ": line " + std::to_string(lineno) +
                                   " needs 3 columns f_hz,re_ohm,im_ohm");
     c.f_hz.push_back(v[0]);

@@ -15,6 +15,8 @@ class Driver : public Awg {
   void load(const ArbWaveform& w) override;
   void output(bool on) override;
   void trigger() override;
+  // The SCPI session, for commands outside the Awg role (the simulator's SIM:DUT).
+  ScpiClient& scpi() { return scpi_; }
 
  private:
   ScpiClient scpi_;

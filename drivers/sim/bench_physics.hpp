@@ -18,6 +18,16 @@ struct PiecewiseLinear {
   double at(double time) const;  // right-continuous value
 };
 
+// What sits at the transducer terminals (simulator only: a real bench has a
+// technician swap it, see acquisition/calibration_run.hpp). The fixture (lead
+// resistance, fixture capacitance, DAQ input) stays in place for every kind.
+struct DutSelection {
+  enum class Kind { Tube, Open, Short, Load };
+  Kind kind = Kind::Tube;
+  double load_ohm = 0.0;  // Load: its resistance (> 0)
+  double load_parallel_f = 0.0;  // Load: its parallel capacitance (>= 0)
+};
+
 class BenchPhysics {
  public:
   virtual ~BenchPhysics() = default;
@@ -27,6 +37,8 @@ class BenchPhysics {
   // Ground truth recorded in simulated captures (/truth), never read by estimators.
   virtual std::vector<std::pair<std::string, double>> truth() const { return {}; }
   virtual std::string description() const = 0;
+  // Swaps the device at the terminals. Returns "" on success, else why not.
+  virtual std::string select_dut(const DutSelection&) { return "this simulated bench cannot swap its device"; }
 };
 
 }  // namespace piezo::drivers::sim

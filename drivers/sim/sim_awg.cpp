@@ -1,6 +1,7 @@
 #include "drivers/sim/sim_awg.hpp"
 
 #include <cmath>
+#include <cstdio>
 #include <cstdlib>
 #include <cstring>
 
@@ -20,7 +21,60 @@ std::string upper(std::string s) {
 }
 }  // namespace
 
-bool SimAwg::command(const scpi::Command& c, const scpi::ProgramMessage& msg, Reply&) {
+// SIMulation:DUT TUBE | OPEN | SHORT | LOAD,<ohm>[,<farad>]   (simulator only)
+// SIMulation:DUT?  →  TUBE | OPEN | SHORT | LOAD,<ohm>,<farad>
+// Swaps what sits at the transducer terminals; the fixture stays. A real
+// 33500 answers -113 (undefined header), so only the simulator is sent this.
+void SimAwg::sim_dut(const scpi::Command& c, Reply& out) {
+  using K = DutSelection::Kind;
+  if (c.query) {
+    const auto& d = bench_->dut();
+    const char* names[] = {"TUBE", "OPEN", "SHORT", "LOAD"};
+    std::string r = names[static_cast<int>(d.kind)];
+    if (d.kind == K::Load) {
+      char buf[80];
+      std::snprintf(buf, sizeof buf, ",%.10g,%.10g", d.load_ohm, d.load_parallel_f);
+      r += buf;
+    }
+    append(out, r + "\n");
+    return;
+  }
+  DutSelection d;
+  const std::string kind = c.params.empty() ? std::string() : upper(c.params[0]);
+  if (kind == "TUBE" || kind == "DUT") d.kind = K::Tube;
+  else if (kind == "OPEN") d.kind = K::Open;
+  else if (kind == "SHORT") d.kind = K::Short;
+  else if (kind == "LOAD") d.kind = K::Load;
+  else {
+    push_error(-224, "Illegal parameter value; SIM:DUT TUBE|OPEN|SHORT|LOAD,<ohm>[,<farad>]");
+    return;
+  }
+  const std::size_t want = d.kind == K::Load ? 2 : 1;
+  if (c.params.size() < want || c.params.size() > (d.kind == K::Load ? 3u : 1u)) {
+    push_error(-109, d.kind == K::Load ? "Missing parameter; SIM:DUT LOAD,<ohm>[,<farad>]"
+                                       : "Parameter not allowed; SIM:DUT TUBE|OPEN|SHORT takes no value");
+    return;
+  }
+  if (d.kind == K::Load) {
+    double v = 0;
+    if (!parse_num({c.params[1]}, &v)) {
+      push_error(-104, "Data type error; load resistance");
+      return;
+    }
+    d.load_ohm = v;
+    if (c.params.size() == 3) {
+      if (!parse_num({c.params[2]}, &v)) {
+        push_error(-104, "Data type error; load capacitance");
+        return;
+      }
+      d.load_parallel_f = v;
+    }
+  }
+  const std::string why = bench_->select_dut(d);
+  if (!why.empty()) push_error(-222, "Data out of range; " + why);
+}
+
+bool SimAwg::command(const scpi::Command& c, const scpi::ProgramMessage& msg, Reply& out) {
   using scpi::match;
   std::lock_guard lock(bench_->mutex());
   AwgState& a = bench_->awg();
@@ -79,6 +133,8 @@ bool SimAwg::command(const scpi::Command& c, const scpi::ProgramMessage& msg, Re
     a.bus_trigger = !c.params.empty() && upper(c.params[0]) == "BUS";
   } else if (match("OUTPut#[:STATe]", c.header) && !c.query) {
     a.output_on = is_on(c.params);
+  } else if (match("SIMulation:DUT", c.header)) {
+    sim_dut(c, out);
   } else {
     return false;
   }

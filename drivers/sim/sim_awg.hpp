@@ -1,6 +1,8 @@
 #pragma once
 // Simulated Keysight 33522B: the 33500-series SCPI subset the keysight33500
-// driver uses (see drivers/keysight33500/protocol.hpp), over the shared SimBench.
+// driver uses (see drivers/keysight33500/protocol.hpp), over the shared SimBench,
+// plus one simulator-only command, SIMulation:DUT (swaps the device at the
+// terminals for the calibration standards; see sim_awg.cpp).
 #include <map>
 #include <memory>
 
@@ -18,6 +20,8 @@ class SimAwg : public ScpiDevice {
   bool command(const scpi::Command& c, const scpi::ProgramMessage& msg, Reply& out) override;
 
  private:
+  void sim_dut(const scpi::Command& c, Reply& out);  // caller holds the bench mutex
+
   std::shared_ptr<SimBench> bench_;
   std::map<std::string, std::vector<float>> volatile_;  // named arbs in volatile memory
   bool swapped_ = false;

@@ -14,6 +14,17 @@ SimBench::SimBench(std::unique_ptr<BenchPhysics> physics, DaqImperfections daq, 
     throw std::invalid_argument("SimBench: adc_bits must be 4..16");
 }
 
+std::string SimBench::select_dut(const DutSelection& d) {
+  using K = DutSelection::Kind;
+  if (d.kind == K::Load && !(std::isfinite(d.load_ohm) && d.load_ohm > 0))
+    return "load resistance must be positive";
+  if (d.kind == K::Load && !(std::isfinite(d.load_parallel_f) && d.load_parallel_f >= 0))
+    return "load capacitance must be >= 0";
+  std::string why = physics_->select_dut(d);
+  if (why.empty()) dut_ = d;
+  return why;
+}
+
 double PiecewiseLinear::at(double time) const {
   if (t.empty()) return 0.0;
   if (time < t.front()) return v.front();

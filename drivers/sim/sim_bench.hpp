@@ -68,6 +68,10 @@ class SimBench {
   int fetches_started() const { return fetches_; }
   void count_fetch() { ++fetches_; }
   const BenchPhysics& physics() const { return *physics_; }
+  // SIM:DUT (simulator-only command): swaps the device at the terminals.
+  // Caller holds mutex(). Returns "" on success, else the reason.
+  std::string select_dut(const DutSelection& d);
+  const DutSelection& dut() const { return dut_; }
   const DaqImperfections& imperfections() const { return imp_; }
   std::uint64_t seed() const { return seed_; }
 
@@ -85,6 +89,7 @@ class SimBench {
   DaqState daq_;
   int acquisitions_ = 0;
   int fetches_ = 0;
+  DutSelection dut_;
 };
 
 }  // namespace piezo::drivers::sim

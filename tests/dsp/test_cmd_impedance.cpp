@@ -84,7 +84,8 @@ TEST_F(CmdImpedance, PronyJsonCarriesFeaturesOrderAndSingularValues) {
 TEST_F(CmdImpedance, CsvAndTouchstone) {
   const auto c = run("impedance " + file() + " --method fft --fmax 120e3 --csv");
   ASSERT_EQ(c.code, 0);
-  EXPECT_EQ(c.out.rfind("f_hz,re_ohm,im_ohm\n", 0), 0u);
+  // the three columns first; the uncertainty band's columns follow (issue 10)
+  EXPECT_EQ(c.out.rfind("f_hz,re_ohm,im_ohm,abs_ohm,abs_sigma_ohm,phase_deg,phase_sigma_deg,coverage_factor\n", 0), 0u);
   const auto s = run("impedance " + file() + " --method prony --fmax 120e3 --step 1000 --s1p");
   ASSERT_EQ(s.code, 0);
   EXPECT_NE(s.out.find("# HZ Z RI R 50\n"), std::string::npos);

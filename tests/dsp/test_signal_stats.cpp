@@ -37,6 +37,18 @@ TEST(SignalStats, PinnedConverterIsClipped) {
   EXPECT_GT(s.samples_at_limit, 1000u);
 }
 
+// A 14-bit quantised, noise-free exp_decay (1 V, 3000 1/s, 2 ms at 10 MS/s)
+// ends on one code for hundreds of samples near 0 V: a tail, not a rail.
+// Clipped on its positive side, the same record is flagged.
+TEST(SignalStats, QuantisedDecayTailIsNotClippedButItsPinnedPeakIs) {
+  const double lsb = 1.25 / 8192;
+  std::vector<double> x(20000);
+  for (std::size_t i = 0; i < x.size(); ++i) x[i] = std::round(std::exp(-3000.0 * i / 1e7) / lsb) * lsb;
+  EXPECT_FALSE(dsp::compute_stats(x).clipped);
+  for (auto& v : x) v = std::min(v, 0.9);
+  EXPECT_TRUE(dsp::compute_stats(x).clipped);
+}
+
 TEST(SignalStats, KnownRangeUsesTheRange) {
   std::vector<double> x = {0.0, 0.5, 0.99, -0.2};
   dsp::ClipDetection c;

@@ -2,6 +2,9 @@
 // the "dut" shots of a capture by one of the dsp/ estimators, as text, JSON
 // (features, Prony order and singular values), CSV (f_hz,re_ohm,im_ohm) or
 // Touchstone 1-port (.s1p, Z, RI). Capture → dsp only; no estimator code here.
+// Prony, FFT and cross spectra go through acq::assess_impedance: fixture
+// compensation and deskew from the capture's calibration shots, uncertainty
+// band, Kramers-Kronig check, shot validity and the stabilization chart.
 #include <cstdio>
 #include <fstream>
 #include <iostream>
@@ -9,12 +12,15 @@
 
 #include "acquisition/capture_file.hpp"
 #include "acquisition/divider_record.hpp"
+#include "acquisition/impedance_assessment.hpp"
+#include "dsp/deskew.hpp"
 #include "dsp/cross_spectra.hpp"
 #include "dsp/fft_ratio.hpp"
 #include "dsp/impedance_io.hpp"
 #include "dsp/prony_impedance.hpp"
 #include "dsp/rayleigh.hpp"
 #include "dsp/stepped_sine.hpp"
+#include "ui/assessment_json.hpp"
 #include "ui/cli/cli_common.hpp"
 
 namespace piezo::cli {
@@ -27,6 +33,11 @@ struct ImpedanceArgs {
   double fmin = 0, fmax = 0, step = 0, overlap = 0.5;
   std::size_t bootstrap = 20;
   bool csv = false, s1p = false;
+  // Trust (issue 10): compensation, deskew, uncertainty, validity, KK, stabilization.
+  std::string compensation = "auto", uncertainty = "auto", stabilization = "2:30:2";
+  std::optional<double> skew_ns;
+  bool no_deskew = false, average = false, no_kk = false, no_validity = false, no_stabilization = false;
+  std::size_t bootstrap_shots = 30;
 };
 
 std::vector<const acq::Shot*> dut_shots(const acq::Capture& cap, bool sine) {
@@ -116,6 +127,67 @@ nlohmann::json result_json(const dsp::ImpedanceResult& r, const std::string& fil
   return j;
 }
 
+// The trust options of the command as assessment options (method, band, estimator options set by the caller).
+acq::AssessmentOptions trust_options(const ImpedanceArgs& a) {
+  acq::AssessmentOptions o;
+  if (a.compensation == "none") {
+    o.compensate = false;
+  } else if (a.compensation != "auto") {
+    const auto m = dsp::parse_fixture_model(a.compensation);
+    if (!m) throw InputError("--compensation: unknown model '" + a.compensation + "'");
+    o.model = *m;
+  }
+  o.deskew = !a.no_deskew;
+  if (a.skew_ns) o.skew_s = *a.skew_ns * 1e-9;
+  if (a.uncertainty == "auto") o.uncertainty = acq::UncertaintySource::Auto;
+  else if (a.uncertainty == "shots") o.uncertainty = acq::UncertaintySource::Shots;
+  else if (a.uncertainty == "noise") o.uncertainty = acq::UncertaintySource::Noise;
+  else if (a.uncertainty == "none") o.uncertainty = acq::UncertaintySource::None;
+  else throw InputError("--uncertainty: expected auto, shots, noise or none, got '" + a.uncertainty + "'");
+  o.bootstrap = a.bootstrap_shots;
+  o.kk = !a.no_kk;
+  o.validity = !a.no_validity;
+  o.stabilization = !a.no_stabilization;
+  unsigned lo = 0, hi = 0, st = 2;
+  char tail = 0;
+  const int got = std::sscanf(a.stabilization.c_str(), "%u:%u:%u%c", &lo, &hi, &st, &tail);
+  if (got < 2 || got > 3 || lo < 1 || hi < lo || st < 1 || hi > 200)
+    throw InputError("--stabilization: expected MIN:MAX[:STEP] orders with 1 <= MIN <= MAX <= 200, got '" +
+                     a.stabilization + "'");
+  o.stabilization_options.min_order = lo;
+  o.stabilization_options.max_order = hi;
+  o.stabilization_options.step = st;
+  return o;
+}
+
+void print_trust(const nlohmann::json& j) {
+  const auto& c = j["compensation"];
+  std::printf("  fixture model   %s\n", c["description"].get<std::string>().c_str());
+  if (c.contains("fixture")) {
+    const auto& f = c["fixture"];
+    if (f.contains("fixture_capacitance_f"))
+      std::printf("  fixture C       %.4g pF (measured, open)\n", f["fixture_capacitance_f"].get<double>() * 1e12);
+    if (f.contains("lead_resistance_ohm"))
+      std::printf("  lead R          %.4g ohm (measured, short)\n", f["lead_resistance_ohm"].get<double>());
+    if (f.contains("r1_error"))
+      std::printf("  R1 error        %+.3f %% (measured, load)\n", f["r1_error"].get<double>() * 100);
+  }
+  const auto& d = j["deskew"];
+  if (d["applied"].get<bool>())
+    std::printf("  channel skew    %.2f ns removed (%s)\n", d["skew_ns"].get<double>(), d["source"].get<std::string>().c_str());
+  if (j.contains("kramers_kronig"))
+    std::printf("  Kramers-Kronig  %s (%s)\n", j["kramers_kronig"]["pass"].get<bool>() ? "pass" : "FAIL",
+                j["kramers_kronig"]["note"].get<std::string>().c_str());
+  if (j.contains("uncertainty"))
+    std::printf("  uncertainty     %s, k = %.2f\n", j["uncertainty"]["source"].get<std::string>().c_str(),
+                j["uncertainty"]["coverage_factor"].get<double>());
+  if (j.contains("validity"))
+    for (const auto& s : j["validity"]["shots"])
+      if (!s["flags"].empty())
+        std::printf("  shot %s       %s\n", s["name"].get<std::string>().c_str(), s["flags"].dump().c_str());
+  for (const auto& n : j["notes"]) std::printf("  note: %s\n", n.get<std::string>().c_str());
+}
+
 void print_text(const nlohmann::json& j) {
   std::printf("%s  method %s, %zu samples\n", j["file"].get<std::string>().c_str(),
               j["method"].get<std::string>().c_str(), j["samples_used"].get<std::size_t>());
@@ -144,9 +216,13 @@ void run(const ImpedanceArgs& a, Context& ctx) {
   if (cap.shots.empty()) throw InputError("the capture holds no shot");
   const auto win = dsp::parse_window(a.window);
   if (!win) throw InputError("unknown window '" + a.window + "'");
+  acq::AssessmentOptions trust = trust_options(a);
   std::vector<std::string> names;
   dsp::ImpedanceResult r;
-  double band = a.fmax;
+  std::optional<acq::ImpedanceAssessment> assessed;
+  std::optional<dsp::ImpedanceBand> band;
+  std::optional<acq::CaptureCalibration> sine_cal;  // stepped sine: compensated here, not by assess_impedance
+  double band_hz = a.fmax;
   if (a.method == "sine") {
     std::vector<dsp::SineShot> shots;
     for (const auto* s : dut_shots(cap, true)) {
@@ -159,48 +235,55 @@ void run(const ImpedanceArgs& a, Context& ctx) {
     o.features.fmin_hz = a.fmin;
     if (a.fmax > 0) o.features.fmax_hz = a.fmax;
     r = dsp::impedance_stepped_sine(shots, o);
+    // Standards measured with a transient drive apply to a stepped-sine estimate
+    // too (steady state: the skew is exactly the phase ramp e^{jωτ}).
+    bool transient_standards = false;
+    for (const auto& sh : cap.shots)
+      transient_standards = transient_standards || (sh.role != acq::Role::Dut && sh.excitation != acq::Excitation::Sine);
+    if (trust.compensate && transient_standards) {
+      acq::CaptureCalibrationOptions co;
+      co.fmax_hz = r.f_hz.maxCoeff();
+      co.model = trust.model;
+      co.deskew = trust.deskew;
+      sine_cal = acq::calibrate_from_capture(cap, co);
+    } else if (trust.model && *trust.model != dsp::FixtureModel::None) {
+      throw InputError("--compensation " + a.compensation +
+                       ": the capture holds no transient calibration shot (stepped-sine standards are not supported)");
+    }
+    const double skew = sine_cal ? sine_cal->skew_applied_s : (trust.skew_s && trust.deskew ? *trust.skew_s : 0.0);
+    if (skew != 0.0) dsp::deskew_impedance(r, cap.setup.divider_r1_ohm, skew);
+    if (sine_cal) sine_cal->compensate(r);
+    if (r.z_sigma_ohm.size() == r.f_hz.size() && trust.uncertainty != acq::UncertaintySource::None)
+      band = dsp::band_from_sigma(r.f_hz, r.z_ohm, r.z_sigma_ohm, trust.coverage_factor,
+                                  sine_cal ? "lock-in fit covariance + fixture standards" : "lock-in fit covariance");
   } else {
     const acq::Shot& shot = pick_shot(cap, a);
     const double fs = shot.sample_rate_hz;
     const double fmax = a.fmax > 0 ? a.fmax : fs / 4;
-    band = fmax;
+    band_hz = fmax;
     if (!(fmax <= fs / 2)) throw InputError("--fmax above the Nyquist frequency");
     const double step = a.step > 0 ? a.step : fmax / 2000;
-    const double fmin = a.fmin > 0 ? a.fmin : step;
-    if (a.method == "prony") {
-      dsp::PronyImpedanceOptions o;
-      o.prep.max_samples = a.samples.value_or(std::min<std::size_t>(
-          3000, shot.samples() - static_cast<std::size_t>(std::max<std::int64_t>(0, shot.pretrigger_samples))));
-      o.prony.order = a.order;
-      o.prony.band_hz = fmax;
-      o.features.fmin_hz = fmin;
-      o.bootstrap = a.bootstrap;
-      r = dsp::impedance_prony(acq::divider_record(cap, shot), dsp::make_grid(fmin, fmax, step), o);
-      names.push_back(shot.name);
-    } else if (a.method == "fft") {
-      dsp::FftRatioOptions o;
-      o.prep.max_samples = a.samples.value_or(0);
-      o.window = {*win, 0.5};
-      o.fmin_hz = fmin;
-      o.fmax_hz = fmax;
-      r = dsp::impedance_fft(acq::divider_record(cap, shot), o);
-      names.push_back(shot.name);
-    } else {  // xspec: every transient dut shot of the chosen shot's excitation
-      std::vector<dsp::DividerRecord> recs;
-      for (const auto* s : dut_shots(cap, false))
-        if (s->excitation == shot.excitation) {
-          recs.push_back(acq::divider_record(cap, *s));
-          names.push_back(s->name);
-        }
-      dsp::CrossSpectraOptions o;
-      o.segment = a.segment.value_or(0);
-      o.overlap = a.overlap;
-      o.window = {*win, 0.5};
-      o.prep.max_samples = a.samples.value_or(0);
-      o.fmin_hz = fmin;
-      o.fmax_hz = fmax;
-      r = dsp::impedance_xspec(recs, o);
-    }
+    trust.method = a.method;
+    trust.fmin_hz = a.fmin > 0 ? a.fmin : step;
+    trust.fmax_hz = fmax;
+    trust.step_hz = step;
+    const std::size_t post = shot.samples() - static_cast<std::size_t>(std::max<std::int64_t>(0, shot.pretrigger_samples));
+    trust.prony.prep.max_samples = a.samples.value_or(std::min<std::size_t>(3000, post));
+    trust.prony.prony.order = a.order;
+    trust.prony.bootstrap = a.bootstrap;
+    trust.fft.prep.max_samples = a.samples.value_or(0);
+    trust.fft.window = {*win, 0.5};
+    trust.fft.one_sided = true;  // as the fixture standards are measured (no half-sample phase error)
+    trust.xspec.segment = a.segment.value_or(0);
+    trust.xspec.overlap = a.overlap;
+    trust.xspec.window = {*win, 0.5};
+    trust.xspec.prep.max_samples = a.samples.value_or(0);
+    // prony and fft: one shot unless --average; xspec: every shot of the drive as a segment
+    if (a.method != "xspec" && !a.average) trust.shot = static_cast<std::size_t>(&shot - cap.shots.data());
+    assessed = acq::assess_impedance(cap, trust);
+    r = assessed->result;
+    names = assessed->shots;
+    band = assessed->band;
   }
   std::ofstream file;
   std::ostream* os = &std::cout;
@@ -209,12 +292,42 @@ void run(const ImpedanceArgs& a, Context& ctx) {
     if (!file) throw InputError("cannot write " + a.output);
     os = &file;
   }
-  if (a.csv) dsp::write_impedance_csv(*os, r);
-  else if (a.s1p) dsp::write_touchstone_s1p(*os, r);
-  else {
-    const auto j = result_json(r, a.file, names, band > 0 ? band : 1e300);
-    if (ctx.json) *os << j.dump(2) << std::endl;
-    else print_text(j);
+  if (a.csv) {
+    if (band) dsp::write_impedance_csv(*os, r, *band);
+    else dsp::write_impedance_csv(*os, r);
+  } else if (a.s1p) {
+    dsp::write_touchstone_s1p(*os, r);
+  } else {
+    auto j = result_json(r, a.file, names, band_hz > 0 ? band_hz : 1e300);
+    if (assessed) {
+      j.update(ui::assessment_json(*assessed));  // fields added, none renamed
+    } else {  // stepped sine
+      const auto model = sine_cal ? sine_cal->model : dsp::FixtureModel::None;
+      j["compensation"] = {{"applied", model != dsp::FixtureModel::None},
+                           {"model", std::string(dsp::to_string(model))},
+                           {"description", dsp::describe(model)}};
+      if (sine_cal) j["compensation"]["fixture"] = ui::fixture_json(sine_cal->fixture);
+      const double skew = sine_cal ? sine_cal->skew_applied_s : (trust.skew_s && trust.deskew ? *trust.skew_s : 0.0);
+      j["deskew"] = {{"applied", skew != 0.0},
+                     {"skew_s", skew},
+                     {"skew_ns", skew * 1e9},
+                     {"source", sine_cal ? sine_cal->skew_source : (trust.skew_s ? "given (a stored skew)" : "")}};
+      j["notes"] = nlohmann::json::array();
+      bool sine_standards = false;
+      for (const auto& sh : cap.shots)
+        sine_standards = sine_standards || (sh.role != acq::Role::Dut && sh.excitation == acq::Excitation::Sine);
+      if (sine_standards && !sine_cal)
+        j["notes"].push_back("the capture's calibration shots are stepped-sine shots: not supported yet, Z is not compensated");
+      if (band)
+        j["uncertainty"] = {{"source", band->source}, {"coverage_factor", band->coverage_factor},
+                            {"abs_sigma_ohm", std::vector<double>(band->abs_sigma_ohm.data(), band->abs_sigma_ohm.data() + band->size())}};
+    }
+    if (ctx.json) {
+      *os << j.dump(2) << std::endl;
+    } else {
+      print_text(j);
+      print_trust(j);
+    }
   }
 }
 
@@ -236,7 +349,20 @@ void register_impedance_command(CLI::App& app, Context& ctx) {
   cmd->add_option("--segment", a->segment, "xspec segment length (default: the shortest shot)");
   cmd->add_option("--overlap", a->overlap, "xspec segment overlap fraction")->check(CLI::Range(0.0, 0.95));
   cmd->add_option("--bootstrap", a->bootstrap, "Prony: bootstrap refits for the feature uncertainties");
-  cmd->add_flag("--csv", a->csv, "CSV output: f_hz,re_ohm,im_ohm");
+  cmd->add_flag("--csv", a->csv, "CSV output: f_hz,re_ohm,im_ohm, then the uncertainty band columns");
+  cmd->add_option("--compensation", a->compensation,
+                  "Fixture compensation from the capture's open/short/load shots: auto | none | open | short | "
+                  "open-short | open-short-load")
+      ->capture_default_str();
+  cmd->add_flag("--no-deskew", a->no_deskew, "Do not estimate/remove the channel-2 skew");
+  cmd->add_option("--skew-ns", a->skew_ns, "A stored channel-2 skew (ns, > 0: v2 late) for a capture without calibration shots");
+  cmd->add_flag("--average", a->average, "prony/fft: average every dut shot of the drive (default: one shot)");
+  cmd->add_option("--uncertainty", a->uncertainty, "Uncertainty band: auto | shots | noise | none")->capture_default_str();
+  cmd->add_option("--bootstrap-shots", a->bootstrap_shots, "Replicates of the bootstrap over shots")->capture_default_str();
+  cmd->add_flag("--no-kk", a->no_kk, "Skip the Kramers-Kronig / passivity check");
+  cmd->add_flag("--no-validity", a->no_validity, "Skip the per-shot validity flags");
+  cmd->add_option("--stabilization", a->stabilization, "Prony stabilization chart orders MIN:MAX[:STEP]")->capture_default_str();
+  cmd->add_flag("--no-stabilization", a->no_stabilization, "Skip the stabilization chart");
   cmd->add_flag("--s1p", a->s1p, "Touchstone 1-port output (Z, RI, normalised to 50 ohm)");
   cmd->add_option("-o,--output", a->output, "Write the output to this file instead of stdout");
   add_json_flag(cmd, ctx);

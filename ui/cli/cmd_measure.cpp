@@ -6,6 +6,7 @@
 #include <iostream>
 #include <thread>
 
+#include "acquisition/calibration_plan.hpp"
 #include "acquisition/runner.hpp"
 #include "acquisition/sim_setup.hpp"
 #include "drivers/sim/sim_awg.hpp"
@@ -56,6 +57,14 @@ acq::SimSpec sim_spec(const SimOptions& o, const model::TubeGeometry& g) {
 std::atomic<bool> g_cancel{false};
 void on_sigint(int) { g_cancel = true; }
 
+// Asks the technician on the terminal to connect a standard; 'q' cancels.
+bool terminal_prompt(const std::string& instruction) {
+  std::cerr << "\n>>> " << instruction << "\n    press Enter when done (q + Enter cancels): " << std::flush;
+  std::string line;
+  if (!std::getline(std::cin, line)) return false;  // no terminal input: nobody connected it
+  return line != "q" && line != "Q";
+}
+
 }  // namespace
 
 void register_measure_commands(CLI::App& app, Context& ctx) {
@@ -72,6 +81,9 @@ void register_measure_commands(CLI::App& app, Context& ctx) {
     int shots = 1;
     std::string out;
     bool overwrite = false, allow_clipping = false;
+    std::string calibrate;  // "open,short,load" (issue 10)
+    double load_ohm = 1000.0;
+    std::optional<double> load_parallel_f;
     SimOptions sim;
   };
   auto a = std::make_shared<MeasureArgs>();
@@ -95,6 +107,11 @@ void register_measure_commands(CLI::App& app, Context& ctx) {
   m->add_option("--out", a->out, "Capture file to write (.h5)")->required();
   m->add_flag("--overwrite", a->overwrite, "Replace an existing capture");
   m->add_flag("--allow-clipping", a->allow_clipping, "Keep going after a clipped shot");
+  m->add_option("--calibrate", a->calibrate,
+                "Measure fixture standards first, e.g. open,short,load (the simulator swaps them itself; "
+                "on a real bench you are asked to connect each)");
+  m->add_option("--load-ohm", a->load_ohm, "Resistance of the load standard (ohm)")->capture_default_str();
+  m->add_option("--load-parallel-f", a->load_parallel_f, "Parallel capacitance of the load standard (F)");
   add_sim_options(m, a->sim);
   add_json_flag(m, ctx);
   m->callback([&ctx, a, plan_opt] {
@@ -134,6 +151,14 @@ void register_measure_commands(CLI::App& app, Context& ctx) {
       ro.overwrite = a->overwrite;
       ro.stop_on_clipping = !a->allow_clipping;
       ro.software = "piezobench measure";
+      if (!a->calibrate.empty()) {  // fixture standards before the DUT shots
+        try {
+          ro.calibration = acq::parse_calibration_list(a->calibrate, a->load_ohm, a->load_parallel_f);
+        } catch (const std::invalid_argument& e) {
+          throw InputError(e.what());
+        }
+        ro.connect_standard = acq::make_standard_connector(bench, terminal_prompt);
+      }
       std::signal(SIGINT, on_sigint);
       ProgressBar bar("measure");
       acq::RunResult res;
@@ -157,6 +182,12 @@ void register_measure_commands(CLI::App& app, Context& ctx) {
                           {"cancelled", res.cancelled},
                           {"clipped_shots", res.clipped_shots},
                           {"bench", bench.description}};
+      if (!ro.calibration.empty()) {
+        nlohmann::json cal = nlohmann::json::array();
+        for (const auto& c : ro.calibration) cal.push_back(std::string(acq::to_string(c.role)));
+        j["calibration"] = cal;
+        j["standards_switched_by"] = acq::is_simulated_instrument(bench) ? "simulator (SIM:DUT)" : "technician";
+      }
       if (ctx.json) print_json(j);
       else
         std::cout << "wrote " << res.shots_written << "/" << res.shots_planned << " shots to "
@@ -167,7 +198,7 @@ void register_measure_commands(CLI::App& app, Context& ctx) {
 
   // --------------------------------------------------------- sim-instrument
   auto* s = app.add_subcommand("sim-instrument",
-                               "Serve the simulated AWG (PORT) and DAQ (PORT+1) over TCP (SCPI)");
+                               "Serve the simulated AWG (PORT) and DAQ (PORT+1) over TCP (SCPI; the simulator-only SIM:DUT TUBE|OPEN|SHORT|LOAD,<ohm>[,<F>] on the AWG port swaps the device for calibration standards)");
   struct SimArgs {
     std::string host = "127.0.0.1";
     int port = 5025;

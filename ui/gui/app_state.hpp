@@ -9,6 +9,7 @@
 #include <thread>
 #include <vector>
 
+#include "ui/gui/calibration_prompt.hpp"
 #include "ui/gui/plot_widget.hpp"
 #include "ui/pipeline.hpp"
 
@@ -46,6 +47,12 @@ struct AppState {
   ui::PipelineRequest request;  // the plan panel edits this; a job gets a copy
   char capture_out[256] = "piezobench-capture.h5";
   char replay_path[256] = "";
+  // Issue 10: fixture standards before the shots. The prompt is declared before
+  // the job so that it outlives the job's thread, which may be waiting in it;
+  // ~AppState declines that question before the job joins.
+  CalibrationForm calibration;
+  ui::OperatorPrompt calibration_prompt;  // the worker asks, the frame loop draws the dialog
+  ~AppState() { calibration_prompt.close(); }
   Job job;
   std::unique_ptr<ui::PipelineResult> result;
   std::string error;  // shown in the window with what to do

@@ -119,6 +119,7 @@ int main(int argc, char** argv) {
     ImGui::SetNextWindowPos(ImVec2(left, h * 0.66f), ImGuiCond_FirstUseEver);
     ImGui::SetNextWindowSize(ImVec2(w - left, h * 0.34f), ImGuiCond_FirstUseEver);
     render_results_window(state);
+    render_calibration_prompt(state.calibration_prompt);  // issue 10: "connect the standard" while the job waits
 
     if (state.job.take(state.result, state.error)) {
       state.mag_view.fitted = state.phase_view.fitted = state.sv_view.fitted = false;

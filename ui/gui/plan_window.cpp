@@ -43,6 +43,7 @@ void render_plan_window(AppState& s) {
   ImGui::InputText("Capture file", s.capture_out, sizeof s.capture_out);
   ImGui::InputText("Replay capture (optional)", s.replay_path, sizeof s.replay_path);
   ImGui::EndDisabled();
+  render_calibration_controls(s.calibration, busy);  // issue 10
   ImGui::Separator();
 
   if (!busy) {
@@ -52,6 +53,7 @@ void render_plan_window(AppState& s) {
       req.daq = s.instrument.daq;
       req.capture_out = s.capture_out;
       req.replay_capture = s.replay_path;
+      attach_calibration(s.calibration, s.calibration_prompt, req);  // issue 10
       s.error.clear();
       s.frame_ms_during_job.clear();
       s.job.start(req);

@@ -1,0 +1,241 @@
+#include "acquisition/capture_calibration.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+
+#include "acquisition/divider_record.hpp"
+#include "dsp/deskew.hpp"
+#include "dsp/fft_ratio.hpp"
+#include "dsp/signal_stats.hpp"
+
+namespace piezo::acq {
+
+bool same_drive(const Shot& a, const Shot& b) {
+  return a.samples() == b.samples() && a.sample_rate_hz == b.sample_rate_hz &&
+         a.pretrigger_samples == b.pretrigger_samples && a.excitation == b.excitation &&
+         a.amplitude_v == b.amplitude_v && a.decay_per_s == b.decay_per_s &&
+         a.frequency_hz == b.frequency_hz && a.f_start_hz == b.f_start_hz &&
+         a.f_stop_hz == b.f_stop_hz;
+}
+
+OwnedRecord average_shots(const Capture& cap, std::span<const Shot* const> shots) {
+  if (shots.empty()) throw std::invalid_argument("average_shots: no shot");
+  const Shot& first = *shots.front();
+  OwnedRecord r;
+  r.v1.assign(first.samples(), 0.0);
+  r.v2.assign(first.samples(), 0.0);
+  for (const Shot* s : shots) {
+    if (!same_drive(first, *s))
+      throw std::invalid_argument("shot " + s->name + ": its record or drive differs from shot " +
+                                  first.name + ", so the two cannot be averaged");
+    for (std::size_t i = 0; i < r.v1.size(); ++i) {
+      r.v1[i] += s->v1[i];
+      r.v2[i] += s->v2[i];
+    }
+    r.shots.push_back(s->name);
+  }
+  const double n = double(shots.size());
+  for (std::size_t i = 0; i < r.v1.size(); ++i) {
+    r.v1[i] /= n;
+    r.v2[i] /= n;
+  }
+  const auto rec = divider_record(cap, first);
+  r.sample_rate_hz = rec.sample_rate_hz;
+  r.r1_ohm = rec.r1_ohm;
+  r.pretrigger_samples = rec.pretrigger_samples;
+  for (const Shot* s : shots)  // one full scale only when every shot has the same
+    if (s->daq_range_v != first.daq_range_v) return r;
+  r.daq_range_v = first.daq_range_v;
+  return r;
+}
+
+void deskew_record(OwnedRecord& r, double skew_s) {
+  // Runs for a zero skew too: channel 2's sample at t = 0 is then replaced by
+  // the value just after the drive's jump, as channel 1 records it.
+  r.v2 = dsp::deskew_channel(r.v2, r.sample_rate_hz, r.pretrigger_samples, skew_s);
+  // The last samples of a late channel 2 would be extrapolated beyond its record
+  // (noise amplified by the Lagrange weights): both channels end before them.
+  const double d = skew_s * r.sample_rate_hz;
+  const std::size_t drop = static_cast<std::size_t>(std::ceil(std::max(d, 0.0))) + 2;
+  if (r.v1.size() < r.pretrigger_samples + drop + 16)
+    throw std::invalid_argument("deskew_record: the record is too short for a skew of " +
+                                std::to_string(skew_s * 1e9) + " ns");
+  r.v1.resize(r.v1.size() - drop);
+  r.v2.resize(r.v2.size() - drop);
+}
+
+namespace {
+
+bool clipped(const Shot& s) {
+  dsp::ClipDetection c;
+  c.range_v = s.daq_range_v;
+  return dsp::compute_stats(s.v1, c).clipped || dsp::compute_stats(s.v2, c).clipped;
+}
+
+// The usable transient shots of one role, averaged: those matching the first
+// in record and drive; clipped and sine shots are left out (with a note).
+std::optional<OwnedRecord> average_role(const Capture& cap, Role role,
+                                        std::vector<std::string>& notes) {
+  std::vector<const Shot*> use;
+  const std::string rn(to_string(role));
+  for (const auto& s : cap.shots) {
+    if (s.role != role) continue;
+    if (s.excitation == Excitation::Sine) {
+      notes.push_back("shot " + s.name + " (" + rn +
+                      "): sine shots are not used for the fixture calibration");
+    } else if (clipped(s)) {
+      notes.push_back("shot " + s.name + " (" + rn + "): clipped, left out of the calibration");
+    } else if (!use.empty() && !same_drive(*use.front(), s)) {
+      notes.push_back("shot " + s.name + " (" + rn + "): record or drive differs from shot " +
+                      use.front()->name + ", left out of the average");
+    } else {
+      if (role == Role::Load && !s.load_ohm)
+        throw std::invalid_argument("shot " + s.name + ": role \"load\" without load_ohm");
+      if (role == Role::Load && !use.empty() &&
+          (s.load_ohm != use.front()->load_ohm ||
+           s.load_parallel_f != use.front()->load_parallel_f))
+        throw std::invalid_argument(
+            "shot " + s.name + ": load standard differs from shot " + use.front()->name +
+            " (load_ohm/load_parallel_f); one capture holds one load standard");
+      use.push_back(&s);
+    }
+  }
+  if (use.empty()) return std::nullopt;
+  return average_shots(cap, use);
+}
+
+// Z_m(f) of a standard by the one-sided FFT ratio of the whole record.
+// nullopt: channel 2 shows no signal at all (an ideal short: Z_m = 0).
+std::optional<dsp::MeasuredStandard> measure(const OwnedRecord& r, double fmin, double fmax,
+                                             Role role) {
+  dsp::FftRatioOptions o;
+  o.fmin_hz = fmin;
+  o.fmax_hz = fmax;
+  o.one_sided = true;  // the drive's jump at t = 0, as Prony sees it
+  try {
+    const auto z = dsp::impedance_fft(r.view(), o);
+    return dsp::MeasuredStandard{z.f_hz, z.z_ohm, z.z_sigma_ohm};
+  } catch (const std::invalid_argument& e) {
+    const std::string what = e.what();
+    if (role == Role::Short && what.find("v2 is constant") != std::string::npos)
+      return std::nullopt;
+    throw std::invalid_argument("calibration standard '" + std::string(to_string(role)) +
+                                "' (shot " + r.shots.front() + "): " + what);
+  }
+}
+
+}  // namespace
+
+dsp::FixtureCompensation CaptureCalibration::compensation() const {
+  return dsp::FixtureCompensation(model, open, shrt, load, load_value);
+}
+
+void CaptureCalibration::compensate(dsp::ImpedanceResult& r) const { compensation().apply(r); }
+
+std::optional<CaptureCalibration> calibrate_from_capture(const Capture& cap,
+                                                         const CaptureCalibrationOptions& opt) {
+  CaptureCalibration out;
+  auto open = average_role(cap, Role::Open, out.notes);
+  auto shrt = average_role(cap, Role::Short, out.notes);
+  auto load = average_role(cap, Role::Load, out.notes);
+  if (!open && !shrt && !load) {
+    bool any = false;
+    for (const auto& s : cap.shots) any = any || s.role != Role::Dut;
+    if (any)
+      throw std::invalid_argument(
+          "the capture's calibration shots are all unusable: " +
+          (out.notes.empty() ? std::string("none left") : out.notes.front()));
+    return std::nullopt;
+  }
+  const OwnedRecord& ref = open ? *open : shrt ? *shrt : *load;
+  const double fs = ref.sample_rate_hz;
+  double fmax = opt.fmax_hz > 0 ? opt.fmax_hz : fs / 4;
+  if (!(fmax <= fs / 2))
+    throw std::invalid_argument("calibration: fmax above the Nyquist frequency of the standards");
+  fmax =
+      std::min(fs / 2, 1.05 * fmax);  // a few bins beyond the band: the models must cover its top
+  out.r1_nominal_ohm = cap.setup.divider_r1_ohm;
+  if (open) out.shots_open = open->shots;
+  if (shrt) out.shots_short = shrt->shots;
+  if (load) {
+    out.shots_load = load->shots;
+    const Shot* first = nullptr;
+    for (const auto& s : cap.shots)
+      if (s.name == load->shots.front()) first = &s;
+    out.load_value = {*first->load_ohm, first->load_parallel_f.value_or(0.0)};
+  }
+
+  // 2. The skew.
+  if (opt.deskew) {
+    if (open) {
+      dsp::CalibrationStandards c0;
+      c0.r1_nominal_ohm = out.r1_nominal_ohm;
+      c0.open = measure(*open, opt.fmin_hz, fmax, Role::Open);
+      out.skew_applied_s = dsp::fit_fixture(c0).skew_s.value_or(0.0);
+      out.skew_source =
+          "open standard (fixture fit of its transfer: delay separated from the R1*Cp lag)";
+    } else {
+      const OwnedRecord& r = shrt ? *shrt : *load;
+      const auto pre = r.pretrigger_samples;
+      out.skew_applied_s =
+          dsp::xcorr_delay(std::span(r.v1).subspan(pre), std::span(r.v2).subspan(pre), fs);
+      out.skew_source = std::string("cross-correlation of the ") + (shrt ? "short" : "load") +
+                        " standard (no open: +-half a sample, its v2 jumps with the drive)";
+    }
+  } else {
+    out.skew_source = "not estimated (deskew off)";
+  }
+  out.deskewed = opt.deskew;
+  if (opt.deskew)
+    for (auto* r : {&open, &shrt, &load})
+      if (*r) deskew_record(**r, out.skew_applied_s);
+
+  // 4. Standards, fixture quantities, smooth models.
+  dsp::CalibrationStandards cs;
+  cs.r1_nominal_ohm = out.r1_nominal_ohm;
+  cs.load_value = out.load_value;
+  cs.skew_guess_s = 0.0;  // the records are deskewed: the fit sees the residual
+  if (open) cs.open = measure(*open, opt.fmin_hz, fmax, Role::Open);
+  bool short_is_zero = false;
+  if (shrt) {
+    cs.shrt = measure(*shrt, opt.fmin_hz, fmax, Role::Short);
+    short_is_zero = !cs.shrt;
+  }
+  if (load) cs.load = measure(*load, opt.fmin_hz, fmax, Role::Load);
+  if (cs.open || cs.shrt || cs.load) out.fixture = dsp::fit_fixture(cs);
+  if (out.fixture.skew_s) {  // total delay of channel 2: removed from the records + what the fit
+                             // still sees
+    out.fixture.skew_s = *out.fixture.skew_s + out.skew_applied_s;
+  } else {
+    out.fixture.skew_s = out.skew_applied_s;
+  }
+  if (short_is_zero) {
+    out.fixture.lead_resistance_ohm = 0.0;
+    out.notes.push_back(
+        "the short standard shows no voltage on channel 2: lead resistance below the DAQ's "
+        "resolution, "
+        "taken as 0");
+  }
+
+  out.model = opt.model.value_or(
+      dsp::FixtureCompensation::best_model(open.has_value(), shrt.has_value(), load.has_value()));
+  out.model_description = dsp::describe(out.model);
+  // Open and load as admittances (G + jωC after the error box), the short as an impedance (R +
+  // jωL).
+  if (cs.open) out.open = dsp::fit_standard(*cs.open, true, opt.degree, "open");
+  if (cs.load) out.load = dsp::fit_standard(*cs.load, true, opt.degree, "load");
+  if (cs.shrt) out.shrt = dsp::fit_standard(*cs.shrt, false, opt.degree, "short");
+  if (short_is_zero) {  // Z_s ≡ 0
+    dsp::StandardModel z;
+    z.fmax_hz = fmax;
+    z.omega_scale = 2 * M_PI * fmax;
+    z.c = Eigen::VectorXd::Zero(opt.degree + 1);
+    z.cov = Eigen::MatrixXd::Zero(opt.degree + 1, opt.degree + 1);
+    out.shrt = z;
+  }
+  (void)out.compensation();  // checks that the model is supported by the standards present
+  return out;
+}
+
+}  // namespace piezo::acq

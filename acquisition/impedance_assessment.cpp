@@ -1,0 +1,302 @@
+#include "acquisition/impedance_assessment.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+
+#include "acquisition/divider_record.hpp"
+#include "dsp/deskew.hpp"
+#include "dsp/features.hpp"
+
+namespace piezo::acq {
+
+namespace {
+
+struct Band {
+  double fmin, fmax, step;
+};
+
+std::vector<const Shot*> dut_shots(const Capture& cap, const AssessmentOptions& opt) {
+  if (opt.shot) {
+    if (*opt.shot >= cap.shots.size())
+      throw std::invalid_argument("shot " + std::to_string(*opt.shot) +
+                                  " does not exist (the capture has " +
+                                  std::to_string(cap.shots.size()) + ")");
+    const Shot& s = cap.shots[*opt.shot];
+    if (s.role != Role::Dut)
+      throw std::invalid_argument("shot " + s.name + " is a calibration shot (role \"" +
+                                  std::string(to_string(s.role)) +
+                                  "\"), not the device under test");
+    return {&s};
+  }
+  const Shot* first = nullptr;
+  for (const auto& s : cap.shots)
+    if (s.role == Role::Dut && s.excitation == Excitation::ExpDecay) {
+      first = &s;
+      break;
+    }
+  if (!first)
+    for (const auto& s : cap.shots)
+      if (s.role == Role::Dut && s.excitation != Excitation::Sine) {
+        first = &s;
+        break;
+      }
+  if (!first) throw std::invalid_argument("the capture holds no transient \"dut\" shot");
+  std::vector<const Shot*> out;
+  for (const auto& s : cap.shots)
+    if (s.role == Role::Dut && same_drive(*first, s)) out.push_back(&s);
+  return out;
+}
+
+OwnedRecord mean_of(const std::vector<OwnedRecord>& recs) {
+  OwnedRecord avg = recs.front();
+  for (std::size_t k = 1; k < recs.size(); ++k)
+    for (std::size_t i = 0; i < avg.v1.size(); ++i) {
+      avg.v1[i] += recs[k].v1[i];
+      avg.v2[i] += recs[k].v2[i];
+    }
+  for (std::size_t i = 0; i < avg.v1.size(); ++i) {
+    avg.v1[i] /= double(recs.size());
+    avg.v2[i] /= double(recs.size());
+  }
+  return avg;
+}
+
+// One estimate from owned records (averaged for prony/fft, segments for xspec).
+dsp::ImpedanceResult estimate(const std::string& method, const std::vector<OwnedRecord>& recs,
+                              const Band& b, const AssessmentOptions& opt,
+                              std::optional<std::size_t> order, std::size_t bootstrap) {
+  if (method == "xspec") {
+    std::vector<dsp::DividerRecord> v;
+    for (const auto& r : recs) v.push_back(r.view());
+    dsp::CrossSpectraOptions o = opt.xspec;
+    o.fmin_hz = b.fmin;
+    o.fmax_hz = b.fmax;
+    return dsp::impedance_xspec(v, o);
+  }
+  const OwnedRecord avg = mean_of(recs);  // prony / fft: averaged sample by sample
+  if (method == "fft") {
+    dsp::FftRatioOptions o = opt.fft;
+    o.fmin_hz = b.fmin;
+    o.fmax_hz = b.fmax;
+    return dsp::impedance_fft(avg.view(), o);
+  }
+  dsp::PronyImpedanceOptions o = opt.prony;
+  o.prony.band_hz = b.fmax;
+  o.features.fmin_hz = b.fmin;
+  if (order) o.prony.order = order;
+  o.bootstrap = bootstrap;
+  return dsp::impedance_prony(avg.view(), dsp::make_grid(b.fmin, b.fmax, b.step), o);
+}
+
+OwnedRecord single(const Capture& cap, const Shot& s) {
+  const Shot* p = &s;
+  return average_shots(cap, std::span<const Shot* const>(&p, 1));
+}
+
+}  // namespace
+
+ImpedanceAssessment assess_impedance(const Capture& cap, const AssessmentOptions& opt) {
+  if (opt.method != "prony" && opt.method != "fft" && opt.method != "xspec")
+    throw std::invalid_argument("assess_impedance: method '" + opt.method +
+                                "' (expected prony, fft or xspec)");
+  ImpedanceAssessment out;
+  const auto shots = dut_shots(cap, opt);
+  for (const Shot* s : shots) out.shots.push_back(s->name);
+  const double fs = shots.front()->sample_rate_hz;
+  Band b;
+  b.fmax = opt.fmax_hz > 0 ? opt.fmax_hz : fs / 4;
+  if (!(b.fmax <= fs / 2))
+    throw std::invalid_argument("fmax above the Nyquist frequency (" + std::to_string(fs / 2) +
+                                " Hz)");
+  b.step = opt.step_hz > 0 ? opt.step_hz : b.fmax / 2000;
+  b.fmin = opt.fmin_hz > 0 ? opt.fmin_hz : b.step;
+  if (!(b.fmin < b.fmax)) throw std::invalid_argument("fmin must lie below fmax");
+
+  // Calibration (skew and standards) from the capture's calibration shots.
+  if (opt.compensate) {
+    CaptureCalibrationOptions co;
+    co.fmin_hz = 0.0;
+    co.fmax_hz = b.fmax;
+    co.degree = opt.standard_degree;
+    co.model = opt.model;
+    co.deskew = opt.deskew;
+    out.calibration = calibrate_from_capture(cap, co);
+    if (out.calibration) {
+      out.skew_applied_s = out.calibration->skew_applied_s;
+      out.skew_source = out.calibration->skew_source;
+      out.model = out.calibration->model;
+      for (const auto& n : out.calibration->notes) out.notes.push_back(n);
+    } else if (opt.model && *opt.model != dsp::FixtureModel::None) {
+      throw std::invalid_argument(
+          "fixture compensation '" + std::string(dsp::to_string(*opt.model)) +
+          "' asked for, but the capture holds no calibration shot (role open/short/load)");
+    }
+  }
+  if (!out.calibration && opt.skew_s && opt.deskew) {
+    out.skew_applied_s = *opt.skew_s;
+    out.skew_source = "given (a stored skew)";
+  }
+  out.model_description = dsp::describe(out.model);
+
+  std::vector<OwnedRecord> raw, ready;
+  for (const Shot* s : shots) {
+    raw.push_back(single(cap, *s));
+    ready.push_back(raw.back());
+    // As the standards were (also for a skew near 0), or a stored skew; nothing otherwise.
+    if ((out.calibration && opt.deskew) || (!out.calibration && opt.skew_s && opt.deskew))
+      deskew_record(ready.back(), out.skew_applied_s);
+  }
+  // Deskewing drops the last few samples: a sample count meant for the whole
+  // recorded span follows it (one beyond the recorded span stays an error).
+  AssessmentOptions o2 = opt;
+  const std::size_t avail_raw = raw.front().v1.size() - raw.front().pretrigger_samples;
+  const std::size_t avail_ready = ready.front().v1.size() - ready.front().pretrigger_samples;
+  for (auto* p : {&o2.prony.prep, &o2.fft.prep, &o2.xspec.prep})
+    if (p->max_samples > avail_ready && p->max_samples <= avail_raw) p->max_samples = avail_ready;
+  const std::size_t boot_noise = opt.method == "prony" ? opt.prony.bootstrap : 0;
+  out.uncompensated = estimate(opt.method, raw, b, opt, std::nullopt, 0);
+  out.result = estimate(opt.method, ready, b, o2, std::nullopt, boot_noise);
+  const std::optional<std::size_t> order =
+      out.result.prony ? std::optional<std::size_t>(out.result.prony->order) : std::nullopt;
+  std::optional<dsp::FixtureCompensation> comp;
+  if (out.calibration) comp = out.calibration->compensation();
+  // The standards' own uncertainty at each point (before correcting Z in place).
+  Eigen::VectorXd sigma_std;
+  if (comp) {
+    sigma_std.resize(out.result.f_hz.size());
+    for (Eigen::Index k = 0; k < sigma_std.size(); ++k)
+      sigma_std[k] = comp->corrected_sigma(out.result.f_hz[k], out.result.z_ohm[k], 0.0);
+    comp->apply(out.result);
+    dsp::FeatureOptions fo = opt.prony.features;
+    fo.fmin_hz = b.fmin;
+    out.result.features =
+        dsp::find_features(out.result.f_hz, out.result.z_ohm, out.result.z_sigma_ohm, fo);
+    out.notes.push_back(
+        "features of the compensated estimate are |Z| extrema on the grid (not Prony zeros/poles)");
+  }
+
+  // Uncertainty band.
+  UncertaintySource src = opt.uncertainty;
+  if (src == UncertaintySource::Auto)
+    src = ready.size() >= 3 ? UncertaintySource::Shots : UncertaintySource::Noise;
+  if (src == UncertaintySource::Shots && ready.size() < 2) {
+    out.notes.push_back(
+        "uncertainty: a bootstrap over shots needs >= 2 shots; noise propagation used");
+    src = UncertaintySource::Noise;
+  }
+  if (src == UncertaintySource::Shots) {
+    auto reps = dsp::bootstrap_over_shots(ready.size(), opt.bootstrap, opt.seed,
+                                          [&](const std::vector<std::size_t>& idx) {
+                                            std::vector<OwnedRecord> pick;
+                                            for (auto i : idx) pick.push_back(ready[i]);
+                                            auto r = estimate(opt.method, pick, b, o2, order, 0);
+                                            if (comp)
+                                              for (Eigen::Index k = 0; k < r.f_hz.size(); ++k)
+                                                r.z_ohm[k] = comp->correct(r.f_hz[k], r.z_ohm[k]);
+                                            return Eigen::VectorXcd(r.z_ohm);
+                                          });
+    if (reps.size() >= 2) {
+      out.band = dsp::band_from_replicates(
+          out.result.f_hz, out.result.z_ohm, reps, ready.size(), opt.coverage_factor,
+          "bootstrap over " + std::to_string(ready.size()) + " shots (" +
+              std::to_string(reps.size()) + " replicates)");
+      if (comp) {
+        dsp::add_in_quadrature(*out.band, sigma_std);
+        out.band->source += " + fixture standards";
+      }
+    } else {
+      out.notes.push_back("uncertainty: the bootstrap replicates failed; noise propagation used");
+      src = UncertaintySource::Noise;
+    }
+  }
+  if (src == UncertaintySource::Noise) {
+    const bool have = out.result.z_sigma_ohm.size() == out.result.f_hz.size();
+    out.band = dsp::band_from_sigma(
+        out.result.f_hz, out.result.z_ohm, have ? out.result.z_sigma_ohm : Eigen::VectorXd(),
+        opt.coverage_factor,
+        std::string(opt.method == "prony" ? "Prony parametric bootstrap" : "noise propagation") +
+            (comp ? " + fixture standards" : ""));
+    if (!have)
+      out.notes.push_back(
+          "uncertainty: the estimate carries no per-point sigma (Prony bootstrap 0?)");
+  }
+
+  // The band's random part (circular σ), for the KK thresholds: the model-order
+  // part below is a bias allowance, not noise, and must not relax the test.
+  Eigen::VectorXd noise_sigma;
+  if (out.band) {
+    noise_sigma.resize(out.band->size());
+    for (Eigen::Index k = 0; k < noise_sigma.size(); ++k)
+      noise_sigma[k] =
+          std::sqrt(2.0) * std::hypot(out.band->abs_sigma_ohm[k],
+                                      out.band->abs_ohm[k] * out.band->phase_sigma_rad[k]);
+  }
+  // Model-order part (Prony): how much the estimate moves one order step up or down.
+  if (out.band && opt.order_spread && order && opt.method == "prony") {
+    const Eigen::Index n = out.band->size();
+    Eigen::VectorXd dl = Eigen::VectorXd::Zero(n), dp = Eigen::VectorXd::Zero(n);
+    int used = 0;
+    for (long sgn : {-1L, 1L}) {
+      const long q = static_cast<long>(*order) + sgn * static_cast<long>(opt.order_spread_step);
+      if (q < 1) continue;
+      try {
+        auto r = estimate(opt.method, ready, b, o2, static_cast<std::size_t>(q), 0);
+        if (comp)
+          for (Eigen::Index k = 0; k < n; ++k) r.z_ohm[k] = comp->correct(r.f_hz[k], r.z_ohm[k]);
+        for (Eigen::Index k = 0; k < n; ++k) {
+          dl[k] = std::max(
+              dl[k], std::abs(std::log(std::abs(r.z_ohm[k]) / std::abs(out.result.z_ohm[k]))));
+          dp[k] = std::max(dp[k], std::abs(std::arg(r.z_ohm[k] / out.result.z_ohm[k])));
+        }
+        ++used;
+      } catch (const std::invalid_argument&) {
+        // the data cannot carry that order: no spread from it
+      }
+    }
+    if (used) {
+      for (Eigen::Index k = 0; k < n; ++k) {
+        out.band->abs_sigma_ohm[k] =
+            std::hypot(out.band->abs_sigma_ohm[k], dl[k] * out.band->abs_ohm[k]);
+        out.band->phase_sigma_rad[k] = std::hypot(out.band->phase_sigma_rad[k], dp[k]);
+      }
+      out.band->source += " + model order (orders " + std::to_string(*order) + " +- " +
+                          std::to_string(opt.order_spread_step) + ")";
+    }
+  }
+
+  // Kramers–Kronig / passivity of the result.
+  if (opt.kk) {
+    try {
+      out.kk =
+          dsp::kramers_kronig_check(out.result.f_hz, out.result.z_ohm, noise_sigma, opt.kk_options);
+    } catch (const std::invalid_argument& e) {
+      out.notes.push_back(std::string("Kramers-Kronig check not run: ") + e.what());
+    }
+  }
+  // Per-shot validity, on the records as recorded.
+  if (opt.validity) {
+    std::vector<dsp::DividerRecord> v;
+    for (const auto& r : raw) v.push_back(r.view());
+    dsp::ShotValidityOptions vo = opt.validity_options;
+    vo.fmin_hz = b.fmin;
+    vo.fmax_hz = b.fmax;
+    dsp::PronyImpedanceOptions po = opt.prony;
+    po.prony.band_hz = b.fmax;
+    po.prony.order = order;
+    po.bootstrap = 0;
+    out.validity = dsp::check_shots(v, po, vo);
+  }
+  if (opt.stabilization && opt.method == "prony") {
+    const OwnedRecord avg = mean_of(ready);
+    dsp::PronyImpedanceOptions po = o2.prony;
+    po.prony.band_hz = b.fmax;
+    po.bootstrap = 0;
+    dsp::StabilizationOptions so = opt.stabilization_options;
+    if (so.fmax_hz <= 0) so.fmax_hz = b.fmax;
+    out.stabilization = dsp::stabilization_chart(avg.view(), po, so);
+  }
+  return out;
+}
+
+}  // namespace piezo::acq
