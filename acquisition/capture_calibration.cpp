@@ -51,9 +51,12 @@ OwnedRecord average_shots(const Capture& cap, std::span<const Shot* const> shots
 }
 
 void deskew_record(OwnedRecord& r, double skew_s) {
-  // Runs for a zero skew too: channel 2's sample at t = 0 is then replaced by
-  // the value just after the drive's jump, as channel 1 records it.
-  r.v2 = dsp::deskew_channel(r.v2, r.sample_rate_hz, r.pretrigger_samples, skew_s);
+  // The drive leaves its idle level at the last pretrigger sample (t = -dt)
+  // and ramps to its first value at t = 0 (capture format: the AWG's samples
+  // are joined linearly, idle before): channel 2 is idle before that kink and
+  // is never interpolated across it.
+  const std::size_t onset = r.pretrigger_samples > 0 ? r.pretrigger_samples - 1 : 0;
+  r.v2 = dsp::deskew_channel(r.v2, r.sample_rate_hz, onset, skew_s);
   // The last samples of a late channel 2 would be extrapolated beyond its record
   // (noise amplified by the Lagrange weights): both channels end before them.
   const double d = skew_s * r.sample_rate_hz;
@@ -105,16 +108,18 @@ std::optional<OwnedRecord> average_role(const Capture& cap, Role role,
   return average_shots(cap, use);
 }
 
-// Z_m(f) of a standard by the one-sided FFT ratio of the whole record.
-// nullopt: channel 2 shows no signal at all (an ideal short: Z_m = 0).
+// Z_m(f) of a standard by the FFT ratio of the whole record, with channel 2's
+// delay `skew_s` removed in the frequency domain (T = T_m·e^{+jωτ}): exact up
+// to aliasing, where resampling the record would interpolate across the
+// drive's kinks. nullopt: channel 2 shows no signal at all (an ideal short: Z_m = 0).
 std::optional<dsp::MeasuredStandard> measure(const OwnedRecord& r, double fmin, double fmax,
-                                             Role role) {
+                                             Role role, double skew_s = 0.0) {
   dsp::FftRatioOptions o;
   o.fmin_hz = fmin;
   o.fmax_hz = fmax;
-  o.one_sided = true;  // the drive's jump at t = 0, as Prony sees it
   try {
-    const auto z = dsp::impedance_fft(r.view(), o);
+    auto z = dsp::impedance_fft(r.view(), o);
+    if (skew_s != 0.0) dsp::deskew_impedance(z, r.r1_ohm, skew_s);
     return dsp::MeasuredStandard{z.f_hz, z.z_ohm, z.z_sigma_ohm};
   } catch (const std::invalid_argument& e) {
     const std::string what = e.what();
@@ -187,22 +192,20 @@ std::optional<CaptureCalibration> calibrate_from_capture(const Capture& cap,
     out.skew_source = "not estimated (deskew off)";
   }
   out.deskewed = opt.deskew;
-  if (opt.deskew)
-    for (auto* r : {&open, &shrt, &load})
-      if (*r) deskew_record(**r, out.skew_applied_s);
 
-  // 4. Standards, fixture quantities, smooth models.
+  // 4. Standards (deskewed), fixture quantities, smooth models.
+  const double sk = opt.deskew ? out.skew_applied_s : 0.0;
   dsp::CalibrationStandards cs;
   cs.r1_nominal_ohm = out.r1_nominal_ohm;
   cs.load_value = out.load_value;
-  cs.skew_guess_s = 0.0;  // the records are deskewed: the fit sees the residual
-  if (open) cs.open = measure(*open, opt.fmin_hz, fmax, Role::Open);
+  cs.skew_guess_s = 0.0;  // the standards are deskewed: the fit sees the residual
+  if (open) cs.open = measure(*open, opt.fmin_hz, fmax, Role::Open, sk);
   bool short_is_zero = false;
   if (shrt) {
-    cs.shrt = measure(*shrt, opt.fmin_hz, fmax, Role::Short);
+    cs.shrt = measure(*shrt, opt.fmin_hz, fmax, Role::Short, sk);
     short_is_zero = !cs.shrt;
   }
-  if (load) cs.load = measure(*load, opt.fmin_hz, fmax, Role::Load);
+  if (load) cs.load = measure(*load, opt.fmin_hz, fmax, Role::Load, sk);
   if (cs.open || cs.shrt || cs.load) out.fixture = dsp::fit_fixture(cs);
   if (out.fixture.skew_s) {  // total delay of channel 2: removed from the records + what the fit
                              // still sees

@@ -273,7 +273,6 @@ void run(const ImpedanceArgs& a, Context& ctx) {
     trust.prony.bootstrap = a.bootstrap;
     trust.fft.prep.max_samples = a.samples.value_or(0);
     trust.fft.window = {*win, 0.5};
-    trust.fft.one_sided = true;  // as the fixture standards are measured (no half-sample phase error)
     trust.xspec.segment = a.segment.value_or(0);
     trust.xspec.overlap = a.overlap;
     trust.xspec.window = {*win, 0.5};
