@@ -6,13 +6,16 @@
 #include <filesystem>
 #include <map>
 
+#include "acquisition/capture_calibration.hpp"
 #include "acquisition/capture_file.hpp"
 #include "acquisition/divider_record.hpp"
 #include "acquisition/runner.hpp"
 #include "dsp/cross_spectra.hpp"
+#include "dsp/deskew.hpp"
 #include "dsp/fft_ratio.hpp"
 #include "dsp/prony_impedance.hpp"
 #include "dsp/shot_ensemble.hpp"
+#include "model/effects.hpp"
 #include "model/harmonic.hpp"
 #include "model/material_spec.hpp"
 #include "model/modal.hpp"
@@ -49,7 +52,7 @@ acq::Capture acquire(const PipelineRequest& req, PipelineResult& out, const Stag
   acq::RunnerOptions ro;
   ro.overwrite = true;
   ro.software = "piezobench";
-  if (!req.calibration.empty()) {  // --- issue 10 hook (branch comp): standards first
+  if (!req.calibration.empty()) {  // the fixture standards first (issue 10)
     ro.calibration = req.calibration;
     ro.connect_standard = acq::make_standard_connector(bench, req.prompt);
   }
@@ -96,7 +99,34 @@ Curve curve_of(const std::string& label, const dsp::ImpedanceResult& r) {
 // Z(ω) of the capture: Prony-SS on the first transient "dut" shot (the
 // estimate the update uses), with the direct FFT ratio and the averaged
 // cross-spectra of all such shots as overlays.
+// The fixture from the capture's calibration shots, when it has any. A
+// failure is a warning: the transducer's shots are still estimated, uncorrected.
+void calibrate_stage(const acq::Capture& cap, PipelineResult& out) {
+  const bool any = std::any_of(cap.shots.begin(), cap.shots.end(), [](const acq::Shot& s) { return s.role != acq::Role::Dut; });
+  if (!any) return;
+  try {
+    acq::CaptureCalibrationOptions co;
+    co.fmax_hz = std::min(120e3, cap.shots.front().sample_rate_hz / 4);
+    auto c = acq::calibrate_from_capture(cap, co);
+    if (!c) return;
+    out.fixture = c->fixture;
+    out.fixture_model = c->model_description;
+    const auto& f = c->fixture;
+    char note[300];
+    std::snprintf(note, sizeof note, "fixture from %s: Cp %.1f pF, lead R %.2f ohm, R1 error %+.3f %%, skew %.1f ns",
+                  c->model_description.c_str(), f.fixture_capacitance_f.value_or(0) * 1e12,
+                  f.lead_resistance_ohm.value_or(0), f.r1_error.value_or(0) * 100, f.skew_s.value_or(0) * 1e9);
+    out.stages.push_back({"calibrate", true, note});
+    for (const auto& n : c->notes) out.warnings.push_back("fixture calibration: " + n);
+  } catch (const std::exception& e) {
+    out.stages.push_back({"calibrate", false, std::string("failed: ") + e.what()});
+    out.warnings.push_back(std::string("fixture calibration failed (") + e.what() +
+                           "); the transducer's shots are used without fixture correction");
+  }
+}
+
 dsp::ImpedanceResult estimate(const acq::Capture& cap, PipelineResult& out) {
+  const std::optional<dsp::FixtureCalibration>& fx = out.fixture;
   std::vector<const acq::Shot*> shots;
   for (const auto& s : cap.shots)
     if (s.role == acq::Role::Dut && s.excitation != acq::Excitation::Sine) shots.push_back(&s);
@@ -164,10 +194,20 @@ dsp::ImpedanceResult estimate(const acq::Capture& cap, PipelineResult& out) {
       // and linear between samples, which is then the AWG's ramp onto the
       // burst (drivers/sim/sim_bench.cpp) rather than a jump half a sample off.
       const std::size_t lead = pre > 0 ? 1 : 0;
-      std::vector<double> a(nfit), b(nfit);
-      for (std::size_t i = 0; i < nfit; ++i) {
+      // A measured channel-2 delay is removed first (the port model has none):
+      // channel 2 resampled without crossing the drive's onset, which keeps
+      // the samples the fit uses inside the record.
+      std::vector<double> v2d = v2;
+      std::size_t nuse = nfit;
+      if (fx && fx->skew_s && *fx->skew_s != 0.0 && pre > 0) {
+        v2d = dsp::deskew_channel(v2, first.sample_rate_hz, pre - 1, *fx->skew_s);
+        const auto drop = static_cast<std::size_t>(std::ceil(std::abs(*fx->skew_s) * first.sample_rate_hz)) + 2;
+        nuse = std::min(nfit, post - std::min(post, drop));
+      }
+      std::vector<double> a(nuse), b(nuse);
+      for (std::size_t i = 0; i < nuse; ++i) {
         a[i] = v1[pre - lead + i] - m1;
-        b[i] = v2[pre - lead + i] - m2;
+        b[i] = v2d[pre - lead + i] - m2;
       }
       const auto fit =
           update::fit_port_model(a, b, first.sample_rate_hz, cap.setup.divider_r1_ohm, st);
@@ -184,6 +224,21 @@ dsp::ImpedanceResult estimate(const acq::Capture& cap, PipelineResult& out) {
     } catch (const std::exception& e) {
       out.warnings.push_back(
           std::string("port-model refinement of the features skipped (Prony's kept): ") + e.what());
+    }
+  }
+  // The measured capacitance holds the fixture's: Z_m = Z_v2/(1 + r1_error)
+  // with the fixture capacitance Cp across the v2 node, so C_m = (C + Cp)·(1 + r1_error).
+  if (fx && (fx->fixture_capacitance_f || fx->r1_error)) {
+    const double c_m = prony.features.capacitance_f;
+    const double c = c_m / (1.0 + fx->r1_error.value_or(0.0)) - fx->fixture_capacitance_f.value_or(0.0);
+    if (c > 0) {
+      prony.features.capacitance_f = c;
+      char note[200];
+      std::snprintf(note, sizeof note,
+                    "capacitance corrected for the measured fixture: %.5g F measured -> %.5g F of the transducer", c_m, c);
+      out.warnings.push_back(note);
+    } else {
+      out.warnings.push_back("the measured fixture capacitance exceeds the measured capacitance: not corrected");
     }
   }
   out.curves.push_back(curve_of("measured (Prony-SS)", prony));
@@ -338,6 +393,23 @@ update::GapData gap_data(const acq::Capture& cap, const std::vector<const acq::S
   return d;
 }
 
+// The fixture quantities as effects of the catalogue (model/effects.hpp),
+// clamped to its physical bounds (a lead resistance measured at -0.01 ohm is 0).
+std::vector<update::MeasuredEffect> measured_effects(const dsp::FixtureCalibration& f, const std::string& how) {
+  std::vector<update::MeasuredEffect> v;
+  auto add = [&](const char* name, const std::optional<double>& val, const std::optional<double>& sig) {
+    if (!val) return;
+    const auto* info = model::find_effect(name);
+    v.push_back({name, std::clamp(*val, info->lower, info->upper), sig.value_or(0.0),
+                 "fixture calibration (" + how + ")"});
+  };
+  add("parallel_capacitance", f.fixture_capacitance_f, f.fixture_capacitance_sigma_f);
+  add("series_resistance", f.lead_resistance_ohm, f.lead_resistance_sigma_ohm);
+  add("r1_tolerance", f.r1_error, f.r1_error_sigma);
+  add("channel_skew", f.skew_s, f.skew_sigma_s);
+  return v;
+}
+
 void diagnose_stage(const PipelineRequest& req, const acq::Capture& cap, const acq::Capture* heldout_cap,
                     const UpdateOutcome& u, PipelineResult& out, const Stages& progress,
                     const std::atomic<bool>& cancel) {
@@ -378,6 +450,7 @@ void diagnose_stage(const PipelineRequest& req, const acq::Capture& cap, const a
                                  : update::MaterialClass::transversely_isotropic(nominal.d);
   update::GapOptions go;
   go.candidates = req.gap_candidates;
+  if (out.fixture) go.measured = measured_effects(*out.fixture, out.fixture_model);
   go.damping_ref_hz = u.first_resonance_hz;
   auto d = update::diagnose_gap(
       solver, cls, u.updated, u.damping, cap.setup.divider_r1_ohm, fit, ho ? &*ho : nullptr, go,
@@ -400,6 +473,7 @@ PipelineResult run_pipeline(const PipelineRequest& req, const std::function<void
   std::shared_ptr<drivers::sim::SimBench> sim;
   acq::Capture cap = acquire(req, out, progress, cancel, sim);
   if (cancel) return out;
+  if (req.use_calibration) calibrate_stage(cap, out);
   progress(0.45, "estimate: Prony-SS");
   auto z = estimate(cap, out);
   {

@@ -13,6 +13,7 @@
 #include "acquisition/calibration_plan.hpp"
 #include "acquisition/plan.hpp"
 #include "acquisition/sim_setup.hpp"
+#include "dsp/fixture_calibration.hpp"
 #include "update/gap_diagnosis.hpp"
 
 namespace piezo::ui {
@@ -43,6 +44,8 @@ struct PipelineRequest {
   // SIM:DUT; real bench: `prompt` asks the technician).
   std::vector<acq::CalibrationStep> calibration;
   acq::TechnicianPrompt prompt;
+  // Use the capture's calibration shots (fixture measured, see PipelineResult::fixture).
+  bool use_calibration = true;
 };
 
 struct Curve {
@@ -66,8 +69,14 @@ struct StageReport {
 struct PipelineResult {
   std::string capture_path;
   int shots = 0;
-  int shots_averaged = 0;
-  std::string awg_idn, daq_idn;  // *IDN? of the instruments used (empty for a replay)  // transient dut shots averaged before the Prony fit
+  int shots_averaged = 0;         // transient dut shots averaged before the Prony fit
+  std::string awg_idn, daq_idn;  // *IDN? of the instruments used (empty for a replay)
+  // The fixture measured from the capture's calibration shots (role open,
+  // short, load), when it has any: its Cp and R1 error correct the measured
+  // capacitance, its skew is removed before the port fit, and the diagnosis
+  // takes Cp, lead R, R1 error and skew as measured effects.
+  std::optional<dsp::FixtureCalibration> fixture;
+  std::string fixture_model;  // which standards / fixture model
   std::vector<Curve> curves;  // measured (Prony), FFT, cross-spectra, original model, updated model
   std::vector<double> resonances_hz, antiresonances_hz;
   std::vector<double> singular_values;  // normalised, for the order plot

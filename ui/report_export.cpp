@@ -1,5 +1,7 @@
 #include "ui/report_export.hpp"
 
+#include <algorithm>
+#include <cmath>
 #include <fstream>
 #include <nlohmann/json.hpp>
 #include <stdexcept>
@@ -71,8 +73,19 @@ void export_json(const PipelineResult& r, const std::string& path) {
 nlohmann::json diagnosis_json(const update::GapDiagnosis& d) {
   auto opt = [](const std::optional<double>& v) { return v ? nlohmann::json(*v) : nlohmann::json(nullptr); };
   nlohmann::json j;
-  j["verdict"] = d.verdict;
+  // Issue 7's interface: gap_before, noise_floor, regions, effects (name,
+  // params, gap_after, shrink, holdout_shrink, significant, aliases), verdict
+  // {effect, holdout_shrink}. Gaps are √(χ²/dof): 1 = at the measured noise;
+  // noise_floor is the largest gap still reported as "no gap" for this dof.
+  const double dof = std::max(1, d.dof_fit);
+  j["gap_before"] = d.gap_fit;
+  j["noise_floor"] = std::sqrt(1.0 + std::max(3.0 * std::sqrt(2.0 / dof), 0.3));
+  j["verdict"] = {{"effect", d.verdict_effect}, {"holdout_shrink", opt(d.heldout_shrink)}, {"text", d.verdict}};
+  j["verdict_text"] = d.verdict;
   j["verdict_effect"] = d.verdict_effect;
+  j["measured"] = nlohmann::json::array();
+  for (const auto& m : d.measured)
+    j["measured"].push_back({{"name", m.name}, {"value", m.value}, {"sigma", m.sigma}, {"source", m.source}});
   j["gap"] = d.gap;
   j["gap_fit"] = d.gap_fit;
   j["chi2_fit"] = d.chi2_fit;
@@ -96,7 +109,24 @@ nlohmann::json diagnosis_json(const update::GapDiagnosis& d) {
                         {"detectability", e.detectability}, {"typical", e.typical},
                         {"alias_bias_pct", {{"YE11", e.bias_y_e11_pct}, {"nu12", e.bias_nu12_pct},
                                             {"d31", e.bias_d31_pct}, {"epsT33", e.bias_eps_t33_pct}}}};
+    // What the alias mimics: the constants a typical magnitude would move (> 0.01 %).
+    r["aliases"] = nlohmann::json::array();
+    if (e.alias) {
+      const std::pair<const char*, double> b[] = {
+          {"YE11", e.bias_y_e11_pct}, {"nu12", e.bias_nu12_pct}, {"d31", e.bias_d31_pct}, {"epsT33", e.bias_eps_t33_pct}};
+      for (const auto& [n, v] : b)
+        if (std::abs(v) > 0.01) r["aliases"].push_back(n);
+    }
+    r["params"] = nlohmann::json::object();
+    r["gap_after"] = nullptr;
+    r["shrink"] = nullptr;
+    r["holdout_shrink"] = nullptr;
+    r["significant"] = false;
     if (e.fitted) {
+      r["params"][e.name] = e.value;
+      r["gap_after"] = std::sqrt(e.chi2_after / std::max(1, d.dof_fit - 1));
+      r["shrink"] = e.shrink_fit;
+      r["holdout_shrink"] = opt(e.heldout_shrink);
       r["value"] = e.value;
       r["sigma"] = e.sigma;
       r["chi2_after"] = e.chi2_after;

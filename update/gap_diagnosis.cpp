@@ -65,12 +65,24 @@ GapDiagnosis diagnose_gap(model::ModalSolver& solver, const MaterialClass& cls, 
     if (progress) progress(f, s);
   };
   auto cancelled = [&] { return cancel && cancel->load(); };
-  const std::vector<std::string> candidates = opt.candidates.empty() ? supported_gap_effects() : opt.candidates;
+  std::vector<std::string> candidates = opt.candidates.empty() ? supported_gap_effects() : opt.candidates;
+  model::EffectSet fixed;
+  for (const auto& me : opt.measured) {
+    const auto* info = model::find_effect(me.name);
+    if (!info) throw std::invalid_argument("gap diagnosis: unknown measured effect '" + me.name + "'");
+    if (!std::isfinite(me.value) || me.value < info->lower || me.value > info->upper)
+      throw std::invalid_argument("gap diagnosis: measured " + me.name + " = " + std::to_string(me.value) +
+                                  " lies outside its physical bounds");
+    fixed.*(info->field) = me.value;
+    std::erase(candidates, me.name);  // known: neither a candidate nor an alias
+  }
 
   GapDiagnosis out;
   out.fit_description = fit.description;
   if (heldout) out.heldout_description = heldout->description;
+  out.measured = opt.measured;
   GapModel m(solver, cls, start, damping_start, r1, opt.damping_ref_hz);
+  m.set_fixed_effects(fixed);
 
   // 1. Base fit: material + damping.
   say(0.0, "gap: refitting material and damping to the whole curve");
@@ -218,6 +230,15 @@ GapDiagnosis diagnose_gap(model::ModalSolver& solver, const MaterialClass& cls, 
     alias_note = " Not separable from the constants by the impedance alone (aliases): ";
     for (std::size_t i = 0; i < aliases.size(); ++i) alias_note += (i ? ", " : "") + aliases[i];
     alias_note += " - calibrate the fixture to measure them.";
+  }
+  if (!out.measured.empty()) {
+    alias_note += " Measured by the fixture calibration and held in the model: ";
+    for (std::size_t i = 0; i < out.measured.size(); ++i) {
+      char v[96];
+      std::snprintf(v, sizeof v, "%s%s %.4g", i ? ", " : "", out.measured[i].name.c_str(), out.measured[i].value);
+      alias_note += v;
+    }
+    alias_note += ".";
   }
   char buf[512];
   if (!out.gap) {

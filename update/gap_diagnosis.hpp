@@ -50,6 +50,15 @@ struct EffectReport {
   std::string note;
 };
 
+// An effect measured independently of the impedance (the fixture
+// calibration of issue 10: open/short/load shots in the capture). It enters
+// the model at its value and is reported as measured, not fitted or aliased.
+struct MeasuredEffect {
+  std::string name;  // catalogue name (model/effects.hpp)
+  double value = 0, sigma = 0;  // SI; sigma 0: not known
+  std::string source;
+};
+
 struct GapCurve {  // misfit ln(Z_meas/Z_model) for plots
   std::vector<double> f_hz, residual_db, residual_deg, sigma_db, sigma_deg;
 };
@@ -65,6 +74,7 @@ struct GapDiagnosis {
   TubeParams material_base;            // base refit
   model::RayleighDamping damping_base;
   std::vector<GapRegion> regions;      // of the base misfit
+  std::vector<MeasuredEffect> measured;  // in the model at their measured values (not candidates)
   std::vector<EffectReport> effects;   // first round, ranked best first; aliases last
   std::vector<std::string> added;      // greedy selection, in order
   std::vector<EffectReport> steps;     // the fit of each added effect (in the model with the previous ones)
@@ -83,6 +93,7 @@ struct GapOptions {
   double min_heldout_shrink = 0.3;
   double gap_tolerance = 0.3;           // χ²/N beyond 1 + this (and 3σ) is a gap      // an effect must shrink the held-out gap this much to be added
   double damping_ref_hz = 50e3;
+  std::vector<MeasuredEffect> measured;  // fixed in the model, removed from the candidates
   GapFitOptions fit;
 };
 

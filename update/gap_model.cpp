@@ -110,7 +110,7 @@ double GapModel::effect_value(const std::vector<double>& x, int i) const {
 }
 
 model::EffectSet GapModel::effects(const std::vector<double>& x) const {
-  model::EffectSet fx;
+  model::EffectSet fx = fixed_;
   for (std::size_t i = 6; i < params_.size(); ++i) fx.*(params_[i].effect->field) = effect_value(x, static_cast<int>(i));
   return fx;
 }

@@ -46,6 +46,11 @@ class GapModel {
 
   // The parameter list: the four material parameters, α, β, then `effects` (by catalogue name).
   void set_effects(const std::vector<std::string>& effects);
+  // Effects known from elsewhere (the fixture calibration's measured Cp, lead
+  // R, R1 error, skew): always in the model at these values, never fitted.
+  // An effect that is also a fitted parameter takes the fitted value.
+  void set_fixed_effects(const model::EffectSet& e) { fixed_ = e; }
+  const model::EffectSet& fixed_effects() const { return fixed_; }
   const std::vector<GapParamInfo>& params() const { return params_; }
   int size() const { return static_cast<int>(params_.size()); }
 
@@ -74,6 +79,7 @@ class GapModel {
   model::ModalPortModel port_at(const TubeParams& p, double mass_fraction) const;
 
   model::ModalSolver* solver_;
+  model::EffectSet fixed_;
   MaterialClass cls_;
   TubeParams p_ref_;
   model::RayleighDamping damping0_;

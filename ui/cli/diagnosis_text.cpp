@@ -31,6 +31,11 @@ void print_diagnosis(std::ostream& os, const update::GapDiagnosis& d) {
     if (g.kind == "phase") os << fmt(" %+.3f deg", g.phase_deg);
     os << "\n";
   }
+  if (!d.measured.empty()) {
+    os << "    measured (fixture calibration), held in the model:\n";
+    for (const auto& m : d.measured)
+      os << "      " << m.name << fmt(": %.4g +/- %.2g", m.value, m.sigma) << "\n";
+  }
   os << "    candidate effects (refitted with the constants; held-out shrink decides):\n";
   for (const auto& e : d.effects) {
     os << "      " << e.name << ": ";
