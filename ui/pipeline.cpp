@@ -127,6 +127,7 @@ void calibrate_stage(const acq::Capture& cap, PipelineResult& out) {
 
 dsp::ImpedanceResult estimate(const acq::Capture& cap, PipelineResult& out) {
   const std::optional<dsp::FixtureCalibration>& fx = out.fixture;
+  bool fixture_in_fit = false;  // the port fit ran with the measured fixture in its circuit
   std::vector<const acq::Shot*> shots;
   for (const auto& s : cap.shots)
     if (s.role == acq::Role::Dut && s.excitation != acq::Excitation::Sine) shots.push_back(&s);
@@ -194,23 +195,32 @@ dsp::ImpedanceResult estimate(const acq::Capture& cap, PipelineResult& out) {
       // and linear between samples, which is then the AWG's ramp onto the
       // burst (drivers/sim/sim_bench.cpp) rather than a jump half a sample off.
       const std::size_t lead = pre > 0 ? 1 : 0;
-      // A measured channel-2 delay is removed first (the port model has none):
-      // channel 2 resampled without crossing the drive's onset, which keeps
-      // the samples the fit uses inside the record.
-      std::vector<double> v2d = v2;
-      std::size_t nuse = nfit;
-      if (fx && fx->skew_s && *fx->skew_s != 0.0 && pre > 0) {
-        v2d = dsp::deskew_channel(v2, first.sample_rate_hz, pre - 1, *fx->skew_s);
-        const auto drop = static_cast<std::size_t>(std::ceil(std::abs(*fx->skew_s) * first.sample_rate_hz)) + 2;
-        nuse = std::min(nfit, post - std::min(post, drop));
+      // A measured fixture (calibration shots) goes into the circuit the port
+      // is simulated in: true R1, Cp at node 2, lead R; channel 2's delay τ is
+      // moved to the input (the response at t_k − τ to v1 is the response at
+      // t_k to v1 delayed by τ: v1 interpolated at k − τ·fs, idle before).
+      update::PortFitOptions pfo;
+      double r1_fit = cap.setup.divider_r1_ohm;
+      double d = 0.0;
+      if (fx) {
+        r1_fit *= 1.0 + fx->r1_error.value_or(0.0);
+        pfo.fixture_capacitance_f = std::max(0.0, fx->fixture_capacitance_f.value_or(0.0));
+        pfo.lead_resistance_ohm = std::max(0.0, fx->lead_resistance_ohm.value_or(0.0));
+        d = fx->skew_s.value_or(0.0) * first.sample_rate_hz;
       }
-      std::vector<double> a(nuse), b(nuse);
-      for (std::size_t i = 0; i < nuse; ++i) {
-        a[i] = v1[pre - lead + i] - m1;
-        b[i] = v2d[pre - lead + i] - m2;
+      auto v1_at = [&](double q) {  // v1 − offset at fractional record index q
+        if (q <= 0) return v1[0] - m1;
+        const auto k = static_cast<std::size_t>(std::floor(q));
+        if (k + 1 >= v1.size()) return v1.back() - m1;
+        const double w = q - double(k);
+        return (1 - w) * v1[k] + w * v1[k + 1] - m1;
+      };
+      std::vector<double> a(nfit), b(nfit);
+      for (std::size_t i = 0; i < nfit; ++i) {
+        a[i] = v1_at(double(pre - lead + i) - d);
+        b[i] = v2[pre - lead + i] - m2;
       }
-      const auto fit =
-          update::fit_port_model(a, b, first.sample_rate_hz, cap.setup.divider_r1_ohm, st);
+      const auto fit = update::fit_port_model(a, b, first.sample_rate_hz, r1_fit, st, pfo);
       if (!fit.converged) throw std::runtime_error(fit.message);
       for (std::size_t k = 0; k < n; ++k) {
         fr[k].f_hz = fit.features.resonances_hz[k];
@@ -221,14 +231,15 @@ dsp::ImpedanceResult estimate(const acq::Capture& cap, PipelineResult& out) {
         }
       }
       prony.features.capacitance_f = fit.features.low_frequency_capacitance();
+      fixture_in_fit = fx.has_value();
     } catch (const std::exception& e) {
       out.warnings.push_back(
           std::string("port-model refinement of the features skipped (Prony's kept): ") + e.what());
     }
   }
-  // The measured capacitance holds the fixture's: Z_m = Z_v2/(1 + r1_error)
+  // Without the port fit, Prony's capacitance holds the fixture's: Z_m = Z_v2/(1 + r1_error)
   // with the fixture capacitance Cp across the v2 node, so C_m = (C + Cp)·(1 + r1_error).
-  if (fx && (fx->fixture_capacitance_f || fx->r1_error)) {
+  if (fx && !fixture_in_fit && (fx->fixture_capacitance_f || fx->r1_error)) {
     const double c_m = prony.features.capacitance_f;
     const double c = c_m / (1.0 + fx->r1_error.value_or(0.0)) - fx->fixture_capacitance_f.value_or(0.0);
     if (c > 0) {

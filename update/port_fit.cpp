@@ -232,6 +232,9 @@ PortFitResult fit_port_model(std::span<const double> v1, std::span<const double>
   const Eigen::Map<const Eigen::VectorXd> y(v2.data(), n);
   model::DividerCircuit circuit;
   circuit.r1_ohm = r1_ohm;
+  circuit.c_parallel_f = opt.fixture_capacitance_f;
+  circuit.r_lead_ohm = opt.lead_resistance_ohm;
+  circuit.validate();
   const double band = opt.band_hz > 0 ? opt.band_hz : 1.5 * start.antiresonances_hz[k - 1];
   if (!(band < 0.5 * fs)) throw std::invalid_argument(std::string(fn) + ": band above Nyquist");
   const LowpassDecimator lowpass(fs, band);

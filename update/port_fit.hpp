@@ -49,6 +49,12 @@ struct PortFitOptions {
   // t = 0 excites them all) is not fitted by the few in-band branches.
   // 0: 1.5 × the highest starting anti-resonance.
   double band_hz = 0.0;
+  // A measured fixture (issue 10's calibration) put into the divider the
+  // port is simulated in (model::DividerCircuit): capacitance from node 2 to
+  // ground and lead resistance between node 2 and the tube. r1_ohm of
+  // fit_port_model is then the TRUE R1 (nominal × (1 + measured R1 error)).
+  double fixture_capacitance_f = 0.0;
+  double lead_resistance_ohm = 0.0;
 };
 
 struct PortFitResult {

@@ -5,6 +5,7 @@
 #include <filesystem>
 #include <iostream>
 
+#include "acquisition/calibration_plan.hpp"
 #include "ui/cli/cli_common.hpp"
 #include "model/effects.hpp"
 #include "ui/cli/diagnosis_text.hpp"
@@ -21,6 +22,8 @@ void register_demo_command(CLI::App& app, Context& ctx) {
     std::uint64_t seed = 2016;
     std::vector<std::string> effects;
     bool no_diagnose = false;
+    std::string calibrate = "open,short,load";
+    bool no_calibrate = false;
   };
   auto a = std::make_shared<Args>();
   demo->add_option("--out", a->out_dir, "Folder for the demo's files")->capture_default_str();
@@ -28,6 +31,10 @@ void register_demo_command(CLI::App& app, Context& ctx) {
   demo->add_option("--seed", a->seed, "Noise seed")->capture_default_str();
   demo->add_option("--effect", a->effects, "Bench effect the simulated bench adds and the model lacks, NAME=VALUE (repeatable)");
   demo->add_flag("--no-diagnose", a->no_diagnose, "Stop after the update");
+  demo->add_option("--calibrate", a->calibrate,
+                   "Fixture standards measured before the transducer (open,short,load; load 1000 ohm)")
+      ->capture_default_str();
+  demo->add_flag("--no-calibrate", a->no_calibrate, "No fixture standards (Cp and R1 error are then aliases)");
   add_json_flag(demo, ctx);
   demo->callback([&ctx, a] {
     ctx.exit_code = run_command(ctx, [&] {
@@ -49,6 +56,8 @@ void register_demo_command(CLI::App& app, Context& ctx) {
       req.sim.seed = a->seed;
       for (const auto& e : a->effects) model::apply_effect_assignment(req.sim.effects, e);
       req.diagnose = !a->no_diagnose;
+      if (!a->no_calibrate && !a->calibrate.empty())
+        req.calibration = acq::parse_calibration_list(a->calibrate, 1000.0);
       // Held-out data for the gap diagnosis: a chirp of the same tube, 1-150 kHz.
       acq::MeasurementPlan ho = req.plan;
       ho.excitation.kind = acq::Excitation::Chirp;
@@ -77,6 +86,15 @@ void register_demo_command(CLI::App& app, Context& ctx) {
         j["parameters"].push_back(r);
       }
       j["verdict"] = res.verdict;
+      if (res.fixture) {
+        const auto& f = *res.fixture;
+        auto o = [](const std::optional<double>& v) { return v ? nlohmann::json(*v) : nlohmann::json(nullptr); };
+        j["fixture"] = {{"model", res.fixture_model},
+                        {"fixture_capacitance_f", o(f.fixture_capacitance_f)},
+                        {"lead_resistance_ohm", o(f.lead_resistance_ohm)},
+                        {"r1_error", o(f.r1_error)},
+                        {"skew_s", o(f.skew_s)}};
+      }
       if (res.diagnosis) j["diagnosis"] = ui::diagnosis_json(*res.diagnosis);
       j["warnings"] = res.warnings;
       if (ctx.json) {
