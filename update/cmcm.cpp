@@ -271,10 +271,33 @@ CmcmResult extended_cmcm(const model::TubeModel& tube, model::ModalSolver& solve
     const TsvdSolution sol = solve_tsvd(g, f, opt.svd_rel_tol);  // eq. 193
     res.equations = static_cast<int>(pairs.size());
     res.rank = sol.rank;
+    // The fixed-point step can overshoot out of the physical domain far from
+    // the solution (a ±12 % start drives ν12 past its bound): the step from
+    // the current iterate is halved until the material is physical again
+    // (at most 12 times; the fixed point itself is unchanged).
+    std::vector<double> next_alpha(sol.x.data(), sol.x.data() + nt);
+    for (int halving = 0; halving <= 12; ++halving) {
+      bool physical = true;
+      try {
+        (void)phase.material(theta_of(next_alpha));
+      } catch (const std::invalid_argument&) {
+        physical = false;
+      }
+      if (physical) break;
+      if (halving == 12) {
+        res.status = UpdateStatus::non_physical;
+        res.message = phase.name + ": iterate " + std::to_string(it) +
+                      " stays outside the physical domain after 12 step halvings";
+        res.theta = theta_of(res.alpha);
+        return res;
+      }
+      for (int n = 0; n < nt; ++n) next_alpha[n] = 0.5 * (next_alpha[n] + res.alpha[n]);
+      ++res.step_halvings;
+    }
     double delta = 0;
     for (int n = 0; n < nt; ++n) {
-      delta = std::max(delta, std::abs(sol.x[n] - res.alpha[n]));
-      res.alpha[n] = sol.x[n];
+      delta = std::max(delta, std::abs(next_alpha[n] - res.alpha[n]));
+      res.alpha[n] = next_alpha[n];
     }
     res.alpha_history.push_back(res.alpha);
     res.iterations = it;
@@ -289,6 +312,15 @@ CmcmResult extended_cmcm(const model::TubeModel& tube, model::ModalSolver& solve
     }
   }
   res.theta = theta_of(res.alpha);
+  if (res.status != UpdateStatus::converged && res.step_halvings > 0) {
+    // Held at the edge of the domain by the halving: the features ask for a
+    // non-physical material.
+    res.status = UpdateStatus::non_physical;
+    res.message = phase.name + ": the measured frequencies pull the model out of the physical domain (" +
+                  std::to_string(res.step_halvings) + " steps halved at its edge, not converged after " +
+                  std::to_string(res.iterations) + " iterations)";
+    return res;
+  }
   if (res.status != UpdateStatus::converged) {
     res.status = UpdateStatus::max_iterations;
     std::ostringstream s;

@@ -107,6 +107,7 @@ struct CmcmResult {
   std::vector<double> alpha;  // relative corrections of theta0
   std::vector<double> theta;  // θ0 (1 + α)
   int iterations = 0;
+  int step_halvings = 0;  // steps halved to stay in the physical domain
   std::vector<std::vector<double>> alpha_history;  // one entry per iteration
   std::vector<double> model_hz_initial;            // paired model frequencies of the base model
   std::vector<double> model_hz;                    // paired frequencies of the last modal solve
