@@ -1,0 +1,125 @@
+#include "study_plot.hpp"
+
+#include <cmath>
+#include <complex>
+#include <numbers>
+
+namespace piezo::study {
+
+namespace {
+
+const char* colour_of(std::size_t k) {
+  static constexpr const char* kColours[] = {"#ff7f0e", "#1f77b4", "#2ca02c",
+                                             "#d62728", "#9467bd", "#8c564b"};
+  return kColours[k % (sizeof kColours / sizeof kColours[0])];
+}
+
+std::string label_of(const StudyRow& r) {
+  return r.method + " (" + std::to_string(r.samples) + ")";
+}
+
+double phase_deg(std::complex<double> z) { return std::arg(z) * 180.0 / std::numbers::pi; }
+
+report::Panel panel(const char* title, const char* y_label, report::Scale x, report::Scale y) {
+  report::Panel p;
+  p.title = title;
+  p.x_label = "frequency (Hz)";
+  p.y_label = y_label;
+  p.x_scale = x;
+  p.y_scale = y;
+  return p;
+}
+
+report::Series series(const std::string& label, const std::string& colour, double width,
+                      bool dashed = false) {
+  report::Series s;
+  s.label = label;
+  s.colour = colour;
+  s.width = width;
+  s.dashed = dashed;
+  return s;
+}
+
+}  // namespace
+
+report::Figure comparison_figure(const StudyInput& in, const std::vector<StudyRow>& rows,
+                                 const std::vector<ErrorBand>& bands, const std::string& title) {
+  report::Figure fig;
+  fig.title = title;
+  fig.width = 1000;
+  fig.panel_height = 340;
+
+  // The truth on a fine grid (the features are sharp at β = 1e-7).
+  std::vector<double> ft;
+  for (double f = in.f_lo_hz; f <= in.f_hi_hz * (1 + 1e-12); f *= 1.0005) ft.push_back(f);
+  report::Series mag_true = series("true (FE modal)", "#000000", 2.5);
+  mag_true.x = ft;
+  report::Series ph_true = mag_true;
+  for (double f : ft) {
+    const auto z = in.z_true(f);
+    mag_true.y.push_back(std::abs(z));
+    ph_true.y.push_back(phase_deg(z));
+  }
+
+  using report::Scale;
+  report::Panel mag = panel("|Z|", "|Z| (ohm)", Scale::Log, Scale::Log);
+  report::Panel zoom = panel("|Z|, 45-100 kHz", "|Z| (ohm)", Scale::Linear, Scale::Log);
+  report::Panel ph = panel("phase", "phase (deg)", Scale::Log, Scale::Linear);
+  report::Panel err =
+      panel("|Z| error: 20 log10(|Z est| / |Z true|)", "error (dB)", Scale::Log, Scale::Linear);
+  mag.x_range = ph.x_range = err.x_range = std::make_pair(in.f_lo_hz, in.f_hi_hz);
+  zoom.x_range = std::make_pair(45e3, 100e3);
+  ph.y_range = std::make_pair(-100.0, 100.0);
+  err.y_range = std::make_pair(-6.0, 6.0);
+
+  for (std::size_t k = 0; k < rows.size(); ++k) {
+    const auto& r = rows[k];
+    report::Series m = series(label_of(r), colour_of(k), 1.2);
+    report::Series p = m, e = m;
+    for (std::size_t i = 0; i < r.f_hz.size(); ++i) {
+      const double f = r.f_hz[i];
+      if (f < in.f_lo_hz || f > in.f_hi_hz) continue;
+      const auto z = r.z_ohm[i];
+      m.x.push_back(f);
+      m.y.push_back(std::abs(z));
+      p.x.push_back(f);
+      p.y.push_back(phase_deg(z));
+      e.x.push_back(f);
+      e.y.push_back(20.0 * std::log10(std::abs(z) / std::abs(in.z_true(f))));
+    }
+    mag.series.push_back(m);
+    zoom.series.push_back(m);
+    ph.series.push_back(p);
+    err.series.push_back(e);
+  }
+  // The truth last, drawn over the estimates.
+  mag.series.push_back(mag_true);
+  zoom.series.push_back(mag_true);
+  ph.series.push_back(ph_true);
+
+  for (const auto& b : bands) {
+    report::Series up = series(b.label, b.colour, 1.5, true), dn = series("", b.colour, 1.5, true);
+    up.x = dn.x = b.f_hz;
+    for (double s : b.sigma_db) {
+      up.y.push_back(s);
+      dn.y.push_back(-s);
+    }
+    err.series.push_back(up);
+    err.series.push_back(dn);
+  }
+  err.hlines.push_back(report::HLine{1.0, "#444444", true, "+1 dB target"});
+  err.hlines.push_back(report::HLine{-1.0, "#444444", true, "-1 dB"});
+  for (const auto* v : {&in.true_resonances_hz, &in.true_antiresonances_hz})
+    for (double f : *v)
+      for (auto* p : {&mag, &zoom, &ph, &err}) p->markers.push_back(report::VMarker{f, "#bbbbbb"});
+
+  fig.panels = {mag, zoom, ph, err};
+  return fig;
+}
+
+void write_comparison_svg(const report::Figure& fig, const std::filesystem::path& file) {
+  if (file.has_parent_path()) std::filesystem::create_directories(file.parent_path());
+  report::write_svg(fig, file);
+}
+
+}  // namespace piezo::study
