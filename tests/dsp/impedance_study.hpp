@@ -28,10 +28,11 @@ struct StudyRow {
   std::string method;
   std::size_t samples = 0;                        // samples per channel that entered the estimate
   std::vector<double> res_err_rel, anti_err_rel;  // per true feature; NaN = not found
-  double max_feature_err_rel = 0;                 // worst over features (inf if one is missing)
-  double max_db_err = 0, median_db_err = 0;       // |Z| away from the peaks, f_lo..f_hi
-  double f_max_db_err = 0;                        // where the largest |Z| error sits
-  std::size_t order = 0;                          // Prony only
+  std::size_t ambiguous = 0;       // true features with > 1 found extremum within ±3 % (see match)
+  double max_feature_err_rel = 0;  // worst over features (inf if one is missing)
+  double max_db_err = 0, median_db_err = 0;  // |Z| away from the peaks, f_lo..f_hi
+  double f_max_db_err = 0;                   // where the largest |Z| error sits
+  std::size_t order = 0;                     // Prony only
   double elapsed_ms = 0;
   std::vector<double> f_hz;  // the estimate as computed (for plots)
   std::vector<std::complex<double>> z_ohm;
@@ -46,6 +47,7 @@ struct MethodStats {
   std::vector<double> res_mean, res_std, anti_mean, anti_std;
   std::vector<std::size_t> res_found, anti_found;
   double max_db_median = 0, max_db_p90 = 0, median_db_median = 0;
+  double ambiguous_fraction = 0;  // of the (run, feature) pairs
 };
 MethodStats summarize(const std::vector<StudyRow>& runs);
 

@@ -8,11 +8,17 @@ namespace piezo::study {
 
 namespace {
 
-const char* colour_of(std::size_t k) {
-  static constexpr const char* kColours[] = {"#ff7f0e", "#1f77b4", "#2ca02c",
-                                             "#d62728", "#9467bd", "#8c564b"};
-  return kColours[k % (sizeof kColours / sizeof kColours[0])];
+// Fixed colours for the study's methods (the same in every panel and figure).
+std::string colour_of(const StudyRow& r, std::size_t k) {
+  if (r.method == "prony") return r.samples <= 1000 ? "#ff7f0e" : "#1f77b4";
+  if (r.method.rfind("fft", 0) == 0) return "#2ca02c";
+  if (r.method.rfind("xspec", 0) == 0) return "#d62728";
+  static constexpr const char* kOthers[] = {"#9467bd", "#8c564b", "#e377c2", "#17becf"};
+  return kOthers[k % (sizeof kOthers / sizeof kOthers[0])];
 }
+
+// The noisy FFT-based curves thinner, so the smooth ones drawn over them stay visible.
+double width_of(const StudyRow& r) { return r.method == "prony" ? 1.6 : 0.8; }
 
 std::string label_of(const StudyRow& r) {
   return r.method + " (" + std::to_string(r.samples) + ")";
@@ -67,14 +73,17 @@ report::Figure comparison_figure(const StudyInput& in, const std::vector<StudyRo
   report::Panel ph = panel("phase", "phase (deg)", Scale::Log, Scale::Linear);
   report::Panel err =
       panel("|Z| error: 20 log10(|Z est| / |Z true|)", "error (dB)", Scale::Log, Scale::Linear);
+  report::Panel err_zoom =
+      panel("|Z| error, 45-100 kHz", "error (dB)", Scale::Linear, Scale::Linear);
   mag.x_range = ph.x_range = err.x_range = std::make_pair(in.f_lo_hz, in.f_hi_hz);
-  zoom.x_range = std::make_pair(45e3, 100e3);
+  zoom.x_range = err_zoom.x_range = std::make_pair(45e3, 100e3);
+  err_zoom.y_range = std::make_pair(-4.0, 4.0);
   ph.y_range = std::make_pair(-100.0, 100.0);
   err.y_range = std::make_pair(-6.0, 6.0);
 
   for (std::size_t k = 0; k < rows.size(); ++k) {
     const auto& r = rows[k];
-    report::Series m = series(label_of(r), colour_of(k), 1.2);
+    report::Series m = series(label_of(r), colour_of(r, k), width_of(r));
     report::Series p = m, e = m;
     for (std::size_t i = 0; i < r.f_hz.size(); ++i) {
       const double f = r.f_hz[i];
@@ -91,6 +100,7 @@ report::Figure comparison_figure(const StudyInput& in, const std::vector<StudyRo
     zoom.series.push_back(m);
     ph.series.push_back(p);
     err.series.push_back(e);
+    err_zoom.series.push_back(e);
   }
   // The truth last, drawn over the estimates.
   mag.series.push_back(mag_true);
@@ -104,16 +114,21 @@ report::Figure comparison_figure(const StudyInput& in, const std::vector<StudyRo
       up.y.push_back(s);
       dn.y.push_back(-s);
     }
-    err.series.push_back(up);
-    err.series.push_back(dn);
+    for (auto* p : {&err, &err_zoom}) {
+      p->series.push_back(up);
+      p->series.push_back(dn);
+    }
   }
-  err.hlines.push_back(report::HLine{1.0, "#444444", true, "+1 dB target"});
-  err.hlines.push_back(report::HLine{-1.0, "#444444", true, "-1 dB"});
+  for (auto* p : {&err, &err_zoom}) {
+    p->hlines.push_back(report::HLine{1.0, "#444444", true, "+1 dB target"});
+    p->hlines.push_back(report::HLine{-1.0, "#444444", true, "-1 dB"});
+  }
   for (const auto* v : {&in.true_resonances_hz, &in.true_antiresonances_hz})
     for (double f : *v)
-      for (auto* p : {&mag, &zoom, &ph, &err}) p->markers.push_back(report::VMarker{f, "#bbbbbb"});
+      for (auto* p : {&mag, &zoom, &ph, &err, &err_zoom})
+        p->markers.push_back(report::VMarker{f, "#bbbbbb"});
 
-  fig.panels = {mag, zoom, ph, err};
+  fig.panels = {mag, zoom, ph, err, err_zoom};
   return fig;
 }
 

@@ -1,8 +1,10 @@
 #pragma once
 // The chapter-5 comparison as a figure (test support): |Z| and phase over a log
 // frequency axis (true vs each estimate), a linear zoom on the modes, and the
-// |Z| error in dB against frequency with the Cramér–Rao band and the ±1 dB
-// target. Drawn by the project's headless SVG writer (ui/report/svg_plot).
+// |Z| error in dB against frequency (whole band and the modes' zoom) with the
+// Cramér–Rao band and the ±1 dB target. Rows are drawn in the order given (put
+// the smooth estimates last to keep them on top). Drawn by the project's
+// headless SVG writer (ui/report/svg_plot).
 #include <filesystem>
 #include <string>
 #include <vector>

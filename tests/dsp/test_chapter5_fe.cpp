@@ -177,7 +177,7 @@ TEST(Chapter5Fe, TenPercentNoiseTableBoundsAndPlot) {
 
   // The figure: Prony 1000 / 3000, FFT and cross spectra (differenced), with the
   // CRB band of 3000 samples in the error panel.
-  const std::vector<study::StudyRow> shown{rows[0], rows[1], rows[3], rows[5]};
+  const std::vector<study::StudyRow> shown{rows[3], rows[5], rows[0], rows[1]};
   std::vector<double> fb;
   for (double f = in.f_lo_hz; f <= in.f_hi_hz; f *= 1.002) fb.push_back(f);
   const study::ErrorBand band{"CRB 1σ, 3000 samples", fb,
