@@ -57,7 +57,7 @@ report::Figure comparison_figure(const StudyInput& in, const std::vector<StudyRo
 
   // The truth on a fine grid (the features are sharp at β = 1e-7).
   std::vector<double> ft;
-  for (double f = in.f_lo_hz; f <= in.f_hi_hz * (1 + 1e-12); f *= 1.0005) ft.push_back(f);
+  for (double f = in.f_lo_hz; f <= in.f_hi_hz * (1 + 1e-12); f *= 1.002) ft.push_back(f);
   report::Series mag_true = series("true (FE modal)", "#000000", 2.5);
   mag_true.x = ft;
   report::Series ph_true = mag_true;
@@ -128,6 +128,25 @@ report::Figure comparison_figure(const StudyInput& in, const std::vector<StudyRo
       for (auto* p : {&mag, &zoom, &ph, &err, &err_zoom})
         p->markers.push_back(report::VMarker{f, "#bbbbbb"});
 
+  // The zoom panels keep only their points in range (+1 on each side): the
+  // writer clips, but the file would carry every point.
+  for (auto* p : {&zoom, &err_zoom})
+    for (auto& ser : p->series) {
+      report::Series kept = ser;
+      kept.x.clear();
+      kept.y.clear();
+      for (std::size_t i = 0; i < ser.x.size(); ++i) {
+        const bool in_range = ser.x[i] >= p->x_range->first && ser.x[i] <= p->x_range->second;
+        const bool next_in = i + 1 < ser.x.size() && ser.x[i + 1] >= p->x_range->first;
+        const bool prev_in = i > 0 && ser.x[i - 1] <= p->x_range->second;
+        if (in_range || (next_in && ser.x[i] < p->x_range->first) ||
+            (prev_in && ser.x[i] > p->x_range->second)) {
+          kept.x.push_back(ser.x[i]);
+          kept.y.push_back(ser.y[i]);
+        }
+      }
+      ser = kept;
+    }
   fig.panels = {mag, zoom, ph, err, err_zoom};
   return fig;
 }

@@ -179,7 +179,7 @@ TEST(Chapter5Fe, TenPercentNoiseTableBoundsAndPlot) {
   // CRB band of 3000 samples in the error panel.
   const std::vector<study::StudyRow> shown{rows[3], rows[5], rows[0], rows[1]};
   std::vector<double> fb;
-  for (double f = in.f_lo_hz; f <= in.f_hi_hz; f *= 1.002) fb.push_back(f);
+  for (double f = in.f_lo_hz; f <= in.f_hi_hz; f *= 1.004) fb.push_back(f);
   const study::ErrorBand band{"CRB 1σ, 3000 samples", fb,
                               fe5::db_crb(fe(), 0.10, 3000, fb, fe5::CrbClass::Reduced)};
   const auto fig = study::comparison_figure(
