@@ -218,15 +218,30 @@ Eigen::VectorXd divider_feature_gradient(const std::vector<cd>& poles,
   return -dg.imag() / ld.dg.real() / kTwoPi;
 }
 
+std::vector<FeatureCrb> divider_feature_crb(const std::vector<cd>& poles,
+                                            const std::vector<Channel>& ch, double fs,
+                                            std::size_t n, const std::vector<double>& f_start_hz,
+                                            const std::vector<bool>& known) {
+  const Layout l = layout(poles, 2);
+  const Eigen::MatrixXd fi = fisher(poles, ch, l, fs, n);  // once for all features
+  const auto free = free_mask(poles, l, known);
+  std::vector<FeatureCrb> out;
+  for (double f0 : f_start_hz) {
+    const double f = divider_feature_hz(poles, ch, f0);
+    if (!std::isfinite(f)) {
+      out.push_back({f, f});
+      continue;
+    }
+    const Eigen::VectorXd grad = divider_feature_gradient(poles, ch, f);
+    out.push_back({f, std::sqrt(quadratic_form_inverse(fi, grad, free))});
+  }
+  return out;
+}
+
 FeatureCrb divider_feature_crb(const std::vector<cd>& poles, const std::vector<Channel>& ch,
                                double fs, std::size_t n, double f_start_hz,
                                const std::vector<bool>& known) {
-  const Layout l = layout(poles, 2);
-  const double f = divider_feature_hz(poles, ch, f_start_hz);
-  if (!std::isfinite(f)) return {f, f};
-  const Eigen::VectorXd grad = divider_feature_gradient(poles, ch, f);
-  const Eigen::MatrixXd fi = fisher(poles, ch, l, fs, n);
-  return {f, std::sqrt(quadratic_form_inverse(fi, grad, free_mask(poles, l, known)))};
+  return divider_feature_crb(poles, ch, fs, n, std::vector<double>{f_start_hz}, known)[0];
 }
 
 std::vector<double> divider_db_crb(const std::vector<cd>& poles, const std::vector<Channel>& ch,

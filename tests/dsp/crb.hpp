@@ -52,6 +52,12 @@ FeatureCrb divider_feature_crb(const std::vector<std::complex<double>>& poles,
                                const std::vector<Channel>& channels, double fs, std::size_t n,
                                double f_start_hz, const std::vector<bool>& known = {});
 
+// The same for several features (the Fisher matrix is formed once).
+std::vector<FeatureCrb> divider_feature_crb(const std::vector<std::complex<double>>& poles,
+                                            const std::vector<Channel>& channels, double fs,
+                                            std::size_t n, const std::vector<double>& f_start_hz,
+                                            const std::vector<bool>& known = {});
+
 // CRB standard deviation (dB) of 20·log10|Z(j2πf)| at each f of the same model.
 std::vector<double> divider_db_crb(const std::vector<std::complex<double>>& poles,
                                    const std::vector<Channel>& channels, double fs, std::size_t n,

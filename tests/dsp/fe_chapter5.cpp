@@ -175,15 +175,13 @@ FeatureBounds feature_crb(const FeChapter5& fe, const study::StudyInput& in, dou
                           std::size_t n, CrbClass cls) {
   std::vector<bool> known;
   const CrbModel m = crb_at(fe, level, cls, known);
+  std::vector<double> f = in.true_resonances_hz;
+  f.insert(f.end(), in.true_antiresonances_hz.begin(), in.true_antiresonances_hz.end());
+  const auto c = crb::divider_feature_crb(m.poles, m.channels, fe.sample_rate_hz, n, f, known);
   FeatureBounds b;
-  for (double f : in.true_resonances_hz) {
-    const auto c = crb::divider_feature_crb(m.poles, m.channels, fe.sample_rate_hz, n, f, known);
-    b.res_rel.push_back(c.sigma_hz / c.f_hz);
-  }
-  for (double f : in.true_antiresonances_hz) {
-    const auto c = crb::divider_feature_crb(m.poles, m.channels, fe.sample_rate_hz, n, f, known);
-    b.anti_rel.push_back(c.sigma_hz / c.f_hz);
-  }
+  for (std::size_t k = 0; k < c.size(); ++k)
+    (k < in.true_resonances_hz.size() ? b.res_rel : b.anti_rel)
+        .push_back(c[k].sigma_hz / c[k].f_hz);
   return b;
 }
 

@@ -125,7 +125,7 @@ TEST(Chapter5Fe, OnePercentNoiseComparison) {
   }
   // Mode 3's resonance: the order-8 fit leaves out the FE tube's modes above the
   // band (231 kHz and up), whose tails enter V2 next to its zero at 79.1 kHz:
-  // a bias of +0.16 % at this noise (validate study: +0.159 ± 0.064 % over 40
+  // a bias of +0.16 % at this noise (validate study: +0.165 ± 0.053 % over 100
   // seeds; +0.05 % where the order reaches 10 at 0.1 % noise). Within 0.2 %
   // here, asserted as achieved, with 0.3 % = bias + 2σ as the tolerance.
   EXPECT_LT(std::abs(p3000.res_err_rel.at(2)), 3e-3);
