@@ -86,8 +86,7 @@ double quadratic_form_inverse(const Eigen::MatrixXd& f, const Eigen::VectorXd& g
   return gs.dot(fs.ldlt().solve(gs));
 }
 
-// V(s), V'(s), V''(s) of one channel's pole–residue sum, and their derivatives
-// with respect to the parameters (only the entries touched are non-zero).
+// V(s), V'(s), V''(s) of one channel's pole–residue sum.
 struct Laplace {
   cd v = 0, d1 = 0, d2 = 0;
 };

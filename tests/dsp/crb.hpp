@@ -46,8 +46,9 @@ struct FeatureCrb {
 // The extremum next to `f_start_hz` and its CRB from samples k = 0..n−1 at fs.
 // Poles flagged in `known` (one flag per pole, or empty: none) are treated as
 // known, with their residues: the bound then holds for a smaller parameter set
-// and is a lower bound of the full one (what an estimator of a reduced model
-// that leaves those components out, unbiased otherwise, could reach at best).
+// and is a lower bound of the full one (and the bound of a fit of the reduced
+// model, as far as the data are that model: the flagged components contribute
+// only a small bias then).
 FeatureCrb divider_feature_crb(const std::vector<std::complex<double>>& poles,
                                const std::vector<Channel>& channels, double fs, std::size_t n,
                                double f_start_hz, const std::vector<bool>& known = {});

@@ -42,7 +42,8 @@ const FeChapter5& chapter5();
 
 // The study input: `records` independent noisy copies of the clean records
 // (record 0 feeds Prony and the FFT; all of them the cross spectra), true Z and
-// the true |Z| extrema in 1–120 kHz.
+// the true |Z| extrema in 1–120 kHz. The input's z_true refers to `fe`, which
+// must outlive it (chapter5() does).
 study::StudyInput study_input(const FeChapter5& fe, double level, std::uint64_t seed,
                               std::size_t records);
 
