@@ -16,32 +16,45 @@ namespace {
 using clk = std::chrono::steady_clock;
 constexpr double kInf = std::numeric_limits<double>::infinity();
 
-std::vector<double> match(const std::vector<double>& truth, const std::vector<dsp::Feature>& found) {
+// The study compares |Z| extrema (what every method can report) with the true
+// extrema: per true feature, the nearest found one within ±3 %. `ambiguous`
+// counts the true features with more than one candidate there (noisy curves):
+// picking the nearest then uses the truth, so those errors are optimistic.
+std::vector<double> match(const std::vector<double>& truth, const std::vector<dsp::Feature>& found,
+                          std::size_t& ambiguous) {
   std::vector<double> out;
   for (double t : truth) {
     double best = std::numeric_limits<double>::quiet_NaN(), dist = 0.03 * t;
-    // The study compares |Z| extrema (what every method can report) with the true extrema.
-    for (const auto& f : found)
-      if (std::abs(f.extremum_hz - t) < dist) { dist = std::abs(f.extremum_hz - t); best = (f.extremum_hz - t) / t; }
+    std::size_t candidates = 0;
+    for (const auto& f : found) {
+      if (std::abs(f.extremum_hz - t) < 0.03 * t) ++candidates;
+      if (std::abs(f.extremum_hz - t) < dist) {
+        dist = std::abs(f.extremum_hz - t);
+        best = (f.extremum_hz - t) / t;
+      }
+    }
+    ambiguous += candidates > 1;
     out.push_back(best);
   }
   return out;
 }
 
 void score(const StudyInput& in, const dsp::ImpedanceResult& r, StudyRow& row) {
-  row.res_err_rel = match(in.true_resonances_hz, r.features.resonances);
-  row.anti_err_rel = match(in.true_antiresonances_hz, r.features.antiresonances);
+  row.f_hz.assign(r.f_hz.data(), r.f_hz.data() + r.f_hz.size());
+  row.z_ohm.assign(r.z_ohm.data(), r.z_ohm.data() + r.z_ohm.size());
+  row.ambiguous = 0;
+  row.res_err_rel = match(in.true_resonances_hz, r.features.resonances, row.ambiguous);
+  row.anti_err_rel = match(in.true_antiresonances_hz, r.features.antiresonances, row.ambiguous);
   row.max_feature_err_rel = 0;
   for (const auto* v : {&row.res_err_rel, &row.anti_err_rel})
-    for (double e : *v) row.max_feature_err_rel = std::isfinite(e) ? std::max(row.max_feature_err_rel, std::abs(e)) : kInf;
+    for (double e : *v)
+      row.max_feature_err_rel =
+          std::isfinite(e) ? std::max(row.max_feature_err_rel, std::abs(e)) : kInf;
   std::vector<double> err;
   for (Eigen::Index k = 0; k < r.f_hz.size(); ++k) {
     const double f = r.f_hz[k];
     if (f < in.f_lo_hz || f > in.f_hi_hz) continue;
-    bool near = false;
-    for (const auto* v : {&in.true_resonances_hz, &in.true_antiresonances_hz})
-      for (double t : *v) near = near || std::abs(f - t) <= in.peak_exclusion_rel * t;
-    if (near) continue;
+    if (near_feature(in, f)) continue;
     err.push_back(std::abs(20.0 * std::log10(std::abs(r.z_ohm[k]) / std::abs(in.z_true(f)))));
     if (err.back() > row.max_db_err) {
       row.max_db_err = err.back();
@@ -58,15 +71,24 @@ dsp::DividerRecord record(const StudyInput& in, std::size_t k) {
 }
 }  // namespace
 
-StudyRow study_prony(const StudyInput& in, std::size_t samples) {
+bool near_feature(const StudyInput& in, double f) {
+  for (const auto* v : {&in.true_resonances_hz, &in.true_antiresonances_hz})
+    for (double t : *v)
+      if (std::abs(f - t) <= in.peak_exclusion_rel * t) return true;
+  return false;
+}
+
+StudyRow study_prony(const StudyInput& in, std::size_t samples, dsp::PronyOptions prony) {
   StudyRow row;
   row.method = "prony";
   dsp::PronyImpedanceOptions o;
   o.prep.max_samples = samples;
-  o.prony.band_hz = in.f_hi_hz;
+  o.prony = prony;
+  if (o.prony.band_hz == 0.0) o.prony.band_hz = in.f_hi_hz;
   o.features.fmin_hz = in.f_lo_hz;
   const auto t0 = clk::now();
-  const auto r = dsp::impedance_prony(record(in, 0), dsp::make_grid(in.f_lo_hz, in.f_hi_hz, in.prony_grid_hz), o);
+  const auto r = dsp::impedance_prony(record(in, 0),
+                                      dsp::make_grid(in.f_lo_hz, in.f_hi_hz, in.prony_grid_hz), o);
   row.elapsed_ms = std::chrono::duration<double, std::milli>(clk::now() - t0).count();
   row.samples = r.samples_used;
   row.order = r.prony->order;
@@ -113,23 +135,112 @@ std::string format_table(const std::vector<StudyRow>& rows) {
   std::string s;
   char buf[512];
   std::snprintf(buf, sizeof buf, "| %-20s | %8s | %5s | %-27s | %-27s | %18s | %9s |\n", "method",
-                "samples", "order", "resonance err %", "anti-resonance err %",
-                "max dB (at kHz)", "median dB");
+                "samples", "order", "resonance err %", "anti-resonance err %", "max dB (at kHz)",
+                "median dB");
   s += buf;
+  s += "|---|---:|---:|---|---|---:|---:|\n";
   auto errs = [](const std::vector<double>& v) {
     std::string o;
     char b[32];
     for (double e : v) {
-      if (std::isfinite(e)) std::snprintf(b, sizeof b, "%+8.3f ", 100 * e);
-      else std::snprintf(b, sizeof b, "%8s ", "missing");
+      if (std::isfinite(e))
+        std::snprintf(b, sizeof b, "%+8.3f ", 100 * e);
+      else
+        std::snprintf(b, sizeof b, "%8s ", "missing");
       o += b;
     }
     return o;
   };
   for (const auto& r : rows) {
-    std::snprintf(buf, sizeof buf, "| %-20s | %8zu | %5zu | %-27s | %-27s | %7.3f (%7.1f) | %9.3f |\n",
-                  r.method.c_str(), r.samples, r.order, errs(r.res_err_rel).c_str(),
-                  errs(r.anti_err_rel).c_str(), r.max_db_err, r.f_max_db_err / 1e3, r.median_db_err);
+    std::snprintf(
+        buf, sizeof buf, "| %-20s | %8zu | %5zu | %-27s | %-27s | %7.3f (%7.1f) | %9.3f |\n",
+        r.method.c_str(), r.samples, r.order, errs(r.res_err_rel).c_str(),
+        errs(r.anti_err_rel).c_str(), r.max_db_err, r.f_max_db_err / 1e3, r.median_db_err);
+    s += buf;
+  }
+  return s;
+}
+
+MethodStats summarize(const std::vector<StudyRow>& runs) {
+  MethodStats st;
+  if (runs.empty()) return st;
+  st.method = runs[0].method;
+  st.samples = runs[0].samples;
+  st.runs = runs.size();
+  auto moments = [&](std::size_t k, bool res, double& mean, double& sd, std::size_t& found) {
+    std::vector<double> e;
+    for (const auto& r : runs) {
+      const auto& v = res ? r.res_err_rel : r.anti_err_rel;
+      if (k < v.size() && std::isfinite(v[k])) e.push_back(v[k]);
+    }
+    found = e.size();
+    mean = sd = std::numeric_limits<double>::quiet_NaN();
+    if (e.empty()) return;
+    mean = 0;
+    for (double x : e) mean += x / double(e.size());
+    if (e.size() < 2) return;
+    sd = 0;
+    for (double x : e) sd += (x - mean) * (x - mean) / double(e.size() - 1);
+    sd = std::sqrt(sd);
+  };
+  for (bool res : {true, false}) {
+    const std::size_t nf = (res ? runs[0].res_err_rel : runs[0].anti_err_rel).size();
+    for (std::size_t k = 0; k < nf; ++k) {
+      double m, s;
+      std::size_t f;
+      moments(k, res, m, s, f);
+      (res ? st.res_mean : st.anti_mean).push_back(m);
+      (res ? st.res_std : st.anti_std).push_back(s);
+      (res ? st.res_found : st.anti_found).push_back(f);
+    }
+  }
+  auto quantile = [](std::vector<double> v, double q) {
+    const auto i = static_cast<std::size_t>(q * double(v.size() - 1) + 0.5);
+    std::nth_element(v.begin(), v.begin() + static_cast<std::ptrdiff_t>(i), v.end());
+    return v[i];
+  };
+  std::vector<double> mx, md;
+  std::size_t ambiguous = 0, features = 0;
+  for (const auto& r : runs) {
+    mx.push_back(r.max_db_err);
+    md.push_back(r.median_db_err);
+    ambiguous += r.ambiguous;
+    features += r.res_err_rel.size() + r.anti_err_rel.size();
+  }
+  st.ambiguous_fraction = features ? double(ambiguous) / double(features) : 0.0;
+  st.max_db_median = quantile(mx, 0.5);
+  st.max_db_p90 = quantile(mx, 0.9);
+  st.median_db_median = quantile(md, 0.5);
+  return st;
+}
+
+std::string format_stats(const std::vector<MethodStats>& stats) {
+  std::string s =
+      "| method | samples | runs | resonance err % (mean ± std [found]) | anti-resonance err % "
+      "(mean ± std [found]) | ambiguous | max dB median / p90 | median dB |\n"
+      "|---|---:|---:|---|---|---:|---:|---:|\n";
+  char buf[160];
+  auto cells = [&](const std::vector<double>& m, const std::vector<double>& sd,
+                   const std::vector<std::size_t>& found, std::size_t runs) {
+    std::string o;
+    for (std::size_t k = 0; k < m.size(); ++k) {
+      if (k) o += ", ";
+      if (found[k] == 0) {
+        o += "missing";
+        continue;
+      }
+      std::snprintf(buf, sizeof buf, "%+.3f ± %.3f", 100 * m[k], 100 * sd[k]);
+      o += buf;
+      if (found[k] < runs) o += " [" + std::to_string(found[k]) + "]";  // runs that found it
+    }
+    return o;
+  };
+  for (const auto& st : stats) {
+    s += "| " + st.method + " | " + std::to_string(st.samples) + " | " + std::to_string(st.runs) +
+         " | " + cells(st.res_mean, st.res_std, st.res_found, st.runs) + " | " +
+         cells(st.anti_mean, st.anti_std, st.anti_found, st.runs) + " | ";
+    std::snprintf(buf, sizeof buf, "%.0f %% | %.2f / %.2f | %.3f |\n", 100 * st.ambiguous_fraction,
+                  st.max_db_median, st.max_db_p90, st.median_db_median);
     s += buf;
   }
   return s;

@@ -9,6 +9,8 @@
 #include <string>
 #include <vector>
 
+#include "dsp/prony_ss.hpp"
+
 namespace piezo::study {
 
 struct StudyInput {
@@ -24,18 +26,41 @@ struct StudyInput {
 
 struct StudyRow {
   std::string method;
-  std::size_t samples = 0;                      // samples per channel that entered the estimate
+  std::size_t samples = 0;                        // samples per channel that entered the estimate
   std::vector<double> res_err_rel, anti_err_rel;  // per true feature; NaN = not found
-  double max_feature_err_rel = 0;               // worst over features (inf if one is missing)
-  double max_db_err = 0, median_db_err = 0;     // |Z| away from the peaks, f_lo..f_hi
-  double f_max_db_err = 0;                      // where the largest |Z| error sits
-  std::size_t order = 0;                        // Prony only
+  std::size_t ambiguous = 0;       // true features with > 1 found extremum within ±3 % (see match)
+  double max_feature_err_rel = 0;  // worst over features (inf if one is missing)
+  double max_db_err = 0, median_db_err = 0;  // |Z| away from the peaks, f_lo..f_hi
+  double f_max_db_err = 0;                   // where the largest |Z| error sits
+  std::size_t order = 0;                     // Prony only
   double elapsed_ms = 0;
+  std::vector<double> f_hz;  // the estimate as computed (for plots)
+  std::vector<std::complex<double>> z_ohm;
 };
 
-StudyRow study_prony(const StudyInput& in, std::size_t samples);
+// One method over many noise seeds: per true feature the mean and std of the
+// relative error over the runs that found it, and how many did; the median and
+// 90th percentile of the max |Z| error and the median of the median error.
+struct MethodStats {
+  std::string method;
+  std::size_t samples = 0, runs = 0;
+  std::vector<double> res_mean, res_std, anti_mean, anti_std;
+  std::vector<std::size_t> res_found, anti_found;
+  double max_db_median = 0, max_db_p90 = 0, median_db_median = 0;
+  double ambiguous_fraction = 0;  // of the (run, feature) pairs
+};
+MethodStats summarize(const std::vector<StudyRow>& runs);
+
+// Within ±peak_exclusion_rel of a true feature (left out of the |Z| scores).
+bool near_feature(const StudyInput& in, double f_hz);
+
+// Prony-SS on the first `samples` samples of record 0; `prony` as given except
+// that band_hz = 0 becomes the study band's top (f_hi_hz: decimation D = fs/(5·band)).
+StudyRow study_prony(const StudyInput& in, std::size_t samples, dsp::PronyOptions prony = {});
 StudyRow study_fft(const StudyInput& in, bool difference = true);
 StudyRow study_xspec(const StudyInput& in, std::size_t segment, bool difference = true);
+// Markdown tables.
 std::string format_table(const std::vector<StudyRow>& rows);
+std::string format_stats(const std::vector<MethodStats>& stats);
 
 }  // namespace piezo::study
