@@ -147,9 +147,9 @@ void run_diagnose(Context& ctx, const DiagnoseArgs& a) {
       throw InputError("--plot " + a.plot + ": no folder " + dir.string());
   }
   const acq::Capture fit_attrs = capture_attributes(a.fit);
+  const std::string material = nominal_material(a, fit_attrs);
   require_repeated_shots(fit_attrs, a.fit);
   if (!a.holdout.empty()) require_repeated_shots(capture_attributes(a.holdout), a.holdout);
-  const std::string material = nominal_material(a, fit_attrs);
 
   ui::PipelineRequest req;
   req.replay_capture = a.fit;

@@ -118,14 +118,224 @@ std::string verdict_line(const update::GapDiagnosis& d) {
   return s;
 }
 
+// Text readable over curves: a white halo one pixel around the glyphs.
+void halo_text(PngCanvas& cv, double x, double y, const std::string& s, Align al, bool vertical) {
+  for (int dx = -1; dx <= 1; ++dx)
+    for (int dy = -1; dy <= 1; ++dy)
+      if (dx || dy) cv.text(x + dx, y + dy, s, kHalo, FontSize::Normal, al, vertical);
+  cv.text(x, y, s, kInk, FontSize::Normal, al, vertical);
+}
+
+// The plot's x axis and the panels sharing it.
+struct Frame {
+  PngCanvas& cv;
+  DiagnosisPlotLayout L;
+  double fmin, fmax;
+  Axis x(const PixelRect& p) const { return {fmin, fmax, p.x0, p.x1, true}; }
+  std::vector<PixelRect> panels() const { return {L.z, L.db, L.deg}; }
+};
+
+// Regions as [lo, hi) bands inside the axis, and their alternate shading in every panel.
+struct Band {
+  double lo, hi;
+  const update::GapRegion* region;
+};
+
+std::vector<Band> bands_of(const update::GapDiagnosis& d, double fmin, double fmax) {
+  std::vector<Band> out;
+  for (const auto& g : d.regions) {
+    const double lo = std::max(g.f_lo_hz, fmin), hi = std::min(g.f_hi_hz, fmax);
+    if (hi > lo) out.push_back({lo, hi, &g});
+  }
+  return out;
+}
+
+void shade_regions(const Frame& F, const std::vector<Band>& bands) {
+  for (std::size_t k = 0; k < bands.size(); ++k)
+    for (const PixelRect& P : F.panels()) {
+      const Axis ax = F.x(P);
+      F.cv.fill_rect(ax(bands[k].lo), P.y0, ax(bands[k].hi), P.y1, k % 2 ? kRegionB : kRegionA);
+    }
+}
+
+// Vertical grid in every panel; tick labels under the last one.
+void frequency_grid(const Frame& F) {
+  for (const PixelRect& P : F.panels()) {
+    const Axis ax = F.x(P);
+    for (double t : log_minor(F.fmin, F.fmax))
+      F.cv.line({std::round(ax(t)) + 0.5, P.y0}, {std::round(ax(t)) + 0.5, P.y1}, kMinorGrid);
+    for (double t : log_labels(F.fmin, F.fmax))
+      F.cv.line({std::round(ax(t)) + 0.5, P.y0}, {std::round(ax(t)) + 0.5, P.y1}, kGrid);
+  }
+  const PixelRect& P = F.L.deg;
+  const Axis ax = F.x(P);
+  for (double t : log_labels(F.fmin, F.fmax)) {
+    F.cv.line({std::round(ax(t)) + 0.5, P.y1}, {std::round(ax(t)) + 0.5, P.y1 + 4}, kMuted);
+    F.cv.text(ax(t), P.y1 + 6, t >= 1e3 ? fmt("%g kHz", t / 1e3) : fmt("%g Hz", t), kInk,
+              FontSize::Normal, Align::Centre);
+  }
+  F.cv.text((P.x0 + P.x1) / 2, P.y1 + 24, "frequency", kInk, FontSize::Normal, Align::Centre);
+}
+
+void frame_and_label(const Frame& F, const PixelRect& P, const std::string& label) {
+  F.cv.line({P.x0 - 0.5, P.y0 - 0.5}, {P.x1 + 0.5, P.y0 - 0.5}, kMuted);
+  F.cv.line({P.x0 - 0.5, P.y1 + 0.5}, {P.x1 + 0.5, P.y1 + 0.5}, kMuted);
+  F.cv.line({P.x0 - 0.5, P.y0 - 0.5}, {P.x0 - 0.5, P.y1 + 0.5}, kMuted);
+  F.cv.line({P.x1 + 0.5, P.y0 - 0.5}, {P.x1 + 0.5, P.y1 + 0.5}, kMuted);
+  F.cv.text(14, (P.y0 + P.y1) / 2, label, kInk, FontSize::Normal, Align::Centre, true);
+}
+
+// |Z|: the model after as a wide halo, the model before dashed, the measurement on top.
+void magnitude_panel(const Frame& F, const std::vector<double>& f, const std::vector<double>& meas,
+                     const std::vector<double>& z_before, const std::vector<double>& z_after) {
+  const PixelRect& P = F.L.z;
+  double lo = INFINITY, hi = 0;
+  for (const auto* v : {&meas, &z_before, &z_after})
+    for (double z : *v)
+      if (z > 0 && std::isfinite(z)) lo = std::min(lo, z), hi = std::max(hi, z);
+  if (!(hi > lo)) throw std::invalid_argument("render_diagnosis_plot: no positive |Z| to plot");
+  const double pad = std::pow(hi / lo, 0.05);
+  const Axis ax = F.x(P), ay{lo / pad, hi * pad, P.y1, P.y0, true};
+  for (double t : log_minor(ay.lo, ay.hi))
+    F.cv.line({P.x0, std::round(ay(t)) + 0.5}, {P.x1, std::round(ay(t)) + 0.5}, kMinorGrid);
+  for (double t : log_labels(ay.lo, ay.hi)) {
+    const double y = std::round(ay(t)) + 0.5;
+    F.cv.line({P.x0, y}, {P.x1, y}, kGrid);
+    F.cv.line({P.x0 - 4, y}, {P.x0, y}, kMuted);
+    F.cv.text(P.x0 - 7, y - 6, tick_label(t, Scale::Log), kInk, FontSize::Normal, Align::Right);
+  }
+  F.cv.set_clip(P.x0, P.y0, P.x1, P.y1);
+  F.cv.polyline(points(f, z_after, ax, ay), kAfter, 4.0);
+  F.cv.polyline(points(f, z_before, ax, ay), kBefore, 1.8, 7.0);
+  F.cv.polyline(points(f, meas, ax, ay), kMeasured, 1.4);
+  F.cv.reset_clip();
+  frame_and_label(F, P, "|Z| (ohm)");
+}
+
+double quantile(std::vector<double> v, double q) {
+  if (v.empty()) return 0.0;
+  const auto k = static_cast<std::size_t>(q * static_cast<double>(v.size() - 1));
+  std::nth_element(v.begin(), v.begin() + static_cast<std::ptrdiff_t>(k), v.end());
+  return v[k];
+}
+
+// A residual, before and after, over the ±1σ band of the measurement. The
+// range is symmetric and set by the better-measured half of the points (σ at
+// most its median): 1.15 × their largest |residual|, at least 3 median σ.
+// Where |Z| is small the noise is large, and its spikes would otherwise
+// flatten the systematic misfit the diagnosis is about; they are clipped at
+// the frame (the σ band shows why), and a note says so.
+void residual_panel(const Frame& F, const PixelRect& P, const std::vector<double>& f,
+                    const std::vector<double>& before, const std::vector<double>& after,
+                    const std::vector<double>& sigma, const std::string& label, const char* unit) {
+  std::vector<double> sig;
+  for (double s : sigma)
+    if (std::isfinite(s)) sig.push_back(s);
+  const double sig_med = quantile(sig, 0.5);
+  double well = 0, all = 0;
+  for (std::size_t i = 0; i < f.size(); ++i)
+    for (double r : {before[i], after[i]}) {
+      if (!std::isfinite(r)) continue;
+      all = std::max(all, std::abs(r));
+      if (sigma[i] <= sig_med) well = std::max(well, std::abs(r));
+    }
+  const double lim = std::max({1.15 * well, 3.0 * sig_med, 1e-3});
+  const bool clipped = all > lim;
+  const Axis ax = F.x(P), ay{-lim, lim, P.y1, P.y0, false};
+  for (double t : linear_ticks(-lim, lim, 5)) {
+    const double y = std::round(ay(t)) + 0.5;
+    F.cv.line({P.x0, y}, {P.x1, y}, t == 0.0 ? kZero : kGrid);
+    F.cv.line({P.x0 - 4, y}, {P.x0, y}, kMuted);
+    F.cv.text(P.x0 - 7, y - 6, tick_label(t, Scale::Linear), kInk, FontSize::Normal, Align::Right);
+  }
+  F.cv.set_clip(P.x0, P.y0, P.x1, P.y1);
+  std::vector<double> px(f.size()), up(f.size()), dn(f.size());
+  for (std::size_t i = 0; i < f.size(); ++i) {
+    px[i] = ax(f[i]);
+    up[i] = ay(sigma[i]);
+    dn[i] = ay(-sigma[i]);
+  }
+  F.cv.fill_band(px, up, dn, kSigma);
+  F.cv.polyline(points(f, before, ax, ay), kBefore, 1.5);
+  F.cv.polyline(points(f, after, ax, ay), kAfter, 1.8);
+  F.cv.reset_clip();
+  if (clipped)
+    halo_text(F.cv, P.x1 - 6, P.y0 + 4, fmt("clipped at \u00b1%.3g ", lim) + unit, Align::Right,
+              false);
+  frame_and_label(F, P, label);
+}
+
+// Region names at the top of the |Z| panel, on a white halo (they may cross a
+// curve): horizontal in a band wide enough, else vertical, in frequency order
+// at least a line apart (nudged off narrow neighbouring bands, never dropped).
+// A region holding a tenth of χ² or more, not noise, says so and of what kind.
+void region_names(const Frame& F, const std::vector<Band>& bands) {
+  const PixelRect& P = F.L.z;
+  const Axis ax = F.x(P);
+  const double lh = F.cv.line_height();
+  std::vector<double> xs(bands.size());
+  std::vector<bool> flat(bands.size());
+  std::vector<std::string> names(bands.size());
+  for (std::size_t k = 0; k < bands.size(); ++k) {
+    const auto& g = *bands[k].region;
+    names[k] = g.name;
+    if (g.share >= 0.1 && g.kind != "noise")
+      names[k] += fmt(": %.0f %% of chi2, ", 100 * g.share) + g.kind;
+    const double xa = ax(bands[k].lo), xz = ax(bands[k].hi);
+    flat[k] = xz - xa > F.cv.text_width(names[k]) + 12;
+    xs[k] = flat[k] ? (xa + xz) / 2 : std::round((xa + xz) / 2 - lh / 2);
+  }
+  for (std::size_t k = 1; k < xs.size(); ++k)  // left to right: keep a line apart
+    if (!flat[k] && !flat[k - 1]) xs[k] = std::max(xs[k], xs[k - 1] + lh + 1);
+  for (std::size_t k = xs.size(); k-- > 0;) {  // right to left: stay inside the panel
+    if (flat[k]) continue;
+    xs[k] = std::min(xs[k], P.x1 - lh - 2);
+    if (k + 1 < xs.size() && !flat[k + 1]) xs[k] = std::min(xs[k], xs[k + 1] - lh - 1);
+  }
+  for (std::size_t k = 0; k < bands.size(); ++k) {
+    const double y = flat[k] ? P.y0 + 6 : P.y0 + 6 + F.cv.text_width(names[k]);
+    halo_text(F.cv, xs[k], y, names[k], flat[k] ? Align::Centre : Align::Left, !flat[k]);
+  }
+}
+
+// Bottom left of the |Z| panel, below the capacitive line (|Z| falls from the top left).
+void legend(const Frame& F, const update::GapDiagnosis& d) {
+  std::string added;
+  for (const auto& a : d.added) added += (added.empty() ? "" : " + ") + a;
+  const std::vector<std::pair<std::string, Rgba>> rows = {
+      {"measured (" + d.fit_description + ")", kMeasured},
+      {"model before: base refit (material + damping)", kBefore},
+      {added.empty() ? "model after: no effect added" : "model after: + " + added, kAfter},
+      {"\u00b11 sigma of the measurement (residual panels)", kSigma},
+  };
+  double w = 0;
+  for (const auto& r : rows) w = std::max(w, F.cv.text_width(r.first));
+  const double lh = F.cv.line_height() + 5, bw = w + 52,
+               bh = static_cast<double>(rows.size()) * lh + 10;
+  const double x0 = F.L.z.x0 + 8, y0 = F.L.z.y1 - bh - 8;
+  F.cv.fill_rect(x0, y0, x0 + bw, y0 + bh, {255, 255, 255, 225});
+  for (std::size_t k = 0; k < rows.size(); ++k) {
+    const double y = y0 + 6 + static_cast<double>(k) * lh, ym = std::round(y + lh / 2 - 3) + 0.5;
+    if (k == 3)
+      F.cv.fill_rect(x0 + 8, ym - 5, x0 + 38, ym + 5, rows[k].second);
+    else if (k == 1)
+      F.cv.polyline({{x0 + 8, ym}, {x0 + 38, ym}}, rows[k].second, 1.8, 7.0);
+    else
+      F.cv.line({x0 + 8, ym}, {x0 + 38, ym}, rows[k].second, k == 2 ? 4.0 : 1.6);
+    F.cv.text(x0 + 46, y, rows[k].first, kInk);
+  }
+}
+
 }  // namespace
 
 DiagnosisPlotLayout diagnosis_plot_layout(int width, int height) {
-  const double left = 84, right = width - 22.0, top = 74, bottom = height - 48.0, gap = 16;
-  const double avail = bottom - top - gap, top_h = std::round(0.58 * avail);
+  const double left = 84, right = width - 22.0, top = 74, bottom = height - 44.0, gap = 12;
+  const double avail = bottom - top - 2 * gap, z_h = std::round(0.48 * avail),
+               r_h = std::round((avail - z_h) / 2);
   DiagnosisPlotLayout l;
-  l.top = {left, top, right, top + top_h};
-  l.bottom = {left, top + top_h + gap, right, bottom};
+  l.z = {left, top, right, top + z_h};
+  l.db = {left, l.z.y1 + gap, right, l.z.y1 + gap + r_h};
+  l.deg = {left, l.db.y1 + gap, right, bottom};
   return l;
 }
 
@@ -134,181 +344,28 @@ PngCanvas render_diagnosis_plot(const update::GapDiagnosis& d, const DiagnosisPl
   const update::GapCurve& after = d.after.f_hz.size() == d.before.f_hz.size() ? d.after : d.before;
   check_curve(after, "after");
   const auto& f = d.before.f_hz;
-  const std::vector<double>& meas = d.before.measured_abs_ohm;
-  const std::vector<double> z_before = model_abs(d.before), z_after = model_abs(after);
-
-  PngCanvas cv(opt.width, opt.height);
-  const DiagnosisPlotLayout L = diagnosis_plot_layout(opt.width, opt.height);
-
-  // Axes. x: the curve's band; top y: every |Z| shown; bottom y: symmetric about 0 dB.
   const auto [fmin_it, fmax_it] = std::minmax_element(f.begin(), f.end());
   const double fmin = snap_down(*fmin_it), fmax = snap_up(*fmax_it);
   if (!(fmin > 0) || !(fmax > fmin))
     throw std::invalid_argument("render_diagnosis_plot: no frequency band to plot");
-  const Axis xt{fmin, fmax, L.top.x0, L.top.x1, true},
-      xb{fmin, fmax, L.bottom.x0, L.bottom.x1, true};
-  double zlo = INFINITY, zhi = 0, rmax = 0;
-  for (const auto* v : {&meas, &z_before, &z_after})
-    for (double z : *v)
-      if (z > 0 && std::isfinite(z)) zlo = std::min(zlo, z), zhi = std::max(zhi, z);
-  for (std::size_t i = 0; i < f.size(); ++i)
-    for (double r : {d.before.residual_db[i], after.residual_db[i], d.before.sigma_db[i]})
-      if (std::isfinite(r)) rmax = std::max(rmax, std::abs(r));
-  if (!(zhi > zlo)) throw std::invalid_argument("render_diagnosis_plot: no positive |Z| to plot");
-  const double pad = std::pow(zhi / zlo, 0.05);
-  const Axis yt{zlo / pad, zhi * pad, L.top.y1, L.top.y0, true};
-  const double rlim = std::max(0.05, 1.08 * rmax);
-  const Axis yb{-rlim, rlim, L.bottom.y1, L.bottom.y0, false};
 
-  // Regions, shaded alternately in both panels.
-  struct Band {
-    double x0, x1;
-    const update::GapRegion* region;
-  };
-  std::vector<Band> bands;
-  for (const auto& g : d.regions) {
-    const double lo = std::max(g.f_lo_hz, fmin), hi = std::min(g.f_hi_hz, fmax);
-    if (!(hi > lo)) continue;
-    bands.push_back({lo, hi, &g});
-  }
-  for (std::size_t k = 0; k < bands.size(); ++k) {
-    const Rgba c = k % 2 ? kRegionB : kRegionA;
-    for (const auto& [P, ax] : {std::pair{L.top, xt}, std::pair{L.bottom, xb}})
-      cv.fill_rect(ax(bands[k].x0), P.y0, ax(bands[k].x1), P.y1, c);
-  }
+  PngCanvas cv(opt.width, opt.height);
+  const Frame F{cv, diagnosis_plot_layout(opt.width, opt.height), fmin, fmax};
+  const auto bands = bands_of(d, fmin, fmax);
+  shade_regions(F, bands);
+  frequency_grid(F);
+  magnitude_panel(F, f, d.before.measured_abs_ohm, model_abs(d.before), model_abs(after));
+  residual_panel(F, F.L.db, f, d.before.residual_db, after.residual_db, d.before.sigma_db,
+                 "residual |Z| (dB)", "dB");
+  residual_panel(F, F.L.deg, f, d.before.residual_deg, after.residual_deg, d.before.sigma_deg,
+                 "residual phase (deg)", "deg");
+  region_names(F, bands);
+  legend(F, d);
 
-  // Grids.
-  for (double t : log_minor(fmin, fmax)) {
-    cv.line({std::round(xt(t)) + 0.5, L.top.y0}, {std::round(xt(t)) + 0.5, L.top.y1}, kMinorGrid);
-    cv.line({std::round(xb(t)) + 0.5, L.bottom.y0}, {std::round(xb(t)) + 0.5, L.bottom.y1},
-            kMinorGrid);
-  }
-  for (double t : log_labels(fmin, fmax)) {
-    cv.line({std::round(xt(t)) + 0.5, L.top.y0}, {std::round(xt(t)) + 0.5, L.top.y1}, kGrid);
-    cv.line({std::round(xb(t)) + 0.5, L.bottom.y0}, {std::round(xb(t)) + 0.5, L.bottom.y1}, kGrid);
-    cv.line({std::round(xb(t)) + 0.5, L.bottom.y1}, {std::round(xb(t)) + 0.5, L.bottom.y1 + 4},
-            kMuted);
-    cv.text(xb(t), L.bottom.y1 + 6, t >= 1e3 ? fmt("%g kHz", t / 1e3) : fmt("%g Hz", t), kInk,
-            FontSize::Normal, Align::Centre);
-  }
-  for (double t : log_minor(yt.lo, yt.hi))
-    cv.line({L.top.x0, std::round(yt(t)) + 0.5}, {L.top.x1, std::round(yt(t)) + 0.5}, kMinorGrid);
-  for (double t : log_labels(yt.lo, yt.hi)) {
-    const double y = std::round(yt(t)) + 0.5;
-    cv.line({L.top.x0, y}, {L.top.x1, y}, kGrid);
-    cv.line({L.top.x0 - 4, y}, {L.top.x0, y}, kMuted);
-    cv.text(L.top.x0 - 7, y - 6, tick_label(t, Scale::Log), kInk, FontSize::Normal, Align::Right);
-  }
-  for (double t : linear_ticks(-rlim, rlim, 7)) {
-    const double y = std::round(yb(t)) + 0.5;
-    cv.line({L.bottom.x0, y}, {L.bottom.x1, y}, t == 0.0 ? kZero : kGrid);
-    cv.line({L.bottom.x0 - 4, y}, {L.bottom.x0, y}, kMuted);
-    cv.text(L.bottom.x0 - 7, y - 6, tick_label(t, Scale::Linear), kInk, FontSize::Normal,
-            Align::Right);
-  }
-
-  // Curves, clipped to their panels. Top: the model after as a wide halo, the
-  // model before dashed, the measurement on top. Bottom: the noise band, then
-  // the residuals before and after.
-  cv.set_clip(L.top.x0, L.top.y0, L.top.x1, L.top.y1);
-  cv.polyline(points(f, z_after, xt, yt), kAfter, 4.0);
-  cv.polyline(points(f, z_before, xt, yt), kBefore, 1.8, 7.0);
-  cv.polyline(points(f, meas, xt, yt), kMeasured, 1.4);
-  cv.set_clip(L.bottom.x0, L.bottom.y0, L.bottom.x1, L.bottom.y1);
-  {
-    std::vector<double> px(f.size()), up(f.size()), dn(f.size());
-    for (std::size_t i = 0; i < f.size(); ++i) {
-      px[i] = xb(f[i]);
-      up[i] = yb(d.before.sigma_db[i]);
-      dn[i] = yb(-d.before.sigma_db[i]);
-    }
-    cv.fill_band(px, up, dn, kSigma);
-  }
-  cv.polyline(points(f, d.before.residual_db, xb, yb), kBefore, 1.5);
-  cv.polyline(points(f, after.residual_db, xb, yb), kAfter, 1.8);
-  cv.reset_clip();
-
-  // Region names at the top of the |Z| panel, on a white halo (they may cross a
-  // curve): horizontal in a band wide enough, else vertical, in frequency order
-  // at least a line apart (nudged off narrow neighbouring bands, never dropped).
-  {
-    const double lh = cv.line_height();
-    std::vector<double> xs(bands.size());
-    std::vector<bool> flat(bands.size());
-    std::vector<std::string> names(bands.size());
-    for (std::size_t k = 0; k < bands.size(); ++k) {
-      const auto& g = *bands[k].region;
-      names[k] = g.name;
-      if (g.share >= 0.1 && g.kind != "noise")
-        names[k] += fmt(": %.0f %% of chi2, ", 100 * g.share) + g.kind;
-      const double xa = xt(bands[k].x0), xz = xt(bands[k].x1);
-      flat[k] = xz - xa > cv.text_width(names[k]) + 12;
-      xs[k] = flat[k] ? (xa + xz) / 2 : std::round((xa + xz) / 2 - lh / 2);
-    }
-    for (std::size_t k = 1; k < xs.size(); ++k)  // left to right: keep a line apart
-      if (!flat[k] && !flat[k - 1]) xs[k] = std::max(xs[k], xs[k - 1] + lh + 1);
-    for (std::size_t k = xs.size(); k-- > 0;) {  // right to left: stay inside the panel
-      if (flat[k]) continue;
-      xs[k] = std::min(xs[k], L.top.x1 - lh - 2);
-      if (k + 1 < xs.size() && !flat[k + 1]) xs[k] = std::min(xs[k], xs[k + 1] - lh - 1);
-    }
-    for (std::size_t k = 0; k < bands.size(); ++k) {
-      const double w = cv.text_width(names[k]);
-      const double x = xs[k], y = flat[k] ? L.top.y0 + 6 : L.top.y0 + 6 + w;
-      const Align al = flat[k] ? Align::Centre : Align::Left;
-      for (int dx = -1; dx <= 1; ++dx)
-        for (int dy = -1; dy <= 1; ++dy)
-          if (dx || dy) cv.text(x + dx, y + dy, names[k], kHalo, FontSize::Normal, al, !flat[k]);
-      cv.text(x, y, names[k], kInk, FontSize::Normal, al, !flat[k]);
-    }
-  }
-
-  // Frames and axis labels.
-  for (const PixelRect& P : {L.top, L.bottom}) {
-    cv.line({P.x0 - 0.5, P.y0 - 0.5}, {P.x1 + 0.5, P.y0 - 0.5}, kMuted);
-    cv.line({P.x0 - 0.5, P.y1 + 0.5}, {P.x1 + 0.5, P.y1 + 0.5}, kMuted);
-    cv.line({P.x0 - 0.5, P.y0 - 0.5}, {P.x0 - 0.5, P.y1 + 0.5}, kMuted);
-    cv.line({P.x1 + 0.5, P.y0 - 0.5}, {P.x1 + 0.5, P.y1 + 0.5}, kMuted);
-  }
-  cv.text(16, (L.top.y0 + L.top.y1) / 2, "|Z| (ohm)", kInk, FontSize::Normal, Align::Centre, true);
-  cv.text(16, (L.bottom.y0 + L.bottom.y1) / 2, "residual (dB)", kInk, FontSize::Normal,
-          Align::Centre, true);
-  cv.text((L.bottom.x0 + L.bottom.x1) / 2, L.bottom.y1 + 26, "frequency", kInk, FontSize::Normal,
-          Align::Centre);
-
-  // Legend, bottom left of the |Z| panel (|Z| falls from the top left).
-  {
-    std::string added;
-    for (const auto& a : d.added) added += (added.empty() ? "" : " + ") + a;
-    const std::vector<std::pair<std::string, Rgba>> rows = {
-        {"measured (" + d.fit_description + ")", kMeasured},
-        {"model before: base refit (material + damping)", kBefore},
-        {added.empty() ? "model after: no effect added" : "model after: + " + added, kAfter},
-        {"+/-1 sigma of the measurement (residual panel)", kSigma},
-    };
-    double w = 0;
-    for (const auto& r : rows) w = std::max(w, cv.text_width(r.first));
-    const double lh = cv.line_height() + 5, bw = w + 52, bh = rows.size() * lh + 10;
-    const double x0 = L.top.x0 + 8, y0 = L.top.y1 - bh - 8;  // below the capacitive line
-    cv.fill_rect(x0, y0, x0 + bw, y0 + bh, {255, 255, 255, 225});
-    cv.line({x0, y0 + 0.5}, {x0 + bw, y0 + 0.5}, kGrid);
-    cv.line({x0, y0 + bh - 0.5}, {x0 + bw, y0 + bh - 0.5}, kGrid);
-    for (std::size_t k = 0; k < rows.size(); ++k) {
-      const double y = y0 + 6 + k * lh, ym = std::round(y + lh / 2 - 3) + 0.5;
-      if (k == 3)
-        cv.fill_rect(x0 + 8, ym - 5, x0 + 38, ym + 5, rows[k].second);
-      else if (k == 1)
-        cv.polyline({{x0 + 8, ym}, {x0 + 38, ym}}, rows[k].second, 1.8, 7.0);
-      else
-        cv.line({x0 + 8, ym}, {x0 + 38, ym}, rows[k].second, k == 2 ? 4.0 : 1.6);
-      cv.text(x0 + 46, y, rows[k].first, kInk);
-    }
-  }
-
-  // Title with the verdict.
-  std::string title = opt.title + " - verdict: " + d.verdict_effect;
+  // Title with the verdict (the normal size when the large one does not fit).
+  const std::string title = opt.title + " - verdict: " + d.verdict_effect;
   const FontSize ts =
-      cv.text_width(title, FontSize::Large) <= opt.width - 30 ? FontSize::Large : FontSize::Normal;
+      32 + cv.text_width(title, FontSize::Large) <= opt.width ? FontSize::Large : FontSize::Normal;
   cv.text(16, 12, title, kInk, ts);
   cv.text(16, 14 + cv.line_height(ts) + 6, verdict_line(d), kMuted);
   return cv;

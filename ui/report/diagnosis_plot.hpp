@@ -2,11 +2,12 @@
 // The gap diagnosis as a PNG (`piezobench diagnose --plot`): the top panel
 // shows |Z| measured against the model before (base refit: material +
 // damping) and after (with the effects the diagnosis added) on log axes; the
-// bottom panel the residual 20·log10|Z_meas/Z_model| in dB, before and after,
-// over the ±1σ band of the measurement's own noise. The misfit regions of the
-// diagnosis (capacitive band, resonances, anti-resonances, bands between,
-// tail) are shaded alternately in both panels and named; the title carries
-// the verdict. Drawn on a PngCanvas (png_canvas.hpp).
+// panels below it the residual ln(Z_meas/Z_model) before and after — its
+// magnitude in dB, then its phase in degrees (where a lead resistance or a
+// channel skew shows) — each over the ±1σ band of the measurement's own
+// noise. The misfit regions of the diagnosis (capacitive band, resonances,
+// anti-resonances, bands between, tail) are shaded alternately in every panel
+// and named; the title carries the verdict. Drawn on a PngCanvas (png_canvas.hpp).
 #include <filesystem>
 #include <string>
 
@@ -24,9 +25,10 @@ struct PixelRect {
   double x0 = 0, y0 = 0, x1 = 0, y1 = 0;
 };
 
-// Where the two panels lie on a canvas of this size (the plot areas, inside the axes).
+// Where the panels lie on a canvas of this size (the plot areas, inside the
+// axes), top to bottom: |Z|, the residual of |Z| in dB, the residual of the phase.
 struct DiagnosisPlotLayout {
-  PixelRect top, bottom;
+  PixelRect z, db, deg;
 };
 DiagnosisPlotLayout diagnosis_plot_layout(int width, int height);
 
