@@ -161,28 +161,33 @@ TEST(CliDiagnose, FitAndHoldoutCapturesNameTheLeadResistance) {
   const auto L = piezo::report::diagnosis_plot_layout(w, h);
   const piezo::report::PixelRect right{L.z.x0 + 0.6 * (L.z.x1 - L.z.x0), L.z.y0, L.z.x1, L.z.y1};
   const piezo::report::PixelRect title{0, 0, static_cast<double>(w), L.z.y0 - 4};
-  // Thresholds are about a third of what this plot draws (measured there: 714,
-  // 442 and 70 curve pixels in the |Z| panel — the dashed model-before mostly
-  // hidden under the measurement —, 7035 and 1578 in the phase panel, 98837
-  // and 3202 shaded pixels, 839 title pixels): a missing element fails, a
-  // shifted colour or layout does too, a changed noise realisation does not.
+  const int measured = count_colour(px, w, right, pal::kMeasured);
+  const int after = count_colour(px, w, right, pal::kAfter);
+  const int before = count_colour(px, w, right, pal::kBefore);
+  const int res_after = count_colour(px, w, L.deg, pal::kAfter);
+  const int res_before = count_colour(px, w, L.deg, pal::kBefore);
+  const int shade_a = count_colour(px, w, L.deg, pal::kRegionA);
+  const int shade_b = count_colour(px, w, L.deg, pal::kRegionB);
+  const int ink = count_colour(px, w, title, {35, 35, 35, 255});
   std::printf(
       "plot pixels: |Z| panel measured %d, after %d, before %d; phase panel after %d, before %d, "
-      "shades %d / %d; title %d\n",
-      count_colour(px, w, right, pal::kMeasured), count_colour(px, w, right, pal::kAfter),
-      count_colour(px, w, right, pal::kBefore), count_colour(px, w, L.deg, pal::kAfter),
-      count_colour(px, w, L.deg, pal::kBefore), count_colour(px, w, L.deg, pal::kRegionA),
-      count_colour(px, w, L.deg, pal::kRegionB), count_colour(px, w, title, {35, 35, 35, 255}));
-  EXPECT_GT(count_colour(px, w, right, pal::kMeasured), 250) << "measured |Z| missing";
-  EXPECT_GT(count_colour(px, w, right, pal::kAfter), 150) << "model-after |Z| missing";
-  EXPECT_GT(count_colour(px, w, right, pal::kBefore), 25) << "model-before |Z| missing";
-  EXPECT_GT(count_colour(px, w, L.deg, pal::kAfter), 2300) << "residual after missing";
-  EXPECT_GT(count_colour(px, w, L.deg, pal::kBefore), 500) << "residual before missing";
-  EXPECT_GT(count_colour(px, w, L.deg, pal::kRegionA), 30000)
-      << "region shading missing in the bottom panel";
-  EXPECT_GT(count_colour(px, w, L.deg, pal::kRegionB), 1000) << "alternate region shading missing";
+      "shades %d / %d; "
+      "title %d\n",
+      measured, after, before, res_after, res_before, shade_a, shade_b, ink);
+  // Thresholds are about a third of what this plot draws (measured here: 685,
+  // 429 and 65 curve pixels in the |Z| panel — the dashed model-before mostly
+  // hidden under the measurement —, 6849 and 1616 in the phase panel, 95575
+  // and 3080 shaded pixels, 2705 title pixels): a missing element fails, a
+  // shifted colour or layout does too, a changed noise realisation does not.
+  EXPECT_GT(measured, 230) << "measured |Z| missing";
+  EXPECT_GT(after, 140) << "model-after |Z| missing";
+  EXPECT_GT(before, 22) << "model-before |Z| missing";
+  EXPECT_GT(res_after, 2200) << "residual after missing";
+  EXPECT_GT(res_before, 530) << "residual before missing";
+  EXPECT_GT(shade_a, 30000) << "region shading missing in the bottom panel";
+  EXPECT_GT(shade_b, 1000) << "alternate region shading missing";
   EXPECT_EQ(count_colour(px, w, title, pal::kRegionA), 0) << "shading outside the panels";
-  EXPECT_GT(count_colour(px, w, title, {35, 35, 35, 255}), 280) << "no title text";
+  EXPECT_GT(ink, 900) << "no title text";
   stbi_image_free(px);
 
   // The text report of the same diagnosis.

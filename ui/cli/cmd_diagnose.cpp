@@ -128,10 +128,12 @@ nlohmann::json context_json(const DiagnoseArgs& a, const std::string& material,
   return j;
 }
 
-std::string plot_title(const DiagnoseArgs& a) {
-  std::string t = "Gap diagnosis of " + fs::path(a.fit).filename().string();
-  if (!a.holdout.empty()) t += ", held out: " + fs::path(a.holdout).filename().string();
-  return t;
+std::string plot_subtitle(const DiagnoseArgs& a, const std::string& material) {
+  std::string t = "fit: " + fs::path(a.fit).filename().string() + ", held out: " +
+                  (a.holdout.empty() ? std::string("other shots of the same capture")
+                                     : fs::path(a.holdout).filename().string());
+  return t + "; nominal " + material + (a.transverse ? ", transversely isotropic" : ", isotropic") +
+         " class";
 }
 
 void run_diagnose(Context& ctx, const DiagnoseArgs& a) {
@@ -179,7 +181,7 @@ void run_diagnose(Context& ctx, const DiagnoseArgs& a) {
     report::DiagnosisPlotOptions po;
     po.width = size.first;
     po.height = size.second;
-    po.title = plot_title(a);
+    po.subtitle = plot_subtitle(a, material);
     report::write_diagnosis_png(d, po, a.plot);
     plot = a.plot;
   }

@@ -329,7 +329,7 @@ void legend(const Frame& F, const update::GapDiagnosis& d) {
 }  // namespace
 
 DiagnosisPlotLayout diagnosis_plot_layout(int width, int height) {
-  const double left = 84, right = width - 22.0, top = 74, bottom = height - 44.0, gap = 12;
+  const double left = 84, right = width - 22.0, top = 92, bottom = height - 44.0, gap = 12;
   const double avail = bottom - top - 2 * gap, z_h = std::round(0.48 * avail),
                r_h = std::round((avail - z_h) / 2);
   DiagnosisPlotLayout l;
@@ -362,12 +362,19 @@ PngCanvas render_diagnosis_plot(const update::GapDiagnosis& d, const DiagnosisPl
   region_names(F, bands);
   legend(F, d);
 
-  // Title with the verdict (the normal size when the large one does not fit).
+  // Title with the verdict (the normal size when the large one does not fit),
+  // the subtitle, and the verdict's numbers.
   const std::string title = opt.title + " - verdict: " + d.verdict_effect;
   const FontSize ts =
       32 + cv.text_width(title, FontSize::Large) <= opt.width ? FontSize::Large : FontSize::Normal;
-  cv.text(16, 12, title, kInk, ts);
-  cv.text(16, 14 + cv.line_height(ts) + 6, verdict_line(d), kMuted);
+  double y = 10;
+  cv.text(16, y, title, kInk, ts);
+  y += cv.line_height(ts) + 6;
+  if (!opt.subtitle.empty()) {
+    cv.text(16, y, opt.subtitle, kInk);
+    y += cv.line_height() + 3;
+  }
+  cv.text(16, y, verdict_line(d), kMuted);
   return cv;
 }
 

@@ -18,7 +18,8 @@ namespace piezo::report {
 
 struct DiagnosisPlotOptions {
   int width = 1200, height = 800;
-  std::string title = "Gap diagnosis";  // the verdict is appended
+  std::string title = "Gap diagnosis";  // large; the verdict is appended
+  std::string subtitle;  // e.g. the captures; the verdict's numbers follow on a line of their own
 };
 
 struct PixelRect {
