@@ -46,8 +46,8 @@ std::pair<int, int> parse_size(const std::string& s) {
   char x = 0, rest = 0;
   if (std::sscanf(s.c_str(), "%d%c%d%c", &w, &x, &h, &rest) != 3 || (x != 'x' && x != 'X'))
     throw InputError("--plot-size: expected WIDTHxHEIGHT, e.g. 1200x800, got '" + s + "'");
-  if (w < 480 || h < 360 || w > 8000 || h > 8000)
-    throw InputError("--plot-size: " + s + " is outside 480x360 .. 8000x8000");
+  if (w < 800 || h < 560 || w > 8000 || h > 8000)  // below 800x560 the labels crowd the panels
+    throw InputError("--plot-size: " + s + " is outside 800x560 .. 8000x8000");
   return {w, h};
 }
 
@@ -98,7 +98,7 @@ void check_candidates(const std::vector<std::string>& c) {
     }
 }
 
-// The stage's note and the warnings that explain it, for a diagnosis that did not run.
+// The stages' notes that explain a diagnosis that did not run.
 std::string why_not_diagnosed(const ui::PipelineResult& r) {
   std::string why = "the gap diagnosis did not run";
   for (const auto& s : r.stages)
@@ -128,10 +128,15 @@ nlohmann::json context_json(const DiagnoseArgs& a, const std::string& material,
   return j;
 }
 
-std::string plot_subtitle(const DiagnoseArgs& a, const std::string& material) {
-  std::string t = "fit: " + fs::path(a.fit).filename().string() + ", held out: " +
-                  (a.holdout.empty() ? std::string("other shots of the same capture")
-                                     : fs::path(a.holdout).filename().string());
+// Which data the plot shows and which it was judged on (the held-out data as
+// the diagnosis found them when no --holdout was given).
+std::string plot_subtitle(const DiagnoseArgs& a, const std::string& material,
+                          const update::GapDiagnosis& d) {
+  std::string t = "fit: " + fs::path(a.fit).filename().string() + "; ";
+  if (!a.holdout.empty())
+    t += "held out: " + fs::path(a.holdout).filename().string();
+  else
+    t += d.heldout_description.empty() ? std::string("no held-out data") : d.heldout_description;
   return t + "; nominal " + material + (a.transverse ? ", transversely isotropic" : ", isotropic") +
          " class";
 }
@@ -181,7 +186,7 @@ void run_diagnose(Context& ctx, const DiagnoseArgs& a) {
     report::DiagnosisPlotOptions po;
     po.width = size.first;
     po.height = size.second;
-    po.subtitle = plot_subtitle(a, material);
+    po.subtitle = plot_subtitle(a, material, d);
     report::write_diagnosis_png(d, po, a.plot);
     plot = a.plot;
   }

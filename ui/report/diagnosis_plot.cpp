@@ -177,12 +177,29 @@ void frequency_grid(const Frame& F) {
   F.cv.text((P.x0 + P.x1) / 2, P.y1 + 24, "frequency", kInk, FontSize::Normal, Align::Centre);
 }
 
-void frame_and_label(const Frame& F, const PixelRect& P, const std::string& label) {
+// `s` cut to `max_w` pixels, ending in "..." when cut (whole code points only).
+std::string fit_width(const PngCanvas& cv, const std::string& s, double max_w) {
+  if (cv.text_width(s) <= max_w) return s;
+  std::string t = s;
+  while (!t.empty() && cv.text_width(t + "...") > max_w) {
+    t.pop_back();
+    while (!t.empty() && (static_cast<unsigned char>(t.back()) & 0xC0) == 0x80)
+      t.pop_back();                                                                // continuation
+    if (!t.empty() && static_cast<unsigned char>(t.back()) >= 0xC0) t.pop_back();  // lead byte
+  }
+  return t + "...";
+}
+
+// The frame of a panel and its y label: `label`, or `short_label` when the panel is too short for
+// it.
+void frame_and_label(const Frame& F, const PixelRect& P, const std::string& label,
+                     const std::string& short_label) {
   F.cv.line({P.x0 - 0.5, P.y0 - 0.5}, {P.x1 + 0.5, P.y0 - 0.5}, kMuted);
   F.cv.line({P.x0 - 0.5, P.y1 + 0.5}, {P.x1 + 0.5, P.y1 + 0.5}, kMuted);
   F.cv.line({P.x0 - 0.5, P.y0 - 0.5}, {P.x0 - 0.5, P.y1 + 0.5}, kMuted);
   F.cv.line({P.x1 + 0.5, P.y0 - 0.5}, {P.x1 + 0.5, P.y1 + 0.5}, kMuted);
-  F.cv.text(14, (P.y0 + P.y1) / 2, label, kInk, FontSize::Normal, Align::Centre, true);
+  const std::string& l = F.cv.text_width(label) + 8 <= P.y1 - P.y0 ? label : short_label;
+  F.cv.text(14, (P.y0 + P.y1) / 2, l, kInk, FontSize::Normal, Align::Centre, true);
 }
 
 // |Z|: the model after as a wide halo, the model before dashed, the measurement on top.
@@ -209,7 +226,7 @@ void magnitude_panel(const Frame& F, const std::vector<double>& f, const std::ve
   F.cv.polyline(points(f, z_before, ax, ay), kBefore, 1.8, 7.0);
   F.cv.polyline(points(f, meas, ax, ay), kMeasured, 1.4);
   F.cv.reset_clip();
-  frame_and_label(F, P, "|Z| (ohm)");
+  frame_and_label(F, P, "|Z| (ohm)", "|Z|");
 }
 
 double quantile(std::vector<double> v, double q) {
@@ -227,7 +244,8 @@ double quantile(std::vector<double> v, double q) {
 // the frame (the σ band shows why), and a note says so.
 void residual_panel(const Frame& F, const PixelRect& P, const std::vector<double>& f,
                     const std::vector<double>& before, const std::vector<double>& after,
-                    const std::vector<double>& sigma, const std::string& label, const char* unit) {
+                    const std::vector<double>& sigma, const std::string& label,
+                    const std::string& short_label, const char* unit) {
   std::vector<double> sig;
   for (double s : sigma)
     if (std::isfinite(s)) sig.push_back(s);
@@ -262,7 +280,7 @@ void residual_panel(const Frame& F, const PixelRect& P, const std::vector<double
   if (clipped)
     halo_text(F.cv, P.x1 - 6, P.y0 + 4, fmt("clipped at \u00b1%.3g ", lim) + unit, Align::Right,
               false);
-  frame_and_label(F, P, label);
+  frame_and_label(F, P, label, short_label);
 }
 
 // Region names at the top of the |Z| panel, on a white halo (they may cross a
@@ -292,10 +310,12 @@ void region_names(const Frame& F, const std::vector<Band>& bands) {
     xs[k] = std::min(xs[k], P.x1 - lh - 2);
     if (k + 1 < xs.size() && !flat[k + 1]) xs[k] = std::min(xs[k], xs[k + 1] - lh - 1);
   }
+  F.cv.set_clip(P.x0, P.y0, P.x1, P.y1);  // a long name on a short panel is cut, not spilled
   for (std::size_t k = 0; k < bands.size(); ++k) {
     const double y = flat[k] ? P.y0 + 6 : P.y0 + 6 + F.cv.text_width(names[k]);
     halo_text(F.cv, xs[k], y, names[k], flat[k] ? Align::Centre : Align::Left, !flat[k]);
   }
+  F.cv.reset_clip();
 }
 
 // Bottom left of the |Z| panel, below the capacitive line (|Z| falls from the top left).
@@ -356,9 +376,9 @@ PngCanvas render_diagnosis_plot(const update::GapDiagnosis& d, const DiagnosisPl
   frequency_grid(F);
   magnitude_panel(F, f, d.before.measured_abs_ohm, model_abs(d.before), model_abs(after));
   residual_panel(F, F.L.db, f, d.before.residual_db, after.residual_db, d.before.sigma_db,
-                 "residual |Z| (dB)", "dB");
+                 "residual |Z| (dB)", "resid. dB", "dB");
   residual_panel(F, F.L.deg, f, d.before.residual_deg, after.residual_deg, d.before.sigma_deg,
-                 "residual phase (deg)", "deg");
+                 "residual phase (deg)", "resid. deg", "deg");
   region_names(F, bands);
   legend(F, d);
 
@@ -371,10 +391,10 @@ PngCanvas render_diagnosis_plot(const update::GapDiagnosis& d, const DiagnosisPl
   cv.text(16, y, title, kInk, ts);
   y += cv.line_height(ts) + 6;
   if (!opt.subtitle.empty()) {
-    cv.text(16, y, opt.subtitle, kInk);
+    cv.text(16, y, fit_width(cv, opt.subtitle, opt.width - 32), kInk);
     y += cv.line_height() + 3;
   }
-  cv.text(16, y, verdict_line(d), kMuted);
+  cv.text(16, y, fit_width(cv, verdict_line(d), opt.width - 32), kMuted);
   return cv;
 }
 
