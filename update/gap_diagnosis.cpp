@@ -35,6 +35,7 @@ GapCurve curve_of(const GapModel& m, const GapData& d, const std::vector<double>
     c.residual_deg.push_back(deg * l.imag());
     c.sigma_db.push_back(db * d.sigma_log_mag[i]);
     c.sigma_deg.push_back(deg * d.sigma_phase[i]);
+    c.measured_abs_ohm.push_back(std::abs(d.z_ohm[i]));
   }
   return c;
 }

@@ -61,6 +61,7 @@ struct MeasuredEffect {
 
 struct GapCurve {  // misfit ln(Z_meas/Z_model) for plots
   std::vector<double> f_hz, residual_db, residual_deg, sigma_db, sigma_deg;
+  std::vector<double> measured_abs_ohm;  // |Z_meas|; the model's |Z| is |Z_meas|·10^(−residual_db/20)
 };
 
 struct GapDiagnosis {
