@@ -4,6 +4,8 @@
 #include <cmath>
 #include <cstdio>
 
+#include "ui/gui/palette.hpp"
+
 namespace piezo::gui {
 
 namespace {
@@ -123,7 +125,7 @@ bool plot(const char* id, const PlotSpec& spec, PlotView& view, ImVec2 size) {
   view.y1 = inv(Y1, view.log_y);
 
   // Frame, grid, ticks.
-  dl->AddRectFilled(a, b, IM_COL32(20, 22, 28, 255));
+  dl->AddRectFilled(a, b, kColPlotBg);
   const ImU32 grid = IM_COL32(70, 75, 90, 255), text = IM_COL32(200, 200, 210, 255);
   for (double t : ticks(X0, X1, view.log_x)) {
     float x = a.x + static_cast<float>((t - X0) / (X1 - X0)) * (b.x - a.x);
@@ -135,7 +137,10 @@ bool plot(const char* id, const PlotSpec& spec, PlotView& view, ImVec2 size) {
     dl->AddLine(ImVec2(a.x, y), ImVec2(b.x, y), grid);
     dl->AddText(ImVec2(p0.x + 2, y - 7), text, fmt(inv(t, view.log_y)).c_str());
   }
-  dl->AddText(ImVec2(a.x, p0.y + 2), text, spec.title.c_str());
+  // Title centred over the frame, the y label at the top left (they overlap
+  // when both sit at the left edge and the y label is long).
+  const float title_w = ImGui::CalcTextSize(spec.title.c_str()).x;
+  dl->AddText(ImVec2(0.5f * (a.x + b.x - title_w), p0.y + 2), text, spec.title.c_str());
   dl->AddText(ImVec2(b.x - ImGui::CalcTextSize(spec.x_label.c_str()).x, b.y + 18), text, spec.x_label.c_str());
   dl->AddText(ImVec2(p0.x + 2, p0.y + 2), text, spec.y_label.c_str());
 
@@ -143,7 +148,8 @@ bool plot(const char* id, const PlotSpec& spec, PlotView& view, ImVec2 size) {
   for (const auto& band : spec.bands) {
     float xa = sx(band.x0), xb = sx(band.x1);
     dl->AddRectFilled(ImVec2(xa, a.y), ImVec2(xb, b.y), band.color);
-    if (!band.label.empty()) dl->AddText(ImVec2(xa + 2, a.y + 2), text, band.label.c_str());
+    if (!band.label.empty() && ImGui::CalcTextSize(band.label.c_str()).x + 4 < xb - xa)
+      dl->AddText(ImVec2(xa + 2, b.y - 16), text, band.label.c_str());
   }
   for (const auto& m : spec.markers) {
     float x = sx(m.x);
@@ -167,6 +173,7 @@ bool plot(const char* id, const PlotSpec& spec, PlotView& view, ImVec2 size) {
   // Legend.
   float ly = a.y + 4;
   for (const auto& s : spec.series) {
+    if (!s.listed) continue;
     float w = ImGui::CalcTextSize(s.label.c_str()).x;
     dl->AddRectFilled(ImVec2(b.x - w - 28, ly + 3), ImVec2(b.x - w - 14, ly + 11), s.color);
     dl->AddText(ImVec2(b.x - w - 8, ly), text, s.label.c_str());
@@ -180,11 +187,17 @@ bool plot(const char* id, const PlotSpec& spec, PlotView& view, ImVec2 size) {
     ImGui::BeginTooltip();
     ImGui::Text("%s = %s", spec.x_label.c_str(), fmt(cx).c_str());
     for (const auto& s : spec.series) {
-      if (s.x.empty()) continue;
+      // The nearest sample in x, and only inside the series' own x range (a
+      // curve that ends at 120 kHz has no value to read at 200 kHz).
+      if (!s.listed || s.x.empty() || s.y.size() < s.x.size() || cx < s.x.front() || cx > s.x.back()) continue;
       auto it = std::lower_bound(s.x.begin(), s.x.end(), cx);
       std::size_t i = std::min<std::size_t>(static_cast<std::size_t>(it - s.x.begin()), s.x.size() - 1);
+      if (i > 0 && cx - s.x[i - 1] < s.x[i] - cx) --i;
       ImGui::TextColored(ImGui::ColorConvertU32ToFloat4(s.color), "%s: %s", s.label.c_str(), fmt(s.y[i]).c_str());
     }
+    for (const auto& band : spec.bands)
+      if (!band.detail.empty() && cx >= std::min(band.x0, band.x1) && cx <= std::max(band.x0, band.x1))
+        ImGui::TextUnformatted(band.detail.c_str());
     ImGui::EndTooltip();
   }
   ImGui::EndChild();

@@ -17,6 +17,7 @@ struct Series {
   ImU32 color = IM_COL32(255, 255, 255, 255);
   float thickness = 1.5f;
   bool points = false;  // draw markers instead of a line
+  bool listed = true;   // in the legend and the hover read-out (false: e.g. the lower half of a ±band)
 };
 
 struct Marker {
@@ -27,7 +28,8 @@ struct Marker {
 struct Band {
   double x0 = 0, x1 = 0;
   ImU32 color = IM_COL32(255, 255, 0, 40);
-  std::string label;
+  std::string label;   // drawn inside the band when it fits
+  std::string detail;  // added to the hover read-out while the cursor is in the band
 };
 
 struct PlotView {
