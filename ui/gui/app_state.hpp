@@ -75,7 +75,9 @@ struct AppState {
   std::optional<Problem> error;    // stopped the last job or export; shown with what to do
   std::vector<Problem> warnings;   // of the last result, with what to do
   std::vector<std::string> log;
-  PlotView mag_view{true, true}, phase_view{true, false}, sv_view{false, true}, residual_view{true, false};
+  // Log frequency for the impedance; linear for the residual, whose regions
+  // crowd around the resonances in the top octave.
+  PlotView mag_view{true, true}, phase_view{true, false}, sv_view{false, true}, residual_view{false, false};
   bool show_fft = false, show_xspec = false;
   bool residual_phase = false;  // the residual plot shows phase (deg) instead of |Z| (dB)
   DiagnosisShown diagnosis_shown;

@@ -12,39 +12,36 @@ namespace {
 void effects_table(const update::GapDiagnosis& d, DiagnosisShown& shown) {
   const ImGuiTableFlags flags = ImGuiTableFlags_Borders | ImGuiTableFlags_RowBg | ImGuiTableFlags_SizingFixedFit |
                                 ImGuiTableFlags_ScrollX;
-  if (!ImGui::BeginTable("effects", 5, flags)) return;
-  ImGui::TableSetupColumn("#");
-  ImGui::TableSetupColumn("effect");
-  ImGui::TableSetupColumn("fitted value");
+  if (!ImGui::BeginTable("effects", 4, flags)) return;
+  ImGui::TableSetupColumn("effect (ranked)");
+  ImGui::TableSetupColumn("value (sigma)");
   ImGui::TableSetupColumn("d chi2");
-  ImGui::TableSetupColumn("held-out shrink / alias");
+  ImGui::TableSetupColumn("shrink");
   ImGui::TableHeadersRow();
-  int rank = 0;
   for (const auto& e : d.effects) {
     const bool added = std::find(d.added.begin(), d.added.end(), e.name) != d.added.end();
     ImGui::TableNextRow();
     ImGui::TableNextColumn();
-    ImGui::Text("%d", ++rank);
-    ImGui::TableNextColumn();
     const ImVec4 colour = added ? ImVec4(0.5f, 1, 0.5f, 1)
                           : e.alias ? ImVec4(0.65f, 0.65f, 0.65f, 1)
                                     : ImGui::GetStyleColorVec4(ImGuiCol_Text);
-    ImGui::TextColored(colour, "%s%s", e.name.c_str(), added ? " (added)" : "");
+    ImGui::TextColored(colour, "%s", e.name.c_str());
     if (!e.note.empty() && ImGui::IsItemHovered()) ImGui::SetTooltip("%s", e.note.c_str());
     ImGui::TableNextColumn();
-    if (e.fitted) ImGui::Text("%.4g +/- %.2g %s", e.value, e.sigma, e.unit.c_str());
+    if (e.fitted) ImGui::Text("%.3g (%.2g) %s", e.value, e.sigma, e.unit.c_str());
     else ImGui::TextDisabled("-");
     ImGui::TableNextColumn();
     if (e.fitted) ImGui::Text("%.1f%s", e.delta_chi2, e.significant ? " *" : "");
     else ImGui::TextDisabled("-");
     ImGui::TableNextColumn();
     if (e.alias) {
-      ImGui::TextDisabled("alias (%.1f %% left)", 100 * e.alias_residual);
+      ImGui::TextDisabled("alias");
       if (ImGui::IsItemHovered())
         ImGui::SetTooltip(
-            "The constants mimic this effect: a typical %.3g %s would read as\nYE11 %+.2f %%, nu12 %+.2f %%, "
-            "d31 %+.2f %%, epsT33 %+.2f %%.\nCalibrate the fixture to measure it.",
-            e.typical, e.unit.c_str(), e.bias_y_e11_pct, e.bias_nu12_pct, e.bias_d31_pct, e.bias_eps_t33_pct);
+            "The constants mimic this effect (%.1f %% of its signature is left): a typical %.3g %s\n"
+            "would read as YE11 %+.2f %%, nu12 %+.2f %%, d31 %+.2f %%, epsT33 %+.2f %%.\n"
+            "Calibrate the fixture to measure it.",
+            100 * e.alias_residual, e.typical, e.unit.c_str(), e.bias_y_e11_pct, e.bias_nu12_pct, e.bias_d31_pct, e.bias_eps_t33_pct);
     } else if (e.heldout_shrink) {
       ImGui::Text("%.0f %%", 100 * *e.heldout_shrink);
     } else {
@@ -53,6 +50,7 @@ void effects_table(const update::GapDiagnosis& d, DiagnosisShown& shown) {
     ++shown.effects;
   }
   ImGui::EndTable();
+  ImGui::TextDisabled("green: added to the model; grey: alias (hover); * significant");
 }
 
 void regions_table(const update::GapDiagnosis& d, DiagnosisShown& shown) {
@@ -101,15 +99,11 @@ void render_diagnosis_window(AppState& s) {
   ImGui::TextWrapped("%s", d.verdict.c_str());
   ImGui::PopStyleColor();
   s.diagnosis_shown.verdict = d.verdict;
-  ImGui::Text("misfit chi2/dof %.2f on the fit data", d.gap_fit);
-  if (d.gap_heldout) {
-    ImGui::SameLine(0, 0);
-    ImGui::Text(", %.2f held out", *d.gap_heldout);
-  }
-  ImGui::SameLine(0, 0);
-  ImGui::TextDisabled("  (1 = at the noise)");
+  if (d.gap_heldout) ImGui::Text("misfit chi2/dof %.2f on the fit data, %.2f held out", d.gap_fit, *d.gap_heldout);
+  else ImGui::Text("misfit chi2/dof %.2f on the fit data", d.gap_fit);
   if (ImGui::IsItemHovered())
-    ImGui::SetTooltip("%s\n%s", d.fit_description.c_str(), d.heldout_description.c_str());
+    ImGui::SetTooltip("1 = at the noise of the repeated shots.\n%s\n%s", d.fit_description.c_str(),
+                      d.heldout_description.c_str());
   if (ImGui::BeginTabBar("diag")) {
     if (ImGui::BeginTabItem("Effects")) {
       effects_table(d, s.diagnosis_shown);

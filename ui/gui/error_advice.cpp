@@ -16,13 +16,15 @@ bool starts_with(const std::string& s, const char* prefix) { return s.rfind(pref
 const char* kind_name(ErrorKind k) {
   switch (k) {
     case ErrorKind::Connection:
-      return "connection";
+      return "connection error";
     case ErrorKind::Instrument:
-      return "instrument";
+      return "instrument error";
     case ErrorKind::File:
-      return "file";
+      return "file error";
     case ErrorKind::Input:
-      return "input";
+      return "input error";
+    case ErrorKind::Attention:
+      return "attention";
     case ErrorKind::Other:
       break;
   }
@@ -77,6 +79,7 @@ std::string advice_for(ErrorKind kind, const std::string& stage) {
         return "Write effects as NAME=VALUE separated by commas, e.g. series_resistance=15.";
       return "Correct the value named above in the plan and run again.";
     case ErrorKind::Other:
+    case ErrorKind::Attention:
       break;
   }
   if (starts_with(stage, "estimate"))
@@ -94,18 +97,18 @@ std::vector<Problem> result_problems(const ui::PipelineResult& r) {
   std::vector<Problem> out;
   for (const auto& st : r.stages) {
     if (st.name == "update" && !st.ran)
-      out.push_back({ErrorKind::Other, "update", st.note,
+      out.push_back({ErrorKind::Attention, "update", st.note,
                      "The model update did not converge. Check the geometry, the nominal "
                      "material and R1; more shots lower the noise on the features; a tube far "
                      "from the nominal material may need the transversely isotropic class."});
     if (st.name == "diagnose" && !st.ran && starts_with(st.note, "failed"))
-      out.push_back({ErrorKind::Other, "diagnose", st.note,
+      out.push_back({ErrorKind::Attention, "diagnose", st.note,
                      "The update above stands. The diagnosis needs at least 3 repeated shots "
                      "of one drive (6 or more to hold some out): raise Shots and run again."});
   }
   for (const auto& w : r.warnings)
     if (starts_with(w, "cancelled"))
-      out.push_back({ErrorKind::Other, "acquire", w,
+      out.push_back({ErrorKind::Attention, "acquire", w,
                      "The shots acquired before Cancel are in the capture; replay it or measure again."});
   return out;
 }

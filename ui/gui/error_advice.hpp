@@ -15,7 +15,8 @@ enum class ErrorKind {
   Instrument,  // the instrument refused a command or answered nonsense (drivers::InstrumentError)
   File,        // a capture that cannot be read (acq::CaptureError)
   Input,       // a bad value in a form or an address (std::invalid_argument)
-  Other,
+  Other,       // any other exception
+  Attention,   // not an error: a run that finished but needs action (result_problems)
 };
 
 struct Problem {
@@ -36,6 +37,7 @@ std::string advice_for(ErrorKind kind, const std::string& stage);
 // a cancelled acquisition), each with what to do.
 std::vector<Problem> result_problems(const ui::PipelineResult& r);
 
+// "connection error", ..., "attention": the heading a window shows.
 const char* kind_name(ErrorKind k);
 
 }  // namespace piezo::gui

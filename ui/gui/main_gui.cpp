@@ -32,7 +32,7 @@ void glfw_error(int code, const char* msg) { std::fprintf(stderr, "piezobench-gu
 // right, results and diagnosis side by side below the plots.
 void render_windows(AppState& s, int w, int h) {
   const float left = 380.0f, W = static_cast<float>(w), H = static_cast<float>(h);
-  const float plan_h = H * 0.64f, plots_h = H * 0.58f, half = 0.5f * (W - left);
+  const float plan_h = H * 0.64f, plots_h = H * 0.58f, results_w = 0.465f * (W - left);
   auto place = [](float x, float y, float width, float height) {
     ImGui::SetNextWindowPos(ImVec2(x, y), ImGuiCond_FirstUseEver);
     ImGui::SetNextWindowSize(ImVec2(width, height), ImGuiCond_FirstUseEver);
@@ -43,9 +43,9 @@ void render_windows(AppState& s, int w, int h) {
   render_instrument_window(s);
   place(left, 0, W - left, plots_h);
   render_plots_window(s);
-  place(left, plots_h, half, H - plots_h);
+  place(left, plots_h, results_w, H - plots_h);
   render_results_window(s);
-  place(left + half, plots_h, W - left - half, H - plots_h);
+  place(left + results_w, plots_h, W - left - results_w, H - plots_h);
   render_diagnosis_window(s);
 }
 

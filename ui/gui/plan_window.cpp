@@ -59,7 +59,7 @@ void render_plan_window(AppState& s) {
   if (!busy) {
     ImGui::BeginDisabled(connecting);
     if (tracked_button(s, "Measure and update", ImVec2(-1, 48))) start_job(s, false);
-    ImGui::Text("Or open a recorded capture and run it through the same steps:");
+    ImGui::TextWrapped("Or open a recorded capture and run it through the same steps:");
     ImGui::SetNextItemWidth(ImGui::GetContentRegionAvail().x - 130);
     ImGui::InputTextWithHint("##replay", "capture.h5", s.replay_path, sizeof s.replay_path);
     ImGui::SameLine();
@@ -70,8 +70,13 @@ void render_plan_window(AppState& s) {
     if (tracked_button(s, "Cancel", ImVec2(-1, 0))) s.job.cancel();
     if (s.job.cancel_requested()) ImGui::TextDisabled("cancelling after the current step...");
   }
-  if (s.error) show_problem(*s.error);
-  for (const auto& w : s.warnings) show_problem(w);
+  if (s.error || !s.warnings.empty())
+  {
+    ImGui::PushStyleColor(ImGuiCol_Text, ImVec4(1, 0.45f, 0.45f, 1));
+    ImGui::TextWrapped("%s: see Results for what to do.",
+                       s.error ? "The last run failed" : "The last run needs attention");
+    ImGui::PopStyleColor();
+  }
   ImGui::End();
 }
 

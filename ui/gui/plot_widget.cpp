@@ -127,16 +127,44 @@ bool plot(const char* id, const PlotSpec& spec, PlotView& view, ImVec2 size) {
   // Frame, grid, ticks.
   dl->AddRectFilled(a, b, kColPlotBg);
   const ImU32 grid = IM_COL32(70, 75, 90, 255), text = IM_COL32(200, 200, 210, 255);
-  for (double t : ticks(X0, X1, view.log_x)) {
+  // Tick labels that would overlap are left out; on a log axis the decades
+  // are labelled first, the 2…9 multiples only where there is room.
+  std::vector<std::pair<float, float>> taken;  // occupied label extents along the axis
+  auto place_label = [&](float centre, float extent, float gap) {
+    const float lo = centre - 0.5f * extent - gap, hi = centre + 0.5f * extent + gap;
+    for (const auto& [l, h] : taken)
+      if (lo < h && hi > l) return false;
+    taken.emplace_back(lo, hi);
+    return true;
+  };
+  auto is_decade = [](double t) { return std::fabs(t - std::round(t)) < 1e-9; };
+  const auto xt = ticks(X0, X1, view.log_x), yt = ticks(Y0, Y1, view.log_y);
+  for (double t : xt) {
     float x = a.x + static_cast<float>((t - X0) / (X1 - X0)) * (b.x - a.x);
     dl->AddLine(ImVec2(x, a.y), ImVec2(x, b.y), grid);
-    dl->AddText(ImVec2(x - 14, b.y + 4), text, fmt(inv(t, view.log_x)).c_str());
   }
-  for (double t : ticks(Y0, Y1, view.log_y)) {
+  for (int pass = 0; pass < 2; ++pass)
+    for (double t : xt) {
+      if (view.log_x && (pass == 0) != is_decade(t)) continue;
+      if (!view.log_x && pass == 1) continue;
+      const float x = a.x + static_cast<float>((t - X0) / (X1 - X0)) * (b.x - a.x);
+      const std::string label = fmt(inv(t, view.log_x));
+      const float w = ImGui::CalcTextSize(label.c_str()).x;
+      if (place_label(x, w, 4)) dl->AddText(ImVec2(x - 0.5f * w, b.y + 4), text, label.c_str());
+    }
+  taken.clear();
+  for (double t : yt) {
     float y = b.y - static_cast<float>((t - Y0) / (Y1 - Y0)) * (b.y - a.y);
     dl->AddLine(ImVec2(a.x, y), ImVec2(b.x, y), grid);
-    dl->AddText(ImVec2(p0.x + 2, y - 7), text, fmt(inv(t, view.log_y)).c_str());
   }
+  for (int pass = 0; pass < 2; ++pass)
+    for (double t : yt) {
+      if (view.log_y && (pass == 0) != is_decade(t)) continue;
+      if (!view.log_y && pass == 1) continue;
+      const float y = b.y - static_cast<float>((t - Y0) / (Y1 - Y0)) * (b.y - a.y);
+      if (place_label(y, ImGui::GetTextLineHeight(), 1))
+        dl->AddText(ImVec2(p0.x + 2, y - 7), text, fmt(inv(t, view.log_y)).c_str());
+    }
   // Title centred over the frame, the y label at the top left (they overlap
   // when both sit at the left edge and the y label is long).
   const float title_w = ImGui::CalcTextSize(spec.title.c_str()).x;
@@ -170,8 +198,17 @@ bool plot(const char* id, const PlotSpec& spec, PlotView& view, ImVec2 size) {
   }
   dl->PopClipRect();
 
-  // Legend.
-  float ly = a.y + 4;
+  // Legend, on a translucent backing so that it stays readable over curves.
+  float ly = a.y + 4, legend_w = 0;
+  int listed = 0;
+  for (const auto& s : spec.series)
+    if (s.listed) {
+      legend_w = std::max(legend_w, ImGui::CalcTextSize(s.label.c_str()).x);
+      ++listed;
+    }
+  if (listed > 0)
+    dl->AddRectFilled(ImVec2(b.x - legend_w - 32, ly - 2), ImVec2(b.x - 2, ly + 16.0f * listed + 2),
+                      (kColPlotBg & ~IM_COL32_A_MASK) | IM_COL32(0, 0, 0, 200));
   for (const auto& s : spec.series) {
     if (!s.listed) continue;
     float w = ImGui::CalcTextSize(s.label.c_str()).x;

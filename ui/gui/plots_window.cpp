@@ -60,17 +60,17 @@ void render_plots_window(AppState& s) {
     s.mag_view.fitted = s.phase_view.fitted = s.sv_view.fitted = s.residual_view.fitted = false;
   PlotSpec mag{"|Z|", "f [Hz]", "ohm", {}, {}, {}}, ph{"phase", "f [Hz]", "deg", {}, {}, {}};
   impedance_specs(s, mag, ph);
-  PlotSpec res{"gap: residual (no diagnosis)", "f [Hz]", "dB", {}, {}, {}};
+  PlotSpec res{"gap: residual (no diagnosis)", "f [kHz]", "dB", {}, {}, {}};
   if (s.result && s.result->diagnosis) res = residual_plot_spec(*s.result->diagnosis, s.residual_phase);
-  PlotSpec sv{"Hankel singular values", "index", "sigma/sigma1", {}, {}, {}};
+  PlotSpec sv{"Hankel SVs", "index", "s_k/s_1", {}, {}, {}};
   if (s.result && !s.result->singular_values.empty()) {
-    Series pts{"normalised", {}, s.result->singular_values, kColMeasured, 1.0f, true};
+    sv.title = "Hankel SVs (order " + std::to_string(s.result->order) + ")";
+    Series pts{"s_k/s_1", {}, s.result->singular_values, kColMeasured, 1.0f, true};
     for (std::size_t i = 0; i < pts.y.size(); ++i) pts.x.push_back(static_cast<double>(i + 1));
     sv.series.push_back(std::move(pts));
     sv.markers.push_back({s.result->order + 0.5, IM_COL32(255, 80, 80, 200)});
-    char order[40];
-    std::snprintf(order, sizeof order, "order %d", s.result->order);
-    sv.bands.push_back({0.5, s.result->order + 0.5, IM_COL32(255, 80, 80, 30), "", order});
+    sv.bands.push_back({0.5, s.result->order + 0.5, IM_COL32(255, 80, 80, 30), "",
+                        "kept by Prony-SS (order " + std::to_string(s.result->order) + ")"});
   }
 
   // |Z| across the full width; below it the residual, the phase and the
@@ -81,7 +81,7 @@ void render_plots_window(AppState& s) {
   plot("mag", mag, s.mag_view, ImVec2(avail.x, avail.y - row2 - ImGui::GetStyle().ItemSpacing.y));
   plot("residual", res, s.residual_view, ImVec2(avail.x * 0.42f, row2));
   ImGui::SameLine();
-  plot("phase", ph, s.phase_view, ImVec2(avail.x * 0.34f - gap, row2));
+  plot("phase", ph, s.phase_view, ImVec2(avail.x * 0.30f - gap, row2));
   ImGui::SameLine();
   plot("sv", sv, s.sv_view, ImVec2(0, row2));
   ImGui::End();

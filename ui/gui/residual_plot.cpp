@@ -30,21 +30,28 @@ std::string region_detail(const update::GapRegion& g) {
   return buf;
 }
 
+std::vector<double> khz(const std::vector<double>& f_hz) {
+  std::vector<double> v;
+  v.reserve(f_hz.size());
+  for (double f : f_hz) v.push_back(f / 1e3);
+  return v;
+}
+
 Series residual_series(const std::string& label, const update::GapCurve& c, bool phase, ImU32 colour,
                        float width) {
-  return {label, c.f_hz, phase ? c.residual_deg : c.residual_db, colour, width, false};
+  return {label, khz(c.f_hz), phase ? c.residual_deg : c.residual_db, colour, width, false};
 }
 }  // namespace
 
 PlotSpec residual_plot_spec(const update::GapDiagnosis& d, bool phase) {
-  PlotSpec spec{phase ? "gap: residual phase" : "gap: residual |Z|", "f [Hz]", phase ? "deg" : "dB", {}, {}, {}};
+  PlotSpec spec{phase ? "gap: residual phase" : "gap: residual |Z|", "f [kHz]", phase ? "deg" : "dB", {}, {}, {}};
   for (const auto& g : d.regions) {
     if (g.points == 0) continue;
-    spec.bands.push_back({g.f_lo_hz, g.f_hi_hz, region_colour(g.kind), short_kind(g.kind), region_detail(g)});
+    spec.bands.push_back({g.f_lo_hz / 1e3, g.f_hi_hz / 1e3, region_colour(g.kind), short_kind(g.kind), region_detail(g)});
   }
   // The noise first and thin, the residuals on top.
   const auto& sig = phase ? d.before.sigma_deg : d.before.sigma_db;
-  Series hi{"+/-2 sigma (noise)", d.before.f_hz, {}, kColNoiseBand, 1.0f, false}, lo = hi;
+  Series hi{"+/-2 sigma (noise)", khz(d.before.f_hz), {}, kColNoiseBand, 1.0f, false}, lo = hi;
   lo.listed = false;
   for (double v : sig) {
     hi.y.push_back(2 * v);

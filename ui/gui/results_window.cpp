@@ -1,5 +1,5 @@
-// Results: original vs updated parameters with the change in %, the stages
-// that ran, the exports (CSV, Touchstone, JSON report, PNG of the window) and
+// Results: the error that stopped the last run (with what to do), original
+// vs updated parameters with the change in %, the stages that ran, the exports (CSV, Touchstone, JSON report, PNG of the window) and
 // the log. The gap verdict and effect ranking are in the diagnosis window.
 #include "ui/gui/windows.hpp"
 
@@ -36,27 +36,33 @@ void parameter_table(const ui::PipelineResult& r) {
 
 void render_results_window(AppState& s) {
   ImGui::Begin("Results");
-  if (!s.result) {
+  // What stopped the last run, or needs the technician's action, comes first.
+  if (s.error) show_problem(*s.error);
+  for (const auto& w : s.warnings) show_problem(w);
+  if (!s.result && !s.error) {
     ImGui::TextWrapped("No result yet. Set the plan and press 'Measure and update', or replay a capture.");
-  } else {
+  } else if (s.result) {
     const auto& r = *s.result;
     ImGui::TextWrapped("Capture: %s (%d shots)", r.capture_path.c_str(), r.shots);
     if (r.params.empty()) ImGui::TextDisabled("No updated parameters (see the stages below).");
     else parameter_table(r);
-    ImGui::SetNextItemWidth(150);
-    ImGui::InputText("##export", s.export_base, sizeof s.export_base);
-    if (ImGui::IsItemHovered()) ImGui::SetTooltip("File name without extension for the exports");
-    ImGui::SameLine();
-    if (tracked_button(s, "CSV")) export_result(s, ExportFormat::Csv);
-    ImGui::SameLine();
-    if (tracked_button(s, "Touchstone")) export_result(s, ExportFormat::Touchstone);
-    ImGui::SameLine();
-    if (tracked_button(s, "JSON")) export_result(s, ExportFormat::Json);
-    ImGui::SameLine();
-    if (tracked_button(s, "PNG")) s.png_request = std::string(s.export_base) + ".png";
+    if (!r.curves.empty()) {  // the exports need at least the impedance estimate
+      ImGui::SetNextItemWidth(150);
+      ImGui::InputText("##export", s.export_base, sizeof s.export_base);
+      if (ImGui::IsItemHovered()) ImGui::SetTooltip("File name without extension for the exports");
+      ImGui::SameLine();
+      if (tracked_button(s, "CSV")) export_result(s, ExportFormat::Csv);
+      ImGui::SameLine();
+      if (tracked_button(s, "Touchstone")) export_result(s, ExportFormat::Touchstone);
+      ImGui::SameLine();
+      if (tracked_button(s, "JSON")) export_result(s, ExportFormat::Json);
+      ImGui::SameLine();
+      if (tracked_button(s, "PNG")) s.png_request = std::string(s.export_base) + ".png";
+    }
     for (const auto& st : r.stages)
       ImGui::TextColored(st.ran ? ImVec4(0.5f, 1, 0.5f, 1) : ImVec4(0.7f, 0.7f, 0.7f, 1), "%s %s: %s",
                          st.ran ? "[ran]" : "[skipped]", st.name.c_str(), st.note.c_str());
+    for (const auto& w : r.warnings) ImGui::TextColored(ImVec4(1, 0.8f, 0.3f, 1), "warning: %s", w.c_str());
   }
   ImGui::BeginChild("log", ImVec2(0, 0), true, ImGuiWindowFlags_HorizontalScrollbar);
   for (const auto& l : s.log) ImGui::TextUnformatted(l.c_str());
