@@ -61,9 +61,9 @@ void start_job(AppState& s, bool replay) {
       return;
     }
   }
-  s.frame_ms_during_job.clear();
   if (!s.job.start(req)) return;
   ++s.jobs_started;
+  s.frame_ms_jobs.emplace_back();
   if (!replay) s.instrument.state = InstrumentForm::State::Connecting;
   s.log.push_back(replay ? "replay of " + req.replay_capture + " started"
                          : "measure and update started on " + req.instrument);

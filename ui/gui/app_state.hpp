@@ -85,7 +85,9 @@ struct AppState {
   std::map<std::string, ImVec4> button_rects;
   char export_base[256] = "piezobench-report";
   std::string png_request;  // set by the PNG button, read back by the frame loop after rendering
-  std::vector<double> frame_ms_during_job, frame_ms_idle;
+  // Frame times (ms): one list per job started, of the frames while it ran; and the others.
+  std::vector<std::vector<double>> frame_ms_jobs;
+  std::vector<double> frame_ms_idle;
   TaskQueue tasks;  // last: its thread stops before the state its outcomes write to goes away
 };
 

@@ -80,6 +80,7 @@ bool plot(const char* id, const PlotSpec& spec, PlotView& view, ImVec2 size) {
   const ImVec2 avail = ImGui::GetContentRegionAvail();
   const float left = 64, bottom = 36, top = 22, right = 10;
   const ImVec2 a(p0.x + left, p0.y + top), b(p0.x + avail.x - right, p0.y + avail.y - bottom);
+  view.frame = ImVec4(a.x, a.y, b.x, b.y);
   ImGui::InvisibleButton("canvas", avail);
   const bool hovered = ImGui::IsItemHovered();
   const ImGuiIO& io = ImGui::GetIO();

@@ -36,6 +36,7 @@ struct PlotView {
   bool log_x = true, log_y = false;
   double x0 = 1, x1 = 10, y0 = 0, y1 = 1;  // visible range (data units)
   bool fitted = false;  // fit to data on the next draw
+  ImVec4 frame{0, 0, 0, 0};  // where plot() drew the data area last (x0, y0, x1, y1; screen pixels)
 };
 
 struct PlotSpec {
