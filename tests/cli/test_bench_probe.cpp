@@ -27,8 +27,10 @@ constexpr double kR1 = 3140.0;
 struct TcpBench {
   TcpBench() {
     auto bench = acq::make_sim_bench(acq::SimSpec{}, kR1);
-    awg = std::make_unique<drivers::sim::TcpServer>(std::make_shared<drivers::sim::SimAwg>(bench), "127.0.0.1", 0);
-    daq = std::make_unique<drivers::sim::TcpServer>(std::make_shared<drivers::sim::SimDaq>(bench), "127.0.0.1", 0);
+    awg = std::make_unique<drivers::sim::TcpServer>(std::make_shared<drivers::sim::SimAwg>(bench),
+                                                    "127.0.0.1", 0);
+    daq = std::make_unique<drivers::sim::TcpServer>(std::make_shared<drivers::sim::SimDaq>(bench),
+                                                    "127.0.0.1", 0);
     awg->start();
     daq->start();
   }
@@ -85,5 +87,6 @@ TEST(BenchProbeErrors, NobodyAtTheAddressIsATransportError) {
 TEST(BenchProbeErrors, BadAddressesAreInvalidArguments) {
   EXPECT_THROW(ui::probe_bench("gpib://3", "", acq::SimSpec{}, kR1), std::invalid_argument);
   // A USB bench cannot guess the DAQ's address.
-  EXPECT_THROW(ui::probe_bench("usbtmc://0957:1607", "", acq::SimSpec{}, kR1), std::invalid_argument);
+  EXPECT_THROW(ui::probe_bench("usbtmc://0957:1607", "", acq::SimSpec{}, kR1),
+               std::invalid_argument);
 }

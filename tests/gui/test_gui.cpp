@@ -51,9 +51,9 @@ GuiRun run_gui(const std::string& name, const std::string& args) {
   // dlopen'ed llvmpipe driver never frees (frames in "<unknown module>");
   // leak checks of our own code run in every other test, so they are off for
   // this process only (ASan's other checks stay on).
-  const std::string cmd = "cd '" + r.dir.string() +
-                          "' && ASAN_OPTIONS=detect_leaks=0 xvfb-run -a -f '" + (r.dir / "Xauthority").string() +
-                          "' -s '-screen 0 1280x800x24' sh run.sh > gui.log 2>&1";
+  const std::string cmd =
+      "cd '" + r.dir.string() + "' && ASAN_OPTIONS=detect_leaks=0 xvfb-run -a -f '" +
+      (r.dir / "Xauthority").string() + "' -s '-screen 0 1280x800x24' sh run.sh > gui.log 2>&1";
   (void)std::system(cmd.c_str());
   std::ifstream rc(r.dir / "gui.rc");
   rc >> r.exit_code;
@@ -93,7 +93,8 @@ int count_colour(const Image& img, const nlohmann::json& rect, Rgb c, int tol = 
   for (int y = y0; y < y1; ++y)
     for (int x = x0; x < x1; ++x) {
       const unsigned char* p = &img.px[4 * (static_cast<std::size_t>(y) * img.w + x)];
-      if (std::abs(p[0] - c.r) < tol && std::abs(p[1] - c.g) < tol && std::abs(p[2] - c.b) < tol) ++n;
+      if (std::abs(p[0] - c.r) < tol && std::abs(p[1] - c.g) < tol && std::abs(p[2] - c.b) < tol)
+        ++n;
     }
   return n;
 }
@@ -101,9 +102,10 @@ int count_colour(const Image& img, const nlohmann::json& rect, Rgb c, int tol = 
 void print_frame_times(const nlohmann::json& stats) {
   int k = 0;
   for (const auto& j : stats["jobs"])
-    std::printf("frame time during job %d: median %.2f ms, p95 %.2f ms, max %.2f ms over %d frames\n", ++k,
-                j["median_ms"].get<double>(), j["p95_ms"].get<double>(), j["max_ms"].get<double>(),
-                j["frames"].get<int>());
+    std::printf(
+        "frame time during job %d: median %.2f ms, p95 %.2f ms, max %.2f ms over %d frames\n", ++k,
+        j["median_ms"].get<double>(), j["p95_ms"].get<double>(), j["max_ms"].get<double>(),
+        j["frames"].get<int>());
 }
 
 // A loopback port with nobody listening: bound, then released.
@@ -130,8 +132,10 @@ constexpr int kConnected = 2, kReplay = 3, kError = 4;
 // drawn (the first runs over empty plots); the JSON report is exported in
 // between through its button.
 TEST(Gui, MeasureAndUpdateUnderXvfb) {
-  auto run = run_gui("measure", "--sim-effects series_resistance=15 --click 'Measure and update' --click JSON "
-                                "--click 'Measure and update' --hover 700,90 --wait-job --screenshot screenshot.png");
+  auto run =
+      run_gui("measure",
+              "--sim-effects series_resistance=15 --click 'Measure and update' --click JSON "
+              "--click 'Measure and update' --hover 700,90 --wait-job --screenshot screenshot.png");
   ASSERT_EQ(run.exit_code, 0) << "GUI run failed; see " << (run.dir / "gui.log");
   const auto& j = run.stats;
   ASSERT_TRUE(j.is_object()) << "no frame statistics";
@@ -149,7 +153,8 @@ TEST(Gui, MeasureAndUpdateUnderXvfb) {
   EXPECT_EQ(piezo::acq::read_capture(cap).shots.size(), 8u);
   // The parameter table holds updated values.
   ASSERT_EQ(j["params"].size(), 4u);
-  for (const auto& p : j["params"]) EXPECT_NE(p["updated"].get<double>(), p["original"].get<double>()) << p;
+  for (const auto& p : j["params"])
+    EXPECT_NE(p["updated"].get<double>(), p["original"].get<double>()) << p;
 
   // The diagnosis window showed the verdict and every ranked effect, and the
   // diagnosis added the series resistance the bench has.
@@ -186,12 +191,14 @@ TEST(Gui, MeasureAndUpdateUnderXvfb) {
   // the largest share of chi2 (composited over the plot background).
   const auto& res = j["plots"]["residual"];
   EXPECT_GT(count_colour(img, res, rgb_of(kColResidual)), 250) << "residual curve missing";
-  EXPECT_GT(count_colour(img, res, rgb_of(kColResidualAfter)), 250) << "residual with the effect missing";
+  EXPECT_GT(count_colour(img, res, rgb_of(kColResidualAfter)), 250)
+      << "residual with the effect missing";
   const auto& regions = d["regions"];
   ASSERT_FALSE(regions.empty());
-  const auto main_region = *std::max_element(regions.begin(), regions.end(), [](const auto& a, const auto& b) {
-    return a["share"].template get<double>() < b["share"].template get<double>();
-  });
+  const auto main_region =
+      *std::max_element(regions.begin(), regions.end(), [](const auto& a, const auto& b) {
+        return a["share"].template get<double>() < b["share"].template get<double>();
+      });
   const ImU32 shade = region_colour(main_region["kind"].get<std::string>());
   EXPECT_GT(count_colour(img, res, blend_over(shade, kColPlotBg), 12), 1500)
       << "shade of " << main_region["name"] << " (" << main_region["kind"] << ") missing";
@@ -205,12 +212,15 @@ TEST(Gui, ReplayOfARecordedCapture) {
   const fs::path dir = fs::temp_directory_path() / ("piezobench-gui-" + std::to_string(::getpid()));
   fs::create_directories(dir);
   const fs::path cap = dir / "recorded.h5";
-  const std::string measure = std::string("'") + PIEZO_CLI +
-                              "' measure --instrument sim --sim-isotropic "
-                              "--sim-set YE11=6.66e10,nu12=0.3333,d31=-210e-12,epsT33_rel=2294 --noise 0.005 "
-                              "--shots 8 --overwrite --out '" + cap.string() + "' > /dev/null 2>&1";
+  const std::string measure =
+      std::string("'") + PIEZO_CLI +
+      "' measure --instrument sim --sim-isotropic "
+      "--sim-set YE11=6.66e10,nu12=0.3333,d31=-210e-12,epsT33_rel=2294 --noise 0.005 "
+      "--shots 8 --overwrite --out '" +
+      cap.string() + "' > /dev/null 2>&1";
   ASSERT_EQ(std::system(measure.c_str()), 0);
-  auto run = run_gui("replay", "--replay '" + cap.string() + "' --click 'Replay capture' --wait-job");
+  auto run =
+      run_gui("replay", "--replay '" + cap.string() + "' --click 'Replay capture' --wait-job");
   ASSERT_EQ(run.exit_code, 0) << "GUI run failed; see " << (run.dir / "gui.log");
   const auto& j = run.stats;
   EXPECT_EQ(j["error"], "");
@@ -219,7 +229,8 @@ TEST(Gui, ReplayOfARecordedCapture) {
   ASSERT_EQ(j["params"].size(), 4u);
   const auto& ye11 = j["params"][0];
   ASSERT_EQ(ye11["name"], "YE11");
-  EXPECT_LT(std::abs(ye11["updated"].get<double>() - 6.66e10), std::abs(ye11["original"].get<double>() - 6.66e10));
+  EXPECT_LT(std::abs(ye11["updated"].get<double>() - 6.66e10),
+            std::abs(ye11["original"].get<double>() - 6.66e10));
   EXPECT_FALSE(j["verdict_shown"].get<std::string>().empty());
 }
 
@@ -227,11 +238,13 @@ TEST(Gui, ReplayOfARecordedCapture) {
 // (the run's error) with the problem's kind and advice in the statistics.
 TEST(Gui, ErrorsAreShownWithWhatToDo) {
   {
-    const fs::path dir = fs::temp_directory_path() / ("piezobench-gui-" + std::to_string(::getpid()));
+    const fs::path dir =
+        fs::temp_directory_path() / ("piezobench-gui-" + std::to_string(::getpid()));
     fs::create_directories(dir);
     const fs::path bad = dir / "not-a-capture.h5";
     std::ofstream(bad) << "this is not HDF5\n";
-    auto run = run_gui("bad-file", "--replay '" + bad.string() + "' --click 'Replay capture' --wait-job");
+    auto run =
+        run_gui("bad-file", "--replay '" + bad.string() + "' --click 'Replay capture' --wait-job");
     EXPECT_EQ(run.exit_code, 2) << "see " << (run.dir / "gui.log");
     EXPECT_EQ(run.stats["error_kind"], "file error");
     EXPECT_NE(run.stats["error"].get<std::string>().find("not-a-capture.h5"), std::string::npos);

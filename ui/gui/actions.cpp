@@ -91,7 +91,8 @@ bool collect_job(AppState& s) {
   }
   const auto& r = *s.result;
   s.log.push_back(cancelled ? "job cancelled" : "job finished");
-  for (const auto& st : r.stages) s.log.push_back((st.ran ? "  ran " : "  skipped ") + st.name + ": " + st.note);
+  for (const auto& st : r.stages)
+    s.log.push_back((st.ran ? "  ran " : "  skipped ") + st.name + ": " + st.note);
   for (const auto& w : r.warnings) s.log.push_back("  warning: " + w);
   s.warnings = result_problems(r);
   if (r.awg_idn.empty()) {
@@ -146,7 +147,9 @@ void connect_instruments(AppState& s) {
 void export_result(AppState& s, ExportFormat f) {
   if (!s.result) return;
   const std::string base = s.export_base;
-  const char* ext = f == ExportFormat::Csv ? ".csv" : f == ExportFormat::Touchstone ? ".s1p" : ".json";
+  const char* ext = f == ExportFormat::Csv          ? ".csv"
+                    : f == ExportFormat::Touchstone ? ".s1p"
+                                                    : ".json";
   const std::string path = base + ext;
   std::shared_ptr<const ui::PipelineResult> r = s.result;
   s.tasks.post("export " + path, [r, f, path]() -> TaskQueue::Apply {

@@ -50,7 +50,13 @@ struct InstrumentForm {
   // Bench effects the simulated bench adds (NAME=VALUE, comma separated), so
   // that the gap diagnosis has something to find; see model/effects.hpp.
   char sim_effects[256] = "";
-  enum class State { NotConnected, Connecting, Connected, Replay, Error } state = State::NotConnected;
+  enum class State {
+    NotConnected,
+    Connecting,
+    Connected,
+    Replay,
+    Error
+  } state = State::NotConnected;
   std::string idn_awg, idn_daq, description;
   std::optional<Problem> problem;  // the last connection or instrument error
 };
@@ -65,19 +71,20 @@ struct AppState {
   InstrumentForm instrument;
   ui::PipelineRequest request;  // the plan panel edits this; a job gets a copy
   char transducer_id[64] = "";  // recorded in the capture's set-up
-  int material_index = 0;        // into model::material_presets(): the nominal model to update
+  int material_index = 0;       // into model::material_presets(): the nominal model to update
   char capture_out[256] = "piezobench-capture.h5";
   char replay_path[256] = "";
   Job job;
   int jobs_started = 0;
   // Shared with background exports, so a new job can replace it while one runs.
   std::shared_ptr<const ui::PipelineResult> result;
-  std::optional<Problem> error;    // stopped the last job or export; shown with what to do
-  std::vector<Problem> warnings;   // of the last result, with what to do
+  std::optional<Problem> error;   // stopped the last job or export; shown with what to do
+  std::vector<Problem> warnings;  // of the last result, with what to do
   std::vector<std::string> log;
   // Log frequency for the impedance; linear for the residual, whose regions
   // crowd around the resonances in the top octave.
-  PlotView mag_view{true, true}, phase_view{true, false}, sv_view{false, true}, residual_view{false, false};
+  PlotView mag_view{true, true}, phase_view{true, false}, sv_view{false, true},
+      residual_view{false, false};
   bool show_fft = false, show_xspec = false;
   bool residual_phase = false;  // the residual plot shows phase (deg) instead of |Z| (dB)
   DiagnosisShown diagnosis_shown;

@@ -83,7 +83,8 @@ std::string advice_for(ErrorKind kind, const std::string& stage) {
       break;
   }
   if (starts_with(stage, "estimate"))
-    return "The record holds no usable transient: check the excitation (exp_decay, chirp or noise), "
+    return "The record holds no usable transient: check the excitation (exp_decay, chirp or "
+           "noise), "
            "the record length and that the DAQ is not clipping.";
   if (starts_with(stage, "update"))
     return "Check that the geometry and the nominal material match the tube and that R1 is right.";
@@ -108,8 +109,9 @@ std::vector<Problem> result_problems(const ui::PipelineResult& r) {
   }
   for (const auto& w : r.warnings)
     if (starts_with(w, "cancelled"))
-      out.push_back({ErrorKind::Attention, "acquire", w,
-                     "The shots acquired before Cancel are in the capture; replay it or measure again."});
+      out.push_back(
+          {ErrorKind::Attention, "acquire", w,
+           "The shots acquired before Cancel are in the capture; replay it or measure again."});
   return out;
 }
 

@@ -26,7 +26,9 @@
 using namespace piezo::gui;
 
 namespace {
-void glfw_error(int code, const char* msg) { std::fprintf(stderr, "piezobench-gui: GLFW error %d: %s\n", code, msg); }
+void glfw_error(int code, const char* msg) {
+  std::fprintf(stderr, "piezobench-gui: GLFW error %d: %s\n", code, msg);
+}
 
 // Windows in a fixed layout: plan and instruments on the left, plots on the
 // right, results and diagnosis side by side below the plots.
@@ -84,7 +86,9 @@ nlohmann::json frame_stats(const AppState& s, const TestScript& script) {
                       {"verdict_shown", s.diagnosis_shown.verdict},
                       {"effects_shown", s.diagnosis_shown.effects},
                       {"log", s.log}};
-  auto rect = [](const PlotView& v) { return nlohmann::json{v.frame.x, v.frame.y, v.frame.z, v.frame.w}; };
+  auto rect = [](const PlotView& v) {
+    return nlohmann::json{v.frame.x, v.frame.y, v.frame.z, v.frame.w};
+  };
   j["plots"] = {{"mag", rect(s.mag_view)},
                 {"phase", rect(s.phase_view)},
                 {"residual", rect(s.residual_view)},
@@ -93,12 +97,17 @@ nlohmann::json frame_stats(const AppState& s, const TestScript& script) {
     for (const auto& p : s.result->params)
       j["params"].push_back({{"name", p.name}, {"original", p.original}, {"updated", p.updated}});
     if (const auto& d = s.result->diagnosis) {
-      j["diagnosis"] = {{"verdict", d->verdict}, {"effects", d->effects.size()}, {"added", d->added},
+      j["diagnosis"] = {{"verdict", d->verdict},
+                        {"effects", d->effects.size()},
+                        {"added", d->added},
                         {"regions", nlohmann::json::array()}};
       for (const auto& g : d->regions)
         if (g.points > 0)
-          j["diagnosis"]["regions"].push_back(
-              {{"name", g.name}, {"kind", g.kind}, {"share", g.share}, {"f_lo_hz", g.f_lo_hz}, {"f_hi_hz", g.f_hi_hz}});
+          j["diagnosis"]["regions"].push_back({{"name", g.name},
+                                               {"kind", g.kind},
+                                               {"share", g.share},
+                                               {"f_lo_hz", g.f_lo_hz},
+                                               {"f_hi_hz", g.f_hi_hz}});
     }
   }
   return j;
@@ -113,16 +122,21 @@ int main(int argc, char** argv) {
   bool wait_job = false;
   double timeout_s = 0;
   int width = 1280, height = 800, shots = 8;
-  cli.add_option("--instrument", instrument, "AWG address: sim | tcp://HOST:PORT | usbtmc://VID:PID[/SERIAL]");
+  cli.add_option("--instrument", instrument,
+                 "AWG address: sim | tcp://HOST:PORT | usbtmc://VID:PID[/SERIAL]");
   cli.add_option("--daq", daq, "DAQ address (default: tcp PORT+1; required for usbtmc)");
-  cli.add_option("--sim-effects", sim_effects, "Effects of the simulated bench, NAME=VALUE[,NAME=VALUE...]");
+  cli.add_option("--sim-effects", sim_effects,
+                 "Effects of the simulated bench, NAME=VALUE[,NAME=VALUE...]");
   cli.add_option("--shots", shots, "Shots in the plan")->check(CLI::PositiveNumber);
   cli.add_option("--replay", replay, "Put this recorded capture in the plan panel for replay");
   cli.add_option("--click", clicks, "Test hook: click these buttons in order once drawn");
   cli.add_flag("--wait-job", wait_job, "Test hook: exit when the clicked work has finished");
-  cli.add_option("--hover", hover, "Test hook: rest the mouse at X Y after the clicks")->expected(2)->delimiter(',');
+  cli.add_option("--hover", hover, "Test hook: rest the mouse at X Y after the clicks")
+      ->expected(2)
+      ->delimiter(',');
   cli.add_option("--screenshot", screenshot, "Test hook: save a PNG of the window before exiting");
-  cli.add_option("--frame-stats", stats_file, "Test hook: write frame times and what was shown (JSON)");
+  cli.add_option("--frame-stats", stats_file,
+                 "Test hook: write frame times and what was shown (JSON)");
   cli.add_option("--timeout", timeout_s, "Exit with an error after this many seconds");
   cli.add_option("--width", width);
   cli.add_option("--height", height);
@@ -143,8 +157,10 @@ int main(int argc, char** argv) {
     return 1;
   }
   glfwMakeContextCurrent(win);
-  TestScript script(clicks, hover.size() == 2 ? std::optional(ImVec2(hover[0], hover[1])) : std::nullopt);
-  glfwSwapInterval(script.active() ? 0 : 1);  // tests measure the frame's work, not the wait for vsync
+  TestScript script(clicks,
+                    hover.size() == 2 ? std::optional(ImVec2(hover[0], hover[1])) : std::nullopt);
+  glfwSwapInterval(script.active() ? 0
+                                   : 1);  // tests measure the frame's work, not the wait for vsync
 
   IMGUI_CHECKVERSION();
   ImGui::CreateContext();
@@ -167,7 +183,8 @@ int main(int argc, char** argv) {
     state.request.sim.noise_rel = 0.005;
     std::snprintf(state.instrument.awg, sizeof state.instrument.awg, "%s", instrument.c_str());
     std::snprintf(state.instrument.daq, sizeof state.instrument.daq, "%s", daq.c_str());
-    std::snprintf(state.instrument.sim_effects, sizeof state.instrument.sim_effects, "%s", sim_effects.c_str());
+    std::snprintf(state.instrument.sim_effects, sizeof state.instrument.sim_effects, "%s",
+                  sim_effects.c_str());
     std::snprintf(state.replay_path, sizeof state.replay_path, "%s", replay.c_str());
     connect_instruments(state);  // on the task thread: *IDN? shows as soon as the bench answers
 
@@ -215,8 +232,11 @@ int main(int argc, char** argv) {
       glfwSwapBuffers(win);
       // The frame time is the work of one frame (input, drawing, swap); the
       // pacing wait below is not part of it.
-      const double ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t_frame).count();
-      (running && !state.frame_ms_jobs.empty() ? state.frame_ms_jobs.back() : state.frame_ms_idle).push_back(ms);
+      const double ms =
+          std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t_frame)
+              .count();
+      (running && !state.frame_ms_jobs.empty() ? state.frame_ms_jobs.back() : state.frame_ms_idle)
+          .push_back(ms);
       // Pacing: at most 60 frames/s while something runs, 10 when nothing
       // does; input ends the wait at once. Xvfb (and some drivers) have no
       // vsync, and an unpaced loop would take the CPU that the job needs.
@@ -225,7 +245,8 @@ int main(int argc, char** argv) {
       if (ms < period_ms) glfwWaitEventsTimeout((period_ms - ms) / 1000.0);
 
       if (finished && (wait_job || !screenshot.empty())) break;
-      if (timeout_s > 0 && std::chrono::steady_clock::now() - t_start > std::chrono::duration<double>(timeout_s)) {
+      if (timeout_s > 0 &&
+          std::chrono::steady_clock::now() - t_start > std::chrono::duration<double>(timeout_s)) {
         std::fprintf(stderr, "piezobench-gui: timeout after %.0f s\n", timeout_s);
         state.job.cancel();
         rc = 1;
@@ -234,7 +255,8 @@ int main(int argc, char** argv) {
     }
 
     if (!stats_file.empty()) std::ofstream(stats_file) << frame_stats(state, script).dump(2);
-    if (!script.failure().empty()) std::fprintf(stderr, "piezobench-gui: %s\n", script.failure().c_str());
+    if (!script.failure().empty())
+      std::fprintf(stderr, "piezobench-gui: %s\n", script.failure().c_str());
     if (rc == 0 && !script.failure().empty()) rc = 3;
     if (rc == 0 && state.error) rc = 2;
   }  // the job and task threads end here, before the GL context goes

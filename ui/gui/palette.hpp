@@ -18,18 +18,18 @@ inline constexpr ImU32 kColXspec = IM_COL32(255, 110, 110, 255);    // red
 
 // Diagnosis residual ln(Z_meas/Z_model): the base refit, the model with the
 // added effects, and the ±2σ noise of the measurement.
-inline constexpr ImU32 kColResidual = IM_COL32(0, 230, 230, 255);         // cyan
-inline constexpr ImU32 kColResidualAfter = IM_COL32(255, 90, 200, 255);   // pink
-inline constexpr ImU32 kColNoiseBand = IM_COL32(150, 150, 150, 255);      // grey
+inline constexpr ImU32 kColResidual = IM_COL32(0, 230, 230, 255);        // cyan
+inline constexpr ImU32 kColResidualAfter = IM_COL32(255, 90, 200, 255);  // pink
+inline constexpr ImU32 kColNoiseBand = IM_COL32(150, 150, 150, 255);     // grey
 
 // Regions of the misfit, shaded by their dominant kind (update/gap_regions.hpp).
 // Regions whose misfit is at the noise get a faint neutral shade so that the
 // region boundaries stay visible.
-inline constexpr ImU32 kColRegionShift = IM_COL32(255, 150, 0, 110);    // orange
-inline constexpr ImU32 kColRegionWidth = IM_COL32(255, 60, 60, 110);    // red
-inline constexpr ImU32 kColRegionLevel = IM_COL32(60, 120, 255, 110);   // blue
-inline constexpr ImU32 kColRegionPhase = IM_COL32(200, 80, 255, 110);   // violet
-inline constexpr ImU32 kColRegionNoise = IM_COL32(255, 255, 255, 14);   // neutral
+inline constexpr ImU32 kColRegionShift = IM_COL32(255, 150, 0, 110);   // orange
+inline constexpr ImU32 kColRegionWidth = IM_COL32(255, 60, 60, 110);   // red
+inline constexpr ImU32 kColRegionLevel = IM_COL32(60, 120, 255, 110);  // blue
+inline constexpr ImU32 kColRegionPhase = IM_COL32(200, 80, 255, 110);  // violet
+inline constexpr ImU32 kColRegionNoise = IM_COL32(255, 255, 255, 14);  // neutral
 
 // The shade of a region by its dominant kind (GapRegion::kind).
 inline ImU32 region_colour(std::string_view kind) {
@@ -45,7 +45,8 @@ struct Rgb {
 };
 
 constexpr Rgb rgb_of(ImU32 c) {
-  return {static_cast<int>((c >> IM_COL32_R_SHIFT) & 0xff), static_cast<int>((c >> IM_COL32_G_SHIFT) & 0xff),
+  return {static_cast<int>((c >> IM_COL32_R_SHIFT) & 0xff),
+          static_cast<int>((c >> IM_COL32_G_SHIFT) & 0xff),
           static_cast<int>((c >> IM_COL32_B_SHIFT) & 0xff)};
 }
 

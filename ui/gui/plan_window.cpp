@@ -18,7 +18,8 @@ void render_plan_window(AppState& s) {
   ImGui::InputDouble("R1 [ohm]", &p.setup.divider_r1_ohm, 10, 100, "%.1f");
   int kind = static_cast<int>(p.excitation.kind);
   if (kind > 3) kind = 0;
-  if (ImGui::Combo("Excitation", &kind, kKinds, 4)) p.excitation.kind = static_cast<acq::Excitation>(kind);
+  if (ImGui::Combo("Excitation", &kind, kKinds, 4))
+    p.excitation.kind = static_cast<acq::Excitation>(kind);
   ImGui::InputDouble("Amplitude [V]", &p.excitation.amplitude_v, 0.1, 1, "%.3f");
   if (p.excitation.kind == acq::Excitation::ExpDecay)
     ImGui::InputDouble("Decay [1/s]", &p.excitation.decay_per_s, 100, 1000, "%.0f");
@@ -31,12 +32,14 @@ void render_plan_window(AppState& s) {
   ImGui::InputInt("Shots", &p.shots);
   ImGui::InputDouble("Sample rate [S/s]", &p.sample_rate_hz, 1e5, 1e6, "%.3g");
   int n = static_cast<int>(p.samples);
-  if (ImGui::InputInt("Record length", &n, 1000, 10000)) p.samples = static_cast<std::size_t>(std::max(16, n));
+  if (ImGui::InputInt("Record length", &n, 1000, 10000))
+    p.samples = static_cast<std::size_t>(std::max(16, n));
   ImGui::Separator();
   ImGui::Text("Transducer and nominal model");
   ImGui::InputTextWithHint("Transducer id", "e.g. T-017", s.transducer_id, sizeof s.transducer_id);
   const auto& presets = model::material_presets();
-  const char* current = presets.at(static_cast<std::size_t>(s.material_index) % presets.size()).name.c_str();
+  const char* current =
+      presets.at(static_cast<std::size_t>(s.material_index) % presets.size()).name.c_str();
   if (ImGui::BeginCombo("Nominal material", current)) {
     for (std::size_t i = 0; i < presets.size(); ++i) {
       if (ImGui::Selectable(presets[i].name.c_str(), static_cast<int>(i) == s.material_index))
@@ -47,8 +50,10 @@ void render_plan_window(AppState& s) {
   }
   auto g = p.setup.geometry();
   double di = g.inner_diameter_m * 1e3, dout = g.outer_diameter_m * 1e3, len = g.length_m * 1e3;
-  if (ImGui::InputDouble("Inner diameter [mm]", &di, 0.1, 1, "%.3f")) p.setup.inner_diameter_m = di * 1e-3;
-  if (ImGui::InputDouble("Outer diameter [mm]", &dout, 0.1, 1, "%.3f")) p.setup.outer_diameter_m = dout * 1e-3;
+  if (ImGui::InputDouble("Inner diameter [mm]", &di, 0.1, 1, "%.3f"))
+    p.setup.inner_diameter_m = di * 1e-3;
+  if (ImGui::InputDouble("Outer diameter [mm]", &dout, 0.1, 1, "%.3f"))
+    p.setup.outer_diameter_m = dout * 1e-3;
   if (ImGui::InputDouble("Length [mm]", &len, 0.1, 1, "%.3f")) p.setup.length_m = len * 1e-3;
   ImGui::Checkbox("Isotropic model class (seed §6.4.3)", &s.request.isotropic);
   ImGui::InputText("Capture file", s.capture_out, sizeof s.capture_out);
@@ -70,8 +75,7 @@ void render_plan_window(AppState& s) {
     if (tracked_button(s, "Cancel", ImVec2(-1, 0))) s.job.cancel();
     if (s.job.cancel_requested()) ImGui::TextDisabled("cancelling after the current step...");
   }
-  if (s.error || !s.warnings.empty())
-  {
+  if (s.error || !s.warnings.empty()) {
     ImGui::PushStyleColor(ImGuiCol_Text, ImVec4(1, 0.45f, 0.45f, 1));
     ImGui::TextWrapped("%s: see Results for what to do.",
                        s.error ? "The last run failed" : "The last run needs attention");

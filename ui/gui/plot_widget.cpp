@@ -34,8 +34,10 @@ std::vector<double> ticks(double a, double b, bool log) {
 std::string fmt(double v) {
   char buf[32];
   double a = std::fabs(v);
-  if (a != 0 && (a >= 1e5 || a < 1e-2)) std::snprintf(buf, sizeof buf, "%.3g", v);
-  else std::snprintf(buf, sizeof buf, "%.4g", v);
+  if (a != 0 && (a >= 1e5 || a < 1e-2))
+    std::snprintf(buf, sizeof buf, "%.3g", v);
+  else
+    std::snprintf(buf, sizeof buf, "%.4g", v);
   return buf;
 }
 }  // namespace
@@ -74,7 +76,8 @@ void fit_view(const PlotSpec& spec, PlotView& view) {
 bool plot(const char* id, const PlotSpec& spec, PlotView& view, ImVec2 size) {
   if (!view.fitted) fit_view(spec, view);
   ImGui::PushID(id);
-  ImGui::BeginChild("plot", size, true, ImGuiWindowFlags_NoScrollbar | ImGuiWindowFlags_NoScrollWithMouse);
+  ImGui::BeginChild("plot", size, true,
+                    ImGuiWindowFlags_NoScrollbar | ImGuiWindowFlags_NoScrollWithMouse);
   ImDrawList* dl = ImGui::GetWindowDrawList();
   const ImVec2 p0 = ImGui::GetCursorScreenPos();
   const ImVec2 avail = ImGui::GetContentRegionAvail();
@@ -87,8 +90,12 @@ bool plot(const char* id, const PlotSpec& spec, PlotView& view, ImVec2 size) {
 
   double X0 = fwd(view.x0, view.log_x), X1 = fwd(view.x1, view.log_x);
   double Y0 = fwd(view.y0, view.log_y), Y1 = fwd(view.y1, view.log_y);
-  auto sx = [&](double x) { return a.x + static_cast<float>((fwd(x, view.log_x) - X0) / (X1 - X0)) * (b.x - a.x); };
-  auto sy = [&](double y) { return b.y - static_cast<float>((fwd(y, view.log_y) - Y0) / (Y1 - Y0)) * (b.y - a.y); };
+  auto sx = [&](double x) {
+    return a.x + static_cast<float>((fwd(x, view.log_x) - X0) / (X1 - X0)) * (b.x - a.x);
+  };
+  auto sy = [&](double y) {
+    return b.y - static_cast<float>((fwd(y, view.log_y) - Y0) / (Y1 - Y0)) * (b.y - a.y);
+  };
 
   // Interaction: wheel zooms about the cursor, drag pans, double-click fits.
   if (hovered && io.MouseWheel != 0) {
@@ -170,7 +177,8 @@ bool plot(const char* id, const PlotSpec& spec, PlotView& view, ImVec2 size) {
   // when both sit at the left edge and the y label is long).
   const float title_w = ImGui::CalcTextSize(spec.title.c_str()).x;
   dl->AddText(ImVec2(0.5f * (a.x + b.x - title_w), p0.y + 2), text, spec.title.c_str());
-  dl->AddText(ImVec2(b.x - ImGui::CalcTextSize(spec.x_label.c_str()).x, b.y + 18), text, spec.x_label.c_str());
+  dl->AddText(ImVec2(b.x - ImGui::CalcTextSize(spec.x_label.c_str()).x, b.y + 18), text,
+              spec.x_label.c_str());
   dl->AddText(ImVec2(p0.x + 2, p0.y + 2), text, spec.y_label.c_str());
 
   dl->PushClipRect(a, b, true);
@@ -188,7 +196,8 @@ bool plot(const char* id, const PlotSpec& spec, PlotView& view, ImVec2 size) {
   for (const auto& s : spec.series) {
     pts.clear();
     for (std::size_t i = 0; i < s.x.size() && i < s.y.size(); ++i) {
-      if ((view.log_x && s.x[i] <= 0) || (view.log_y && s.y[i] <= 0) || !std::isfinite(s.y[i])) continue;
+      if ((view.log_x && s.x[i] <= 0) || (view.log_y && s.y[i] <= 0) || !std::isfinite(s.y[i]))
+        continue;
       pts.emplace_back(sx(s.x[i]), sy(s.y[i]));
     }
     if (s.points) {
@@ -219,22 +228,29 @@ bool plot(const char* id, const PlotSpec& spec, PlotView& view, ImVec2 size) {
   }
 
   // Hover read-out: cursor position and the nearest point of each series.
-  if (hovered && io.MousePos.x >= a.x && io.MousePos.x <= b.x && io.MousePos.y >= a.y && io.MousePos.y <= b.y) {
+  if (hovered && io.MousePos.x >= a.x && io.MousePos.x <= b.x && io.MousePos.y >= a.y &&
+      io.MousePos.y <= b.y) {
     double cx = inv(X0 + (io.MousePos.x - a.x) / (b.x - a.x) * (X1 - X0), view.log_x);
-    dl->AddLine(ImVec2(io.MousePos.x, a.y), ImVec2(io.MousePos.x, b.y), IM_COL32(255, 255, 255, 60));
+    dl->AddLine(ImVec2(io.MousePos.x, a.y), ImVec2(io.MousePos.x, b.y),
+                IM_COL32(255, 255, 255, 60));
     ImGui::BeginTooltip();
     ImGui::Text("%s = %s", spec.x_label.c_str(), fmt(cx).c_str());
     for (const auto& s : spec.series) {
       // The nearest sample in x, and only inside the series' own x range (a
       // curve that ends at 120 kHz has no value to read at 200 kHz).
-      if (!s.listed || s.x.empty() || s.y.size() < s.x.size() || cx < s.x.front() || cx > s.x.back()) continue;
+      if (!s.listed || s.x.empty() || s.y.size() < s.x.size() || cx < s.x.front() ||
+          cx > s.x.back())
+        continue;
       auto it = std::lower_bound(s.x.begin(), s.x.end(), cx);
-      std::size_t i = std::min<std::size_t>(static_cast<std::size_t>(it - s.x.begin()), s.x.size() - 1);
+      std::size_t i =
+          std::min<std::size_t>(static_cast<std::size_t>(it - s.x.begin()), s.x.size() - 1);
       if (i > 0 && cx - s.x[i - 1] < s.x[i] - cx) --i;
-      ImGui::TextColored(ImGui::ColorConvertU32ToFloat4(s.color), "%s: %s", s.label.c_str(), fmt(s.y[i]).c_str());
+      ImGui::TextColored(ImGui::ColorConvertU32ToFloat4(s.color), "%s: %s", s.label.c_str(),
+                         fmt(s.y[i]).c_str());
     }
     for (const auto& band : spec.bands)
-      if (!band.detail.empty() && cx >= std::min(band.x0, band.x1) && cx <= std::max(band.x0, band.x1))
+      if (!band.detail.empty() && cx >= std::min(band.x0, band.x1) &&
+          cx <= std::max(band.x0, band.x1))
         ImGui::TextUnformatted(band.detail.c_str());
     ImGui::EndTooltip();
   }

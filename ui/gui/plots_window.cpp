@@ -44,7 +44,8 @@ void impedance_specs(const AppState& s, PlotSpec& mag, PlotSpec& ph) {
     ph.series.push_back(std::move(p));
   }
   for (double f : s.result->resonances_hz) mag.markers.push_back({f, IM_COL32(255, 255, 255, 90)});
-  for (double f : s.result->antiresonances_hz) mag.markers.push_back({f, IM_COL32(255, 160, 160, 90)});
+  for (double f : s.result->antiresonances_hz)
+    mag.markers.push_back({f, IM_COL32(255, 160, 160, 90)});
 }
 }  // namespace
 
@@ -61,7 +62,8 @@ void render_plots_window(AppState& s) {
   PlotSpec mag{"|Z|", "f [Hz]", "ohm", {}, {}, {}}, ph{"phase", "f [Hz]", "deg", {}, {}, {}};
   impedance_specs(s, mag, ph);
   PlotSpec res{"gap: residual (no diagnosis)", "f [kHz]", "dB", {}, {}, {}};
-  if (s.result && s.result->diagnosis) res = residual_plot_spec(*s.result->diagnosis, s.residual_phase);
+  if (s.result && s.result->diagnosis)
+    res = residual_plot_spec(*s.result->diagnosis, s.residual_phase);
   PlotSpec sv{"Hankel SVs", "index", "s_k/s_1", {}, {}, {}};
   if (s.result && !s.result->singular_values.empty()) {
     sv.title = "Hankel SVs (order " + std::to_string(s.result->order) + ")";

@@ -37,17 +37,23 @@ std::vector<double> khz(const std::vector<double>& f_hz) {
   return v;
 }
 
-Series residual_series(const std::string& label, const update::GapCurve& c, bool phase, ImU32 colour,
-                       float width) {
+Series residual_series(const std::string& label, const update::GapCurve& c, bool phase,
+                       ImU32 colour, float width) {
   return {label, khz(c.f_hz), phase ? c.residual_deg : c.residual_db, colour, width, false};
 }
 }  // namespace
 
 PlotSpec residual_plot_spec(const update::GapDiagnosis& d, bool phase) {
-  PlotSpec spec{phase ? "gap: residual phase" : "gap: residual |Z|", "f [kHz]", phase ? "deg" : "dB", {}, {}, {}};
+  PlotSpec spec{phase ? "gap: residual phase" : "gap: residual |Z|",
+                "f [kHz]",
+                phase ? "deg" : "dB",
+                {},
+                {},
+                {}};
   for (const auto& g : d.regions) {
     if (g.points == 0) continue;
-    spec.bands.push_back({g.f_lo_hz / 1e3, g.f_hi_hz / 1e3, region_colour(g.kind), short_kind(g.kind), region_detail(g)});
+    spec.bands.push_back({g.f_lo_hz / 1e3, g.f_hi_hz / 1e3, region_colour(g.kind),
+                          short_kind(g.kind), region_detail(g)});
   }
   // The noise first and thin, the residuals on top.
   const auto& sig = phase ? d.before.sigma_deg : d.before.sigma_db;
@@ -59,7 +65,8 @@ PlotSpec residual_plot_spec(const update::GapDiagnosis& d, bool phase) {
   }
   spec.series.push_back(std::move(hi));
   spec.series.push_back(std::move(lo));
-  spec.series.push_back(residual_series("updated model (base refit)", d.before, phase, kColResidual, 2.0f));
+  spec.series.push_back(
+      residual_series("updated model (base refit)", d.before, phase, kColResidual, 2.0f));
   if (!d.added.empty()) {
     std::string label = "with";
     for (const auto& e : d.added) label += " " + e;

@@ -1,14 +1,17 @@
 // Results: the error that stopped the last run (with what to do), original
-// vs updated parameters with the change in %, the stages that ran, the exports (CSV, Touchstone, JSON report, PNG of the window) and
-// the log. The gap verdict and effect ranking are in the diagnosis window.
+// vs updated parameters with the change in %, the stages that ran, the exports (CSV, Touchstone,
+// JSON report, PNG of the window) and the log. The gap verdict and effect ranking are in the
+// diagnosis window.
 #include "ui/gui/windows.hpp"
 
 namespace piezo::gui {
 
 namespace {
 void parameter_table(const ui::PipelineResult& r) {
-  const bool sim = std::any_of(r.params.begin(), r.params.end(), [](const auto& p) { return p.truth.has_value(); });
-  if (!ImGui::BeginTable("params", sim ? 5 : 4, ImGuiTableFlags_Borders | ImGuiTableFlags_RowBg)) return;
+  const bool sim = std::any_of(r.params.begin(), r.params.end(),
+                               [](const auto& p) { return p.truth.has_value(); });
+  if (!ImGui::BeginTable("params", sim ? 5 : 4, ImGuiTableFlags_Borders | ImGuiTableFlags_RowBg))
+    return;
   ImGui::TableSetupColumn("parameter");
   ImGui::TableSetupColumn("original");
   ImGui::TableSetupColumn("updated");
@@ -27,8 +30,10 @@ void parameter_table(const ui::PipelineResult& r) {
     ImGui::Text("%+.2f", p.original != 0 ? 100.0 * (p.updated - p.original) / p.original : 0.0);
     if (!sim) continue;
     ImGui::TableNextColumn();
-    if (p.truth) ImGui::Text("%.5g", *p.truth);
-    else ImGui::TextDisabled("-");
+    if (p.truth)
+      ImGui::Text("%.5g", *p.truth);
+    else
+      ImGui::TextDisabled("-");
   }
   ImGui::EndTable();
 }
@@ -40,12 +45,15 @@ void render_results_window(AppState& s) {
   if (s.error) show_problem(*s.error);
   for (const auto& w : s.warnings) show_problem(w);
   if (!s.result && !s.error) {
-    ImGui::TextWrapped("No result yet. Set the plan and press 'Measure and update', or replay a capture.");
+    ImGui::TextWrapped(
+        "No result yet. Set the plan and press 'Measure and update', or replay a capture.");
   } else if (s.result) {
     const auto& r = *s.result;
     ImGui::TextWrapped("Capture: %s (%d shots)", r.capture_path.c_str(), r.shots);
-    if (r.params.empty()) ImGui::TextDisabled("No updated parameters (see the stages below).");
-    else parameter_table(r);
+    if (r.params.empty())
+      ImGui::TextDisabled("No updated parameters (see the stages below).");
+    else
+      parameter_table(r);
     if (!r.curves.empty()) {  // the exports need at least the impedance estimate
       ImGui::SetNextItemWidth(150);
       ImGui::InputText("##export", s.export_base, sizeof s.export_base);
@@ -60,13 +68,16 @@ void render_results_window(AppState& s) {
       if (tracked_button(s, "PNG")) s.png_request = std::string(s.export_base) + ".png";
     }
     for (const auto& st : r.stages)
-      ImGui::TextColored(st.ran ? ImVec4(0.5f, 1, 0.5f, 1) : ImVec4(0.7f, 0.7f, 0.7f, 1), "%s %s: %s",
-                         st.ran ? "[ran]" : "[skipped]", st.name.c_str(), st.note.c_str());
-    for (const auto& w : r.warnings) ImGui::TextColored(ImVec4(1, 0.8f, 0.3f, 1), "warning: %s", w.c_str());
+      ImGui::TextColored(st.ran ? ImVec4(0.5f, 1, 0.5f, 1) : ImVec4(0.7f, 0.7f, 0.7f, 1),
+                         "%s %s: %s", st.ran ? "[ran]" : "[skipped]", st.name.c_str(),
+                         st.note.c_str());
+    for (const auto& w : r.warnings)
+      ImGui::TextColored(ImVec4(1, 0.8f, 0.3f, 1), "warning: %s", w.c_str());
   }
   ImGui::BeginChild("log", ImVec2(0, 0), true, ImGuiWindowFlags_HorizontalScrollbar);
   for (const auto& l : s.log) ImGui::TextUnformatted(l.c_str());
-  if (ImGui::GetScrollY() >= ImGui::GetScrollMaxY()) ImGui::SetScrollHereY(1.0f);  // follow the tail
+  if (ImGui::GetScrollY() >= ImGui::GetScrollMaxY())
+    ImGui::SetScrollHereY(1.0f);  // follow the tail
   ImGui::EndChild();
   ImGui::End();
 }

@@ -19,7 +19,8 @@ TestScript::TestScript(std::vector<std::string> clicks, std::optional<ImVec2> ho
 void TestScript::inject(ImGuiIO& io, const AppState& s) {
   if (!active()) return;
   io.MouseDown[0] = false;
-  const bool clicking = phase_ == Phase::Hovering || phase_ == Phase::Pressing || phase_ == Phase::Releasing;
+  const bool clicking =
+      phase_ == Phase::Hovering || phase_ == Phase::Pressing || phase_ == Phase::Releasing;
   const auto it = clicking ? s.button_rects.find(clicks_[next_]) : s.button_rects.end();
   if (clicking && it == s.button_rects.end()) {
     phase_ = Phase::Waiting;  // the button went away mid-click: start the click again

@@ -15,7 +15,8 @@ bool tracked_button(AppState& s, const char* label, ImVec2 size) {
 
 void show_problem(const Problem& p) {
   const bool error = p.kind != ErrorKind::Attention;
-  ImGui::PushStyleColor(ImGuiCol_Text, error ? ImVec4(1, 0.45f, 0.45f, 1) : ImVec4(1, 0.75f, 0.3f, 1));
+  ImGui::PushStyleColor(ImGuiCol_Text,
+                        error ? ImVec4(1, 0.45f, 0.45f, 1) : ImVec4(1, 0.75f, 0.3f, 1));
   std::string heading = kind_name(p.kind);
   heading[0] = static_cast<char>(std::toupper(static_cast<unsigned char>(heading[0])));
   ImGui::TextWrapped("%s (%s): %s", heading.c_str(), p.stage.c_str(), p.message.c_str());
