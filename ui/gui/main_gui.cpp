@@ -34,7 +34,7 @@ void glfw_error(int code, const char* msg) {
 // right, results and diagnosis side by side below the plots.
 void render_windows(AppState& s, int w, int h) {
   const float left = 380.0f, W = static_cast<float>(w), H = static_cast<float>(h);
-  const float plan_h = H * 0.64f, plots_h = H * 0.58f, results_w = 0.465f * (W - left);
+  const float plan_h = H * 0.64f, plots_h = H * 0.58f, results_w = 0.45f * (W - left);
   auto place = [](float x, float y, float width, float height) {
     ImGui::SetNextWindowPos(ImVec2(x, y), ImGuiCond_FirstUseEver);
     ImGui::SetNextWindowSize(ImVec2(width, height), ImGuiCond_FirstUseEver);

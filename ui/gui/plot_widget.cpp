@@ -192,16 +192,25 @@ bool plot(const char* id, const PlotSpec& spec, PlotView& view, ImVec2 size) {
     float x = sx(m.x);
     dl->AddLine(ImVec2(x, a.y), ImVec2(x, b.y), m.color, 1.0f);
   }
+  // Lines keep a vertex only once it is a pixel away from the last one kept:
+  // the frequency grids are denser than the screen, and every triangle costs
+  // a software rasteriser (llvmpipe under Xvfb) setup time. Points are small
+  // squares for the same reason (a filled circle is a dozen triangles).
   std::vector<ImVec2> pts;
   for (const auto& s : spec.series) {
     pts.clear();
     for (std::size_t i = 0; i < s.x.size() && i < s.y.size(); ++i) {
       if ((view.log_x && s.x[i] <= 0) || (view.log_y && s.y[i] <= 0) || !std::isfinite(s.y[i]))
         continue;
-      pts.emplace_back(sx(s.x[i]), sy(s.y[i]));
+      const ImVec2 p(sx(s.x[i]), sy(s.y[i]));
+      const bool last = i + 1 == std::min(s.x.size(), s.y.size());
+      if (!s.points && !last && !pts.empty() && std::fabs(p.x - pts.back().x) < 1.0f &&
+          std::fabs(p.y - pts.back().y) < 1.0f)
+        continue;
+      pts.push_back(p);
     }
     if (s.points) {
-      for (const auto& p : pts) dl->AddCircleFilled(p, 2.5f, s.color);
+      for (const auto& p : pts) dl->AddRectFilled(ImVec2(p.x - 2, p.y - 2), ImVec2(p.x + 2, p.y + 2), s.color);
     } else if (pts.size() > 1) {
       dl->AddPolyline(pts.data(), static_cast<int>(pts.size()), s.color, 0, s.thickness);
     }
