@@ -210,7 +210,8 @@ bool plot(const char* id, const PlotSpec& spec, PlotView& view, ImVec2 size) {
       pts.push_back(p);
     }
     if (s.points) {
-      for (const auto& p : pts) dl->AddRectFilled(ImVec2(p.x - 2, p.y - 2), ImVec2(p.x + 2, p.y + 2), s.color);
+      for (const auto& p : pts)
+        dl->AddRectFilled(ImVec2(p.x - 2, p.y - 2), ImVec2(p.x + 2, p.y + 2), s.color);
     } else if (pts.size() > 1) {
       dl->AddPolyline(pts.data(), static_cast<int>(pts.size()), s.color, 0, s.thickness);
     }

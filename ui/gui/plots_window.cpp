@@ -57,6 +57,9 @@ void render_plots_window(AppState& s) {
   ImGui::SameLine();
   if (ImGui::Checkbox("Residual phase", &s.residual_phase)) s.residual_view.fitted = false;
   ImGui::SameLine();
+  if (ImGui::Checkbox("log f", &s.residual_view.log_x)) s.residual_view.fitted = false;
+  if (ImGui::IsItemHovered()) ImGui::SetTooltip("Logarithmic frequency axis for the residual plot");
+  ImGui::SameLine();
   if (ImGui::Button("Fit views"))
     s.mag_view.fitted = s.phase_view.fitted = s.sv_view.fitted = s.residual_view.fitted = false;
   PlotSpec mag{"|Z|", "f [Hz]", "ohm", {}, {}, {}}, ph{"phase", "f [Hz]", "deg", {}, {}, {}};
