@@ -10,8 +10,8 @@ namespace piezo::gui {
 
 namespace {
 void effects_table(const update::GapDiagnosis& d, DiagnosisShown& shown) {
-  const ImGuiTableFlags flags = ImGuiTableFlags_Borders | ImGuiTableFlags_RowBg |
-                                ImGuiTableFlags_SizingFixedFit | ImGuiTableFlags_ScrollX;
+  const ImGuiTableFlags flags =
+      ImGuiTableFlags_Borders | ImGuiTableFlags_RowBg | ImGuiTableFlags_SizingFixedFit;
   if (!ImGui::BeginTable("effects", 4, flags)) return;
   ImGui::TableSetupColumn("effect (ranked)");
   ImGui::TableSetupColumn("value (sigma)");

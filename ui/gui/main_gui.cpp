@@ -68,7 +68,8 @@ nlohmann::json frame_stats(const AppState& s, const TestScript& script) {
     jobs.push_back({{"frames", v.size()},
                     {"median_ms", percentile(v, 0.5)},
                     {"p95_ms", percentile(v, 0.95)},
-                    {"max_ms", v.empty() ? 0.0 : *std::max_element(v.begin(), v.end())}});
+                    {"max_ms", v.empty() ? 0.0 : *std::max_element(v.begin(), v.end())},
+                    {"frame_ms", v}});
   nlohmann::json j = {{"jobs", jobs},
                       {"idle_frames", s.frame_ms_idle.size()},
                       {"idle_median_ms", percentile(s.frame_ms_idle, 0.5)},
