@@ -64,7 +64,8 @@ void start_job(AppState& s, bool replay) {
   if (!s.job.start(req)) return;
   ++s.jobs_started;
   s.frame_ms_jobs.emplace_back();
-  if (!replay) s.instrument.state = InstrumentForm::State::Connecting;
+  s.instrument.before_job = s.instrument.state;
+  if (!replay) s.instrument.state = InstrumentForm::State::Measuring;
   s.log.push_back(replay ? "replay of " + req.replay_capture + " started"
                          : "measure and update started on " + req.instrument);
 }
@@ -84,8 +85,8 @@ bool collect_job(AppState& s) {
     if (s.error->kind == ErrorKind::Connection || s.error->kind == ErrorKind::Instrument) {
       in.state = InstrumentForm::State::Error;
       in.problem = s.error;
-    } else if (in.state == InstrumentForm::State::Connecting) {
-      in.state = InstrumentForm::State::NotConnected;
+    } else if (in.state == InstrumentForm::State::Measuring) {
+      in.state = in.before_job;
     }
     return true;
   }

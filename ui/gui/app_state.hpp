@@ -50,13 +50,17 @@ struct InstrumentForm {
   // Bench effects the simulated bench adds (NAME=VALUE, comma separated), so
   // that the gap diagnosis has something to find; see model/effects.hpp.
   char sim_effects[256] = "";
+  // (The order is the frame statistics' numbering; tests/gui relies on it.)
   enum class State {
     NotConnected,
     Connecting,
     Connected,
     Replay,
-    Error
+    Error,
+    Measuring,
   } state = State::NotConnected;
+  State before_job =
+      State::NotConnected;  // restored when a job fails for a reason not the instruments'
   std::string idn_awg, idn_daq, description;
   std::optional<Problem> problem;  // the last connection or instrument error
 };

@@ -16,6 +16,8 @@ const char* state_text(InstrumentForm::State st) {
       return "connected";
     case InstrumentForm::State::Replay:
       return "replay (no instrument used)";
+    case InstrumentForm::State::Measuring:
+      return "in use by the measurement";
     case InstrumentForm::State::Error:
       break;
   }
@@ -29,6 +31,7 @@ ImVec4 state_colour(InstrumentForm::State st) {
     case InstrumentForm::State::Error:
       return ImVec4(1, 0.45f, 0.45f, 1);
     case InstrumentForm::State::Connecting:
+    case InstrumentForm::State::Measuring:
       return ImVec4(1, 0.85f, 0.4f, 1);
     default:
       return ImVec4(0.75f, 0.75f, 0.75f, 1);
