@@ -28,6 +28,18 @@ using piezo::gui::Rgb;
 
 namespace {
 
+// This test process's folder; each run gets a subfolder.
+fs::path scratch() {
+  return fs::temp_directory_path() / ("piezobench-gui-" + std::to_string(::getpid()));
+}
+
+// Removes the folder when the test passed; a failed test's files stay for a look.
+struct ScratchCleanup {
+  ~ScratchCleanup() {
+    if (!::testing::Test::HasFailure()) fs::remove_all(scratch());
+  }
+};
+
 struct GuiRun {
   int exit_code = -1;  // the GUI's own; 128 + N when signal N ended it (a crash)
   nlohmann::json stats;
@@ -38,7 +50,7 @@ struct GuiRun {
 // hooks included); the frame statistics come back parsed.
 GuiRun run_gui(const std::string& name, const std::string& args) {
   GuiRun r;
-  r.dir = fs::temp_directory_path() / ("piezobench-gui-" + std::to_string(::getpid())) / name;
+  r.dir = scratch() / name;
   fs::remove_all(r.dir);
   fs::create_directories(r.dir);
   // The GUI's exit status is recorded by a wrapper script: xvfb-run's own is
@@ -132,6 +144,7 @@ constexpr int kConnected = 2, kReplay = 3, kError = 4;
 // drawn (the first runs over empty plots); the JSON report is exported in
 // between through its button.
 TEST(Gui, MeasureAndUpdateUnderXvfb) {
+  ScratchCleanup cleanup;
   auto run =
       run_gui("measure",
               "--sim-effects series_resistance=15 --click 'Measure and update' --click JSON "
@@ -209,7 +222,8 @@ TEST(Gui, MeasureAndUpdateUnderXvfb) {
 // A recorded capture replayed through the same pipeline: no instrument, and
 // the update moves the parameters towards the simulated tube's.
 TEST(Gui, ReplayOfARecordedCapture) {
-  const fs::path dir = fs::temp_directory_path() / ("piezobench-gui-" + std::to_string(::getpid()));
+  ScratchCleanup cleanup;
+  const fs::path dir = scratch();
   fs::create_directories(dir);
   const fs::path cap = dir / "recorded.h5";
   const std::string measure =
@@ -237,9 +251,9 @@ TEST(Gui, ReplayOfARecordedCapture) {
 // Errors end in the window with what to do, never in a crash: exit code 2
 // (the run's error) with the problem's kind and advice in the statistics.
 TEST(Gui, ErrorsAreShownWithWhatToDo) {
+  ScratchCleanup cleanup;
   {
-    const fs::path dir =
-        fs::temp_directory_path() / ("piezobench-gui-" + std::to_string(::getpid()));
+    const fs::path dir = scratch();
     fs::create_directories(dir);
     const fs::path bad = dir / "not-a-capture.h5";
     std::ofstream(bad) << "this is not HDF5\n";
@@ -267,6 +281,7 @@ TEST(Gui, ErrorsAreShownWithWhatToDo) {
 // start): the run ends without an error, before the update, and the capture
 // keeps what was acquired.
 TEST(Gui, CancelStopsTheRun) {
+  ScratchCleanup cleanup;
   auto run = run_gui("cancel", "--shots 64 --click 'Measure and update' --click Cancel --wait-job");
   ASSERT_EQ(run.exit_code, 0) << "GUI run failed; see " << (run.dir / "gui.log");
   const auto& j = run.stats;
