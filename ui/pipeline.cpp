@@ -67,6 +67,9 @@ acq::Capture acquire(const PipelineRequest& req, PipelineResult& out, const Stag
   out.shots = res.shots_written;
   out.stages.push_back({"acquire", true, std::to_string(res.shots_written) + " shot(s) on " + bench.description});
   if (res.cancelled) out.warnings.push_back("cancelled during acquisition; kept " + std::to_string(res.shots_written) + " shot(s)");
+  // Cancelled before the first shot: the capture holds nothing to read back
+  // (the caller stops on `cancel` before using it).
+  if (res.cancelled && res.shots_written == 0) return {};
   return acq::read_capture(res.capture);
 }
 

@@ -1,25 +1,78 @@
-// Instrument panel: bench addresses, identity and connection state.
+// Instrument panel: bench addresses (the simulated bench, tcp:// or
+// usbtmc://), the simulated bench's effects, Connect, *IDN? of both
+// instruments, the connection state and the last instrument error.
 #include "ui/gui/windows.hpp"
 
 namespace piezo::gui {
 
-bool tracked_button(AppState& s, const char* label, ImVec2 size) {
-  bool clicked = ImGui::Button(label, size);
-  ImVec2 a = ImGui::GetItemRectMin(), b = ImGui::GetItemRectMax();
-  s.button_rects[label] = ImVec4(a.x, a.y, b.x, b.y);
-  return clicked;
+namespace {
+const char* state_text(InstrumentForm::State st) {
+  switch (st) {
+    case InstrumentForm::State::NotConnected:
+      return "not connected";
+    case InstrumentForm::State::Connecting:
+      return "connecting...";
+    case InstrumentForm::State::Connected:
+      return "connected";
+    case InstrumentForm::State::Replay:
+      return "replay (no instrument used)";
+    case InstrumentForm::State::Measuring:
+      return "in use by the measurement";
+    case InstrumentForm::State::Error:
+      break;
+  }
+  return "error";
 }
+
+ImVec4 state_colour(InstrumentForm::State st) {
+  switch (st) {
+    case InstrumentForm::State::Connected:
+      return ImVec4(0.5f, 1, 0.5f, 1);
+    case InstrumentForm::State::Error:
+      return ImVec4(1, 0.45f, 0.45f, 1);
+    case InstrumentForm::State::Connecting:
+    case InstrumentForm::State::Measuring:
+      return ImVec4(1, 0.85f, 0.4f, 1);
+    default:
+      return ImVec4(0.75f, 0.75f, 0.75f, 1);
+  }
+}
+}  // namespace
 
 void render_instrument_window(AppState& s) {
   ImGui::Begin("Instruments");
-  ImGui::TextWrapped("Bench: 'sim' (embedded simulated bench), tcp://HOST:PORT or usbtmc://VID:PID[/SERIAL].");
-  ImGui::InputText("AWG", s.instrument.awg, sizeof s.instrument.awg);
-  ImGui::InputText("DAQ (optional)", s.instrument.daq, sizeof s.instrument.daq);
-  ImGui::Text("State: %s", s.instrument.state.c_str());
-  if (!s.instrument.idn_awg.empty()) ImGui::Text("AWG *IDN?: %s", s.instrument.idn_awg.c_str());
-  if (!s.instrument.idn_daq.empty()) ImGui::Text("DAQ *IDN?: %s", s.instrument.idn_daq.c_str());
-  if (!s.instrument.last_error.empty())
-    ImGui::TextColored(ImVec4(1, 0.4f, 0.4f, 1), "Instrument error: %s", s.instrument.last_error.c_str());
+  auto& in = s.instrument;
+  const bool busy = s.job.running() || in.state == InstrumentForm::State::Connecting;
+  ImGui::TextWrapped("'sim' (the simulated bench), tcp://HOST:PORT or usbtmc://VID:PID[/SERIAL].");
+  ImGui::BeginDisabled(busy);
+  // A changed address is a different bench: what was read from the old one goes.
+  bool edited = ImGui::InputText("AWG", in.awg, sizeof in.awg);
+  edited |= ImGui::InputText("DAQ (optional)", in.daq, sizeof in.daq);
+  if (edited) {
+    in.state = InstrumentForm::State::NotConnected;
+    in.idn_awg.clear();
+    in.idn_daq.clear();
+    in.problem.reset();
+  }
+  if (std::string(in.awg) == "sim") {
+    ImGui::InputTextWithHint("Sim effects", "e.g. series_resistance=15", in.sim_effects,
+                             sizeof in.sim_effects);
+    if (ImGui::IsItemHovered())
+      ImGui::SetTooltip(
+          "Bench effects the simulated bench adds and the model lacks, NAME=VALUE (SI), "
+          "comma separated:\nseries_resistance, parallel_capacitance, daq_input_resistance, "
+          "dielectric_loss,\nchannel_skew, channel_gain, r1_tolerance, mechanical_damping, "
+          "mass_loading");
+  }
+  if (tracked_button(s, "Connect")) connect_instruments(s);
+  ImGui::EndDisabled();
+  ImGui::SameLine();
+  ImGui::TextColored(state_colour(in.state), "%s", state_text(in.state));
+  if (in.state == InstrumentForm::State::Connected || !in.idn_awg.empty()) {
+    ImGui::TextWrapped("AWG *IDN?: %s", in.idn_awg.c_str());
+    ImGui::TextWrapped("DAQ *IDN?: %s", in.idn_daq.c_str());
+  }
+  if (in.problem) show_problem(*in.problem);
   ImGui::End();
 }
 

@@ -1,6 +1,22 @@
+// The pipeline's worker thread (see Job in app_state.hpp).
+#include <sys/resource.h>
+#include <unistd.h>
+
 #include "ui/gui/app_state.hpp"
 
 namespace piezo::gui {
+
+namespace {
+// The worker runs below the UI's priority: on a two-core machine the
+// pipeline's number crunching would otherwise compete on equal terms with the
+// frame loop and the software rasteriser (llvmpipe under Xvfb), and frames
+// would stretch while a job runs. Best effort: the job runs either way.
+void lower_this_thread_priority() {
+#ifdef __linux__
+  setpriority(PRIO_PROCESS, static_cast<id_t>(gettid()), 10);
+#endif
+}
+}  // namespace
 
 Job::~Job() {
   cancel_ = true;
@@ -14,9 +30,14 @@ bool Job::start(const ui::PipelineRequest& req) {
   cancel_ = false;
   finished_ = false;
   progress_ = 0;
+  {
+    std::lock_guard lock(mu_);
+    stage_ = req.replay_capture.empty() ? "connect" : "open capture";
+  }
   thread_ = std::thread([this, req] {
+    lower_this_thread_priority();
     std::unique_ptr<ui::PipelineResult> res;
-    std::string err;
+    std::optional<Problem> problem;
     try {
       res = std::make_unique<ui::PipelineResult>(ui::run_pipeline(
           req,
@@ -26,13 +47,13 @@ bool Job::start(const ui::PipelineRequest& req) {
             stage_ = p.stage;
           },
           cancel_));
-    } catch (const std::exception& e) {
-      err = e.what();
+    } catch (...) {
+      problem = problem_from_current_exception(stage());
     }
     {
       std::lock_guard lock(mu_);
       result_ = std::move(res);
-      error_ = err;
+      problem_ = std::move(problem);
     }
     finished_ = true;
     running_ = false;
@@ -45,11 +66,11 @@ std::string Job::stage() const {
   return stage_;
 }
 
-bool Job::take(std::unique_ptr<ui::PipelineResult>& result, std::string& error) {
+bool Job::take(std::unique_ptr<ui::PipelineResult>& result, std::optional<Problem>& problem) {
   if (!finished_.exchange(false)) return false;
   std::lock_guard lock(mu_);
   result = std::move(result_);
-  error = error_;
+  problem = std::move(problem_);
   return true;
 }
 

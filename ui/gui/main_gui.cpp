@@ -1,10 +1,12 @@
 // piezobench-gui — the bench technician's program (Dear ImGui + GLFW + OpenGL 3).
-// The frame loop only draws: work runs on the Job thread (app_state.hpp).
+// The frame loop only draws: work runs on the Job and TaskQueue threads
+// (app_state.hpp) and comes back through collect_job() and drain().
 //
-// Test hooks (used by tests/gui under Xvfb): --click LABEL injects a mouse click
-// on a tracked button once it is drawn; --wait-job waits for the job to end;
-// --screenshot FILE saves the window after that; --frame-stats FILE writes the
-// frame times measured while the job ran; --timeout S bounds the whole run.
+// Test hooks (used by tests/gui under Xvfb, test_script.hpp): --click LABEL
+// (repeatable) clicks those buttons in order once drawn; --wait-job exits when
+// the work they started has finished; --hover X,Y rests the mouse there
+// afterwards; --screenshot FILE saves the window then; --frame-stats FILE
+// writes the frame times and what the windows showed; --timeout S bounds the run.
 #include <GLFW/glfw3.h>
 #include <imgui.h>
 #include <imgui_impl_glfw.h>
@@ -18,27 +20,125 @@
 #include <nlohmann/json.hpp>
 
 #include "ui/gui/screenshot.hpp"
+#include "ui/gui/test_script.hpp"
 #include "ui/gui/windows.hpp"
 
 using namespace piezo::gui;
 
 namespace {
-void glfw_error(int code, const char* msg) { std::fprintf(stderr, "piezobench-gui: GLFW error %d: %s\n", code, msg); }
+void glfw_error(int code, const char* msg) {
+  std::fprintf(stderr, "piezobench-gui: GLFW error %d: %s\n", code, msg);
+}
 
+// Windows in a fixed layout: plan and instruments on the left, plots on the
+// right, results and diagnosis side by side below the plots.
+void render_windows(AppState& s, int w, int h) {
+  const float left = 380.0f, W = static_cast<float>(w), H = static_cast<float>(h);
+  const float plan_h = H * 0.64f, plots_h = H * 0.58f, results_w = 0.45f * (W - left);
+  auto place = [](float x, float y, float width, float height) {
+    ImGui::SetNextWindowPos(ImVec2(x, y), ImGuiCond_FirstUseEver);
+    ImGui::SetNextWindowSize(ImVec2(width, height), ImGuiCond_FirstUseEver);
+  };
+  place(0, 0, left, plan_h);
+  render_plan_window(s);
+  place(0, plan_h, left, H - plan_h);
+  render_instrument_window(s);
+  place(left, 0, W - left, plots_h);
+  render_plots_window(s);
+  place(left, plots_h, results_w, H - plots_h);
+  render_results_window(s);
+  place(left + results_w, plots_h, W - left - results_w, H - plots_h);
+  render_diagnosis_window(s);
+}
+
+std::string json_or_empty(const std::optional<Problem>& p, std::string Problem::*field) {
+  return p ? (*p).*field : std::string();
+}
+
+double percentile(std::vector<double> v, double q) {
+  if (v.empty()) return 0.0;
+  std::sort(v.begin(), v.end());
+  return v[static_cast<std::size_t>(q * static_cast<double>(v.size() - 1) + 0.5)];
+}
+
+// What the test checks: frame times, and what the windows showed.
+nlohmann::json frame_stats(const AppState& s, const TestScript& script) {
+  nlohmann::json jobs = nlohmann::json::array();
+  for (const auto& v : s.frame_ms_jobs)
+    jobs.push_back({{"frames", v.size()},
+                    {"median_ms", percentile(v, 0.5)},
+                    {"p95_ms", percentile(v, 0.95)},
+                    {"max_ms", v.empty() ? 0.0 : *std::max_element(v.begin(), v.end())},
+                    {"frame_ms", v}});
+  nlohmann::json j = {{"jobs", jobs},
+                      {"idle_frames", s.frame_ms_idle.size()},
+                      {"idle_median_ms", percentile(s.frame_ms_idle, 0.5)},
+                      {"clicked", script.clicked()},
+                      {"script_failure", script.failure()},
+                      {"error", json_or_empty(s.error, &Problem::message)},
+                      {"error_kind", s.error ? kind_name(s.error->kind) : ""},
+                      {"error_advice", json_or_empty(s.error, &Problem::advice)},
+                      {"instrument_state", static_cast<int>(s.instrument.state)},
+                      {"idn_awg", s.instrument.idn_awg},
+                      {"idn_daq", s.instrument.idn_daq},
+                      {"instrument_error", json_or_empty(s.instrument.problem, &Problem::message)},
+                      {"capture", s.result ? s.result->capture_path : ""},
+                      {"params", nlohmann::json::array()},
+                      {"verdict_shown", s.diagnosis_shown.verdict},
+                      {"effects_shown", s.diagnosis_shown.effects},
+                      {"log", s.log}};
+  auto rect = [](const PlotView& v) {
+    return nlohmann::json{v.frame.x, v.frame.y, v.frame.z, v.frame.w};
+  };
+  j["plots"] = {{"mag", rect(s.mag_view)},
+                {"phase", rect(s.phase_view)},
+                {"residual", rect(s.residual_view)},
+                {"sv", rect(s.sv_view)}};
+  if (s.result) {
+    for (const auto& p : s.result->params)
+      j["params"].push_back({{"name", p.name}, {"original", p.original}, {"updated", p.updated}});
+    if (const auto& d = s.result->diagnosis) {
+      j["diagnosis"] = {{"verdict", d->verdict},
+                        {"effects", d->effects.size()},
+                        {"added", d->added},
+                        {"regions", nlohmann::json::array()}};
+      for (const auto& g : d->regions)
+        if (g.points > 0)
+          j["diagnosis"]["regions"].push_back({{"name", g.name},
+                                               {"kind", g.kind},
+                                               {"share", g.share},
+                                               {"f_lo_hz", g.f_lo_hz},
+                                               {"f_hi_hz", g.f_hi_hz}});
+    }
+  }
+  return j;
+}
 }  // namespace
 
 int main(int argc, char** argv) {
   CLI::App cli{"piezobench-gui — Measure and update", "piezobench-gui"};
-  std::string click, screenshot, frame_stats, replay;
+  std::vector<std::string> clicks;
+  std::string screenshot, stats_file, replay, instrument = "sim", daq, sim_effects;
+  std::vector<float> hover;
   bool wait_job = false;
   double timeout_s = 0;
-  int width = 1280, height = 800;
-  cli.add_option("--click", click, "Test hook: click the button with this label once drawn");
-  cli.add_flag("--wait-job", wait_job, "Test hook: exit when the job has finished");
+  int width = 1280, height = 800, shots = 8;
+  cli.add_option("--instrument", instrument,
+                 "AWG address: sim | tcp://HOST:PORT | usbtmc://VID:PID[/SERIAL]");
+  cli.add_option("--daq", daq, "DAQ address (default: tcp PORT+1; required for usbtmc)");
+  cli.add_option("--sim-effects", sim_effects,
+                 "Effects of the simulated bench, NAME=VALUE[,NAME=VALUE...]");
+  cli.add_option("--shots", shots, "Shots in the plan")->check(CLI::PositiveNumber);
+  cli.add_option("--replay", replay, "Put this recorded capture in the plan panel for replay");
+  cli.add_option("--click", clicks, "Test hook: click these buttons in order once drawn");
+  cli.add_flag("--wait-job", wait_job, "Test hook: exit when the clicked work has finished");
+  cli.add_option("--hover", hover, "Test hook: rest the mouse at X Y after the clicks")
+      ->expected(2)
+      ->delimiter(',');
   cli.add_option("--screenshot", screenshot, "Test hook: save a PNG of the window before exiting");
-  cli.add_option("--frame-stats", frame_stats, "Test hook: write frame times during the job (JSON)");
+  cli.add_option("--frame-stats", stats_file,
+                 "Test hook: write frame times and what was shown (JSON)");
   cli.add_option("--timeout", timeout_s, "Exit with an error after this many seconds");
-  cli.add_option("--replay", replay, "Open a recorded capture for replay");
   cli.add_option("--width", width);
   cli.add_option("--height", height);
   CLI11_PARSE(cli, argc, argv);
@@ -58,7 +158,10 @@ int main(int argc, char** argv) {
     return 1;
   }
   glfwMakeContextCurrent(win);
-  glfwSwapInterval(click.empty() ? 1 : 0);  // tests measure real frame cost, not vsync
+  TestScript script(clicks,
+                    hover.size() == 2 ? std::optional(ImVec2(hover[0], hover[1])) : std::nullopt);
+  glfwSwapInterval(script.active() ? 0
+                                   : 1);  // tests measure the frame's work, not the wait for vsync
 
   IMGUI_CHECKVERSION();
   ImGui::CreateContext();
@@ -67,131 +170,98 @@ int main(int argc, char** argv) {
   ImGui_ImplGlfw_InitForOpenGL(win, true);
   ImGui_ImplOpenGL3_Init("#version 330");
 
-  AppState state;
-  state.request.plan.setup.divider_r1_ohm = 3140.0;
-  state.request.plan.samples = 20000;
-  state.request.plan.pretrigger_samples = 200;
-  state.request.plan.shots = 8;
-  // The simulated bench's tube differs from the nominal model (the seed's
-  // Table 4/5 target), so that updating has something to do.
-  state.request.sim.isotropic = true;
-  state.request.sim.set = "YE11=6.66e10,nu12=0.3333,d31=-210e-12,epsT33_rel=2294";
-  state.request.sim.noise_rel = 0.005;
-  if (!replay.empty()) std::snprintf(state.replay_path, sizeof state.replay_path, "%s", replay.c_str());
+  int rc = 0;
+  {
+    AppState state;
+    state.request.plan.setup.divider_r1_ohm = 3140.0;
+    state.request.plan.samples = 20000;
+    state.request.plan.pretrigger_samples = 200;
+    state.request.plan.shots = shots;
+    // The simulated bench's tube differs from the nominal model (the seed's
+    // Table 4/5 target), so that updating has something to do.
+    state.request.sim.isotropic = true;
+    state.request.sim.set = "YE11=6.66e10,nu12=0.3333,d31=-210e-12,epsT33_rel=2294";
+    state.request.sim.noise_rel = 0.005;
+    std::snprintf(state.instrument.awg, sizeof state.instrument.awg, "%s", instrument.c_str());
+    std::snprintf(state.instrument.daq, sizeof state.instrument.daq, "%s", daq.c_str());
+    std::snprintf(state.instrument.sim_effects, sizeof state.instrument.sim_effects, "%s",
+                  sim_effects.c_str());
+    std::snprintf(state.replay_path, sizeof state.replay_path, "%s", replay.c_str());
+    connect_instruments(state);  // on the task thread: *IDN? shows as soon as the bench answers
 
-  enum class Script { Idle, Hovering, Pressing, Releasing, Waiting, Settling, Done } script =
-      click.empty() ? Script::Idle : Script::Hovering;
-  int settle_frames = 0, rc = 0;
-  bool job_seen = false;
-  const auto t_start = std::chrono::steady_clock::now();
+    const auto t_start = std::chrono::steady_clock::now();
+    while (!glfwWindowShouldClose(win)) {
+      const auto t_frame = std::chrono::steady_clock::now();
+      glfwPollEvents();
+      ImGui_ImplOpenGL3_NewFrame();
+      ImGui_ImplGlfw_NewFrame();
+      // Scripted input goes through ImGui's IO after the backend wrote the real mouse state.
+      script.inject(ImGui::GetIO(), state);
+      ImGui::NewFrame();
+      state.button_rects.clear();  // refilled by the buttons drawn this frame
 
-  while (!glfwWindowShouldClose(win)) {
-    const auto t_frame = std::chrono::steady_clock::now();
-    glfwPollEvents();
-    ImGuiIO& io = ImGui::GetIO();
-    ImGui_ImplOpenGL3_NewFrame();
-    ImGui_ImplGlfw_NewFrame();
-    // Scripted input goes through ImGui's IO like the GLFW backend's, after the
-    // backend wrote the real mouse state: hover, press, release (a click).
-    if (script != Script::Idle && script != Script::Waiting && script != Script::Settling &&
-        script != Script::Done && state.button_rects.count(click)) {
-      ImVec4 r = state.button_rects[click];
-      io.MousePos = ImVec2(0.5f * (r.x + r.z), 0.5f * (r.y + r.w));
-      io.MouseDown[0] = script == Script::Pressing;
-      script = script == Script::Hovering ? Script::Pressing
-               : script == Script::Pressing ? Script::Releasing
-                                            : Script::Waiting;
-    }
-    ImGui::NewFrame();
+      int w = 0, h = 0;
+      glfwGetFramebufferSize(win, &w, &h);
+      collect_job(state);
+      state.tasks.drain(state);
+      render_windows(state, w, h);
+      render_calibration_prompt(state.calibration_prompt);  // "connect the standard" while the job waits
 
-    int w = 0, h = 0;
-    glfwGetFramebufferSize(win, &w, &h);
-    const float left = 380.0f;
-    ImGui::SetNextWindowPos(ImVec2(0, 0), ImGuiCond_FirstUseEver);
-    ImGui::SetNextWindowSize(ImVec2(left, h * 0.7f), ImGuiCond_FirstUseEver);
-    render_plan_window(state);
-    ImGui::SetNextWindowPos(ImVec2(0, h * 0.7f), ImGuiCond_FirstUseEver);
-    ImGui::SetNextWindowSize(ImVec2(left, h * 0.3f), ImGuiCond_FirstUseEver);
-    render_instrument_window(state);
-    ImGui::SetNextWindowPos(ImVec2(left, 0), ImGuiCond_FirstUseEver);
-    ImGui::SetNextWindowSize(ImVec2(w - left, h * 0.66f), ImGuiCond_FirstUseEver);
-    render_plots_window(state);
-    ImGui::SetNextWindowPos(ImVec2(left, h * 0.66f), ImGuiCond_FirstUseEver);
-    ImGui::SetNextWindowSize(ImVec2(w - left, h * 0.34f), ImGuiCond_FirstUseEver);
-    render_results_window(state);
-    render_calibration_prompt(state.calibration_prompt);  // issue 10: "connect the standard" while the job waits
+      ImGui::Render();
+      glViewport(0, 0, w, h);
+      glClearColor(0.08f, 0.08f, 0.1f, 1.0f);
+      glClear(GL_COLOR_BUFFER_BIT);
+      ImGui_ImplOpenGL3_RenderDrawData(ImGui::GetDrawData());
 
-    if (state.job.take(state.result, state.error)) {
-      state.mag_view.fitted = state.phase_view.fitted = state.sv_view.fitted = false;
-      state.log.push_back(state.error.empty() ? "job finished" : "job failed: " + state.error);
-      if (state.result)
-        for (const auto& st : state.result->stages)
-          state.log.push_back((st.ran ? "  ran " : "  skipped ") + st.name + ": " + st.note);
-      if (state.result) {
-        state.instrument.idn_awg = state.result->awg_idn;
-        state.instrument.idn_daq = state.result->daq_idn;
-        state.instrument.state = state.result->awg_idn.empty() ? "replay (no instrument)" : "connected";
-      } else if (!state.error.empty()) {
-        state.instrument.state = "error";
-        state.instrument.last_error = state.error;
+      if (!state.png_request.empty()) {
+        // Read back here, after rendering and before the swap (the frame is
+        // complete); compress and write on the task thread.
+        auto img = std::make_shared<Image>(read_framebuffer(w, h));
+        state.tasks.post("png", [img, path = state.png_request]() -> TaskQueue::Apply {
+          try {
+            write_png(*img, path);
+            return [path](AppState& st) { st.log.push_back("exported " + path); };
+          } catch (...) {
+            Problem pr = problem_from_current_exception("png export");
+            return [pr](AppState& st) { st.error = pr; };
+          }
+        });
+        state.png_request.clear();
+      }
+      const bool running = state.job.running();
+      const bool finished = script.done(state);
+      if (finished && !screenshot.empty()) save_framebuffer_png(screenshot, w, h);
+      glfwSwapBuffers(win);
+      // The frame time is the work of one frame (input, drawing, swap); the
+      // pacing wait below is not part of it.
+      const double ms =
+          std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t_frame)
+              .count();
+      (running && !state.frame_ms_jobs.empty() ? state.frame_ms_jobs.back() : state.frame_ms_idle)
+          .push_back(ms);
+      // Pacing: at most 60 frames/s while something runs, 10 when nothing
+      // does; input ends the wait at once. Xvfb (and some drivers) have no
+      // vsync, and an unpaced loop would take the CPU that the job needs.
+      const bool active = state.job.busy() || !state.tasks.idle() || script.active();
+      const double period_ms = active ? 1000.0 / 60 : 100.0;
+      if (ms < period_ms) glfwWaitEventsTimeout((period_ms - ms) / 1000.0);
+
+      if (finished && (wait_job || !screenshot.empty())) break;
+      if (timeout_s > 0 &&
+          std::chrono::steady_clock::now() - t_start > std::chrono::duration<double>(timeout_s)) {
+        std::fprintf(stderr, "piezobench-gui: timeout after %.0f s\n", timeout_s);
+        state.job.cancel();
+        rc = 1;
+        break;
       }
     }
 
-    ImGui::Render();
-    glViewport(0, 0, w, h);
-    glClearColor(0.08f, 0.08f, 0.1f, 1.0f);
-    glClear(GL_COLOR_BUFFER_BIT);
-    ImGui_ImplOpenGL3_RenderDrawData(ImGui::GetDrawData());
-
-    if (!state.png_request.empty()) {  // after rendering, before the swap: the frame is complete
-      try {
-        save_framebuffer_png(state.png_request, w, h);
-        state.log.push_back("exported " + state.png_request);
-      } catch (const std::exception& e) {
-        state.error = e.what();
-      }
-      state.png_request.clear();
-    }
-    const bool running = state.job.running();
-    if (running) job_seen = true;
-    if (script == Script::Waiting && job_seen && !running && !state.result && state.error.empty()) {
-      // finished this frame: the result is taken on the next frame
-    } else if (script == Script::Waiting && job_seen && !running) {
-      script = Script::Settling;
-    }
-    if (script == Script::Settling && ++settle_frames > 5) {
-      if (!screenshot.empty()) save_framebuffer_png(screenshot, w, h);
-      script = Script::Done;
-    }
-    glfwSwapBuffers(win);
-    const double ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t_frame).count();
-    if (running) state.frame_ms_during_job.push_back(ms);
-
-    if (script == Script::Done && (wait_job || !screenshot.empty())) break;
-    if (timeout_s > 0 && std::chrono::steady_clock::now() - t_start > std::chrono::duration<double>(timeout_s)) {
-      std::fprintf(stderr, "piezobench-gui: timeout after %.0f s\n", timeout_s);
-      state.job.cancel();
-      rc = 1;
-      break;
-    }
-  }
-
-  if (!frame_stats.empty()) {
-    auto v = state.frame_ms_during_job;
-    std::sort(v.begin(), v.end());
-    nlohmann::json j = {{"frames_during_job", v.size()},
-                        {"max_ms", v.empty() ? 0.0 : v.back()},
-                        {"median_ms", v.empty() ? 0.0 : v[v.size() / 2]},
-                        {"p95_ms", v.empty() ? 0.0 : v[static_cast<std::size_t>(0.95 * (v.size() - 1))]},
-                        {"error", state.error},
-                        {"capture", state.result ? state.result->capture_path : ""},
-                        {"params", nlohmann::json::array()}};
-    if (state.result)
-      for (const auto& p : state.result->params)
-        j["params"].push_back({{"name", p.name}, {"original", p.original}, {"updated", p.updated}});
-    std::ofstream(frame_stats) << j.dump(2);
-  }
-  if (!state.error.empty()) rc = rc ? rc : 2;
+    if (!stats_file.empty()) std::ofstream(stats_file) << frame_stats(state, script).dump(2);
+    if (!script.failure().empty())
+      std::fprintf(stderr, "piezobench-gui: %s\n", script.failure().c_str());
+    if (rc == 0 && !script.failure().empty()) rc = 3;
+    if (rc == 0 && state.error) rc = 2;
+  }  // the job and task threads end here, before the GL context goes
   ImGui_ImplOpenGL3_Shutdown();
   ImGui_ImplGlfw_Shutdown();
   ImGui::DestroyContext();

@@ -1,7 +1,7 @@
-// Plan panel: R1, excitation, shots, rate, record length; transducer and
-// nominal material; the "Measure and update" button with progress and Cancel.
-#include <cstring>
-
+// Plan panel: R1, excitation, shots, rate, record length; transducer id,
+// geometry and nominal material; the "Measure and update" button with
+// progress and Cancel, and the replay of a recorded capture.
+#include "model/material_presets.hpp"
 #include "ui/gui/windows.hpp"
 
 namespace piezo::gui {
@@ -18,7 +18,8 @@ void render_plan_window(AppState& s) {
   ImGui::InputDouble("R1 [ohm]", &p.setup.divider_r1_ohm, 10, 100, "%.1f");
   int kind = static_cast<int>(p.excitation.kind);
   if (kind > 3) kind = 0;
-  if (ImGui::Combo("Excitation", &kind, kKinds, 4)) p.excitation.kind = static_cast<acq::Excitation>(kind);
+  if (ImGui::Combo("Excitation", &kind, kKinds, 4))
+    p.excitation.kind = static_cast<acq::Excitation>(kind);
   ImGui::InputDouble("Amplitude [V]", &p.excitation.amplitude_v, 0.1, 1, "%.3f");
   if (p.excitation.kind == acq::Excitation::ExpDecay)
     ImGui::InputDouble("Decay [1/s]", &p.excitation.decay_per_s, 100, 1000, "%.0f");
@@ -31,41 +32,54 @@ void render_plan_window(AppState& s) {
   ImGui::InputInt("Shots", &p.shots);
   ImGui::InputDouble("Sample rate [S/s]", &p.sample_rate_hz, 1e5, 1e6, "%.3g");
   int n = static_cast<int>(p.samples);
-  if (ImGui::InputInt("Record length", &n, 1000, 10000)) p.samples = static_cast<std::size_t>(std::max(16, n));
+  if (ImGui::InputInt("Record length", &n, 1000, 10000))
+    p.samples = static_cast<std::size_t>(std::max(16, n));
   ImGui::Separator();
   ImGui::Text("Transducer and nominal model");
+  ImGui::InputTextWithHint("Transducer id", "e.g. T-017", s.transducer_id, sizeof s.transducer_id);
+  const auto& presets = model::material_presets();
+  const char* current =
+      presets.at(static_cast<std::size_t>(s.material_index) % presets.size()).name.c_str();
+  if (ImGui::BeginCombo("Nominal material", current)) {
+    for (std::size_t i = 0; i < presets.size(); ++i) {
+      if (ImGui::Selectable(presets[i].name.c_str(), static_cast<int>(i) == s.material_index))
+        s.material_index = static_cast<int>(i);
+      if (ImGui::IsItemHovered()) ImGui::SetTooltip("%s", presets[i].description.c_str());
+    }
+    ImGui::EndCombo();
+  }
   auto g = p.setup.geometry();
   double di = g.inner_diameter_m * 1e3, dout = g.outer_diameter_m * 1e3, len = g.length_m * 1e3;
-  if (ImGui::InputDouble("Inner diameter [mm]", &di, 0.1, 1, "%.3f")) p.setup.inner_diameter_m = di * 1e-3;
-  if (ImGui::InputDouble("Outer diameter [mm]", &dout, 0.1, 1, "%.3f")) p.setup.outer_diameter_m = dout * 1e-3;
+  if (ImGui::InputDouble("Inner diameter [mm]", &di, 0.1, 1, "%.3f"))
+    p.setup.inner_diameter_m = di * 1e-3;
+  if (ImGui::InputDouble("Outer diameter [mm]", &dout, 0.1, 1, "%.3f"))
+    p.setup.outer_diameter_m = dout * 1e-3;
   if (ImGui::InputDouble("Length [mm]", &len, 0.1, 1, "%.3f")) p.setup.length_m = len * 1e-3;
   ImGui::Checkbox("Isotropic model class (seed §6.4.3)", &s.request.isotropic);
   ImGui::InputText("Capture file", s.capture_out, sizeof s.capture_out);
-  ImGui::InputText("Replay capture (optional)", s.replay_path, sizeof s.replay_path);
   ImGui::EndDisabled();
   render_calibration_controls(s.calibration, busy);  // issue 10
   ImGui::Separator();
 
+  const bool connecting = s.instrument.state == InstrumentForm::State::Connecting;
   if (!busy) {
-    if (tracked_button(s, "Measure and update", ImVec2(-1, 48))) {
-      ui::PipelineRequest req = s.request;  // committed copy: edits during the run do not leak in
-      req.instrument = s.instrument.awg;
-      req.daq = s.instrument.daq;
-      req.capture_out = s.capture_out;
-      req.replay_capture = s.replay_path;
-      attach_calibration(s.calibration, s.calibration_prompt, req);  // issue 10
-      s.error.clear();
-      s.frame_ms_during_job.clear();
-      s.job.start(req);
-      s.log.push_back(req.replay_capture.empty() ? "measure and update started" : "replay started");
-    }
+    ImGui::BeginDisabled(connecting);
+    if (tracked_button(s, "Measure and update", ImVec2(-1, 48))) start_job(s, false);
+    ImGui::TextWrapped("Or open a recorded capture and run it through the same steps:");
+    ImGui::SetNextItemWidth(ImGui::GetContentRegionAvail().x - 130);
+    ImGui::InputTextWithHint("##replay", "capture.h5", s.replay_path, sizeof s.replay_path);
+    ImGui::SameLine();
+    if (tracked_button(s, "Replay capture", ImVec2(-1, 0))) start_job(s, true);
+    ImGui::EndDisabled();
   } else {
     ImGui::ProgressBar(s.job.progress(), ImVec2(-1, 24), s.job.stage().c_str());
     if (tracked_button(s, "Cancel", ImVec2(-1, 0))) s.job.cancel();
+    if (s.job.cancel_requested()) ImGui::TextDisabled("cancelling after the current step...");
   }
-  if (!s.error.empty()) {
+  if (s.error || !s.warnings.empty()) {
     ImGui::PushStyleColor(ImGuiCol_Text, ImVec4(1, 0.45f, 0.45f, 1));
-    ImGui::TextWrapped("%s", s.error.c_str());
+    ImGui::TextWrapped("%s: see Results for what to do.",
+                       s.error ? "The last run failed" : "The last run needs attention");
     ImGui::PopStyleColor();
   }
   ImGui::End();

@@ -4,6 +4,8 @@
 #include <cmath>
 #include <cstdio>
 
+#include "ui/gui/palette.hpp"
+
 namespace piezo::gui {
 
 namespace {
@@ -32,8 +34,10 @@ std::vector<double> ticks(double a, double b, bool log) {
 std::string fmt(double v) {
   char buf[32];
   double a = std::fabs(v);
-  if (a != 0 && (a >= 1e5 || a < 1e-2)) std::snprintf(buf, sizeof buf, "%.3g", v);
-  else std::snprintf(buf, sizeof buf, "%.4g", v);
+  if (a != 0 && (a >= 1e5 || a < 1e-2))
+    std::snprintf(buf, sizeof buf, "%.3g", v);
+  else
+    std::snprintf(buf, sizeof buf, "%.4g", v);
   return buf;
 }
 }  // namespace
@@ -72,20 +76,26 @@ void fit_view(const PlotSpec& spec, PlotView& view) {
 bool plot(const char* id, const PlotSpec& spec, PlotView& view, ImVec2 size) {
   if (!view.fitted) fit_view(spec, view);
   ImGui::PushID(id);
-  ImGui::BeginChild("plot", size, true, ImGuiWindowFlags_NoScrollbar | ImGuiWindowFlags_NoScrollWithMouse);
+  ImGui::BeginChild("plot", size, true,
+                    ImGuiWindowFlags_NoScrollbar | ImGuiWindowFlags_NoScrollWithMouse);
   ImDrawList* dl = ImGui::GetWindowDrawList();
   const ImVec2 p0 = ImGui::GetCursorScreenPos();
   const ImVec2 avail = ImGui::GetContentRegionAvail();
   const float left = 64, bottom = 36, top = 22, right = 10;
   const ImVec2 a(p0.x + left, p0.y + top), b(p0.x + avail.x - right, p0.y + avail.y - bottom);
+  view.frame = ImVec4(a.x, a.y, b.x, b.y);
   ImGui::InvisibleButton("canvas", avail);
   const bool hovered = ImGui::IsItemHovered();
   const ImGuiIO& io = ImGui::GetIO();
 
   double X0 = fwd(view.x0, view.log_x), X1 = fwd(view.x1, view.log_x);
   double Y0 = fwd(view.y0, view.log_y), Y1 = fwd(view.y1, view.log_y);
-  auto sx = [&](double x) { return a.x + static_cast<float>((fwd(x, view.log_x) - X0) / (X1 - X0)) * (b.x - a.x); };
-  auto sy = [&](double y) { return b.y - static_cast<float>((fwd(y, view.log_y) - Y0) / (Y1 - Y0)) * (b.y - a.y); };
+  auto sx = [&](double x) {
+    return a.x + static_cast<float>((fwd(x, view.log_x) - X0) / (X1 - X0)) * (b.x - a.x);
+  };
+  auto sy = [&](double y) {
+    return b.y - static_cast<float>((fwd(y, view.log_y) - Y0) / (Y1 - Y0)) * (b.y - a.y);
+  };
 
   // Interaction: wheel zooms about the cursor, drag pans, double-click fits.
   if (hovered && io.MouseWheel != 0) {
@@ -123,50 +133,104 @@ bool plot(const char* id, const PlotSpec& spec, PlotView& view, ImVec2 size) {
   view.y1 = inv(Y1, view.log_y);
 
   // Frame, grid, ticks.
-  dl->AddRectFilled(a, b, IM_COL32(20, 22, 28, 255));
+  dl->AddRectFilled(a, b, kColPlotBg);
   const ImU32 grid = IM_COL32(70, 75, 90, 255), text = IM_COL32(200, 200, 210, 255);
-  for (double t : ticks(X0, X1, view.log_x)) {
+  // Tick labels that would overlap are left out; on a log axis the decades
+  // are labelled first, the 2…9 multiples only where there is room.
+  std::vector<std::pair<float, float>> taken;  // occupied label extents along the axis
+  auto place_label = [&](float centre, float extent, float gap) {
+    const float lo = centre - 0.5f * extent - gap, hi = centre + 0.5f * extent + gap;
+    for (const auto& [l, h] : taken)
+      if (lo < h && hi > l) return false;
+    taken.emplace_back(lo, hi);
+    return true;
+  };
+  auto is_decade = [](double t) { return std::fabs(t - std::round(t)) < 1e-9; };
+  const auto xt = ticks(X0, X1, view.log_x), yt = ticks(Y0, Y1, view.log_y);
+  for (double t : xt) {
     float x = a.x + static_cast<float>((t - X0) / (X1 - X0)) * (b.x - a.x);
     dl->AddLine(ImVec2(x, a.y), ImVec2(x, b.y), grid);
-    dl->AddText(ImVec2(x - 14, b.y + 4), text, fmt(inv(t, view.log_x)).c_str());
   }
-  for (double t : ticks(Y0, Y1, view.log_y)) {
+  for (int pass = 0; pass < 2; ++pass)
+    for (double t : xt) {
+      if (view.log_x && (pass == 0) != is_decade(t)) continue;
+      if (!view.log_x && pass == 1) continue;
+      const float x = a.x + static_cast<float>((t - X0) / (X1 - X0)) * (b.x - a.x);
+      const std::string label = fmt(inv(t, view.log_x));
+      const float w = ImGui::CalcTextSize(label.c_str()).x;
+      if (place_label(x, w, 4)) dl->AddText(ImVec2(x - 0.5f * w, b.y + 4), text, label.c_str());
+    }
+  taken.clear();
+  for (double t : yt) {
     float y = b.y - static_cast<float>((t - Y0) / (Y1 - Y0)) * (b.y - a.y);
     dl->AddLine(ImVec2(a.x, y), ImVec2(b.x, y), grid);
-    dl->AddText(ImVec2(p0.x + 2, y - 7), text, fmt(inv(t, view.log_y)).c_str());
   }
-  dl->AddText(ImVec2(a.x, p0.y + 2), text, spec.title.c_str());
-  dl->AddText(ImVec2(b.x - ImGui::CalcTextSize(spec.x_label.c_str()).x, b.y + 18), text, spec.x_label.c_str());
+  for (int pass = 0; pass < 2; ++pass)
+    for (double t : yt) {
+      if (view.log_y && (pass == 0) != is_decade(t)) continue;
+      if (!view.log_y && pass == 1) continue;
+      const float y = b.y - static_cast<float>((t - Y0) / (Y1 - Y0)) * (b.y - a.y);
+      if (place_label(y, ImGui::GetTextLineHeight(), 1))
+        dl->AddText(ImVec2(p0.x + 2, y - 7), text, fmt(inv(t, view.log_y)).c_str());
+    }
+  // Title centred over the frame, the y label at the top left (they overlap
+  // when both sit at the left edge and the y label is long).
+  const float title_w = ImGui::CalcTextSize(spec.title.c_str()).x;
+  dl->AddText(ImVec2(0.5f * (a.x + b.x - title_w), p0.y + 2), text, spec.title.c_str());
+  dl->AddText(ImVec2(b.x - ImGui::CalcTextSize(spec.x_label.c_str()).x, b.y + 18), text,
+              spec.x_label.c_str());
   dl->AddText(ImVec2(p0.x + 2, p0.y + 2), text, spec.y_label.c_str());
 
   dl->PushClipRect(a, b, true);
   for (const auto& band : spec.bands) {
     float xa = sx(band.x0), xb = sx(band.x1);
     dl->AddRectFilled(ImVec2(xa, a.y), ImVec2(xb, b.y), band.color);
-    if (!band.label.empty()) dl->AddText(ImVec2(xa + 2, a.y + 2), text, band.label.c_str());
+    if (!band.label.empty() && ImGui::CalcTextSize(band.label.c_str()).x + 4 < xb - xa)
+      dl->AddText(ImVec2(xa + 2, b.y - 16), text, band.label.c_str());
   }
   for (const auto& m : spec.markers) {
     float x = sx(m.x);
     dl->AddLine(ImVec2(x, a.y), ImVec2(x, b.y), m.color, 1.0f);
   }
+  // Lines keep a vertex only once it is a pixel away from the last one kept:
+  // the frequency grids are denser than the screen, and every triangle costs
+  // a software rasteriser (llvmpipe under Xvfb) setup time. Points are small
+  // squares for the same reason (a filled circle is a dozen triangles).
   std::vector<ImVec2> pts;
   for (const auto& s : spec.series) {
     pts.clear();
     for (std::size_t i = 0; i < s.x.size() && i < s.y.size(); ++i) {
-      if ((view.log_x && s.x[i] <= 0) || (view.log_y && s.y[i] <= 0) || !std::isfinite(s.y[i])) continue;
-      pts.emplace_back(sx(s.x[i]), sy(s.y[i]));
+      if ((view.log_x && s.x[i] <= 0) || (view.log_y && s.y[i] <= 0) || !std::isfinite(s.y[i]))
+        continue;
+      const ImVec2 p(sx(s.x[i]), sy(s.y[i]));
+      const bool last = i + 1 == std::min(s.x.size(), s.y.size());
+      if (!s.points && !last && !pts.empty() && std::fabs(p.x - pts.back().x) < 1.0f &&
+          std::fabs(p.y - pts.back().y) < 1.0f)
+        continue;
+      pts.push_back(p);
     }
     if (s.points) {
-      for (const auto& p : pts) dl->AddCircleFilled(p, 2.5f, s.color);
+      for (const auto& p : pts)
+        dl->AddRectFilled(ImVec2(p.x - 2, p.y - 2), ImVec2(p.x + 2, p.y + 2), s.color);
     } else if (pts.size() > 1) {
       dl->AddPolyline(pts.data(), static_cast<int>(pts.size()), s.color, 0, s.thickness);
     }
   }
   dl->PopClipRect();
 
-  // Legend.
-  float ly = a.y + 4;
+  // Legend, on a translucent backing so that it stays readable over curves.
+  float ly = a.y + 4, legend_w = 0;
+  int listed = 0;
+  for (const auto& s : spec.series)
+    if (s.listed) {
+      legend_w = std::max(legend_w, ImGui::CalcTextSize(s.label.c_str()).x);
+      ++listed;
+    }
+  if (listed > 0)
+    dl->AddRectFilled(ImVec2(b.x - legend_w - 32, ly - 2), ImVec2(b.x - 2, ly + 16.0f * listed + 2),
+                      (kColPlotBg & ~IM_COL32_A_MASK) | IM_COL32(0, 0, 0, 200));
   for (const auto& s : spec.series) {
+    if (!s.listed) continue;
     float w = ImGui::CalcTextSize(s.label.c_str()).x;
     dl->AddRectFilled(ImVec2(b.x - w - 28, ly + 3), ImVec2(b.x - w - 14, ly + 11), s.color);
     dl->AddText(ImVec2(b.x - w - 8, ly), text, s.label.c_str());
@@ -174,17 +238,30 @@ bool plot(const char* id, const PlotSpec& spec, PlotView& view, ImVec2 size) {
   }
 
   // Hover read-out: cursor position and the nearest point of each series.
-  if (hovered && io.MousePos.x >= a.x && io.MousePos.x <= b.x && io.MousePos.y >= a.y && io.MousePos.y <= b.y) {
+  if (hovered && io.MousePos.x >= a.x && io.MousePos.x <= b.x && io.MousePos.y >= a.y &&
+      io.MousePos.y <= b.y) {
     double cx = inv(X0 + (io.MousePos.x - a.x) / (b.x - a.x) * (X1 - X0), view.log_x);
-    dl->AddLine(ImVec2(io.MousePos.x, a.y), ImVec2(io.MousePos.x, b.y), IM_COL32(255, 255, 255, 60));
+    dl->AddLine(ImVec2(io.MousePos.x, a.y), ImVec2(io.MousePos.x, b.y),
+                IM_COL32(255, 255, 255, 60));
     ImGui::BeginTooltip();
     ImGui::Text("%s = %s", spec.x_label.c_str(), fmt(cx).c_str());
     for (const auto& s : spec.series) {
-      if (s.x.empty()) continue;
+      // The nearest sample in x, and only inside the series' own x range (a
+      // curve that ends at 120 kHz has no value to read at 200 kHz).
+      if (!s.listed || s.x.empty() || s.y.size() < s.x.size() || cx < s.x.front() ||
+          cx > s.x.back())
+        continue;
       auto it = std::lower_bound(s.x.begin(), s.x.end(), cx);
-      std::size_t i = std::min<std::size_t>(static_cast<std::size_t>(it - s.x.begin()), s.x.size() - 1);
-      ImGui::TextColored(ImGui::ColorConvertU32ToFloat4(s.color), "%s: %s", s.label.c_str(), fmt(s.y[i]).c_str());
+      std::size_t i =
+          std::min<std::size_t>(static_cast<std::size_t>(it - s.x.begin()), s.x.size() - 1);
+      if (i > 0 && cx - s.x[i - 1] < s.x[i] - cx) --i;
+      ImGui::TextColored(ImGui::ColorConvertU32ToFloat4(s.color), "%s: %s", s.label.c_str(),
+                         fmt(s.y[i]).c_str());
     }
+    for (const auto& band : spec.bands)
+      if (!band.detail.empty() && cx >= std::min(band.x0, band.x1) &&
+          cx <= std::max(band.x0, band.x1))
+        ImGui::TextUnformatted(band.detail.c_str());
     ImGui::EndTooltip();
   }
   ImGui::EndChild();

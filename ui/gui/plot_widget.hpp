@@ -17,6 +17,8 @@ struct Series {
   ImU32 color = IM_COL32(255, 255, 255, 255);
   float thickness = 1.5f;
   bool points = false;  // draw markers instead of a line
+  bool listed =
+      true;  // in the legend and the hover read-out (false: e.g. the lower half of a ±band)
 };
 
 struct Marker {
@@ -27,13 +29,15 @@ struct Marker {
 struct Band {
   double x0 = 0, x1 = 0;
   ImU32 color = IM_COL32(255, 255, 0, 40);
-  std::string label;
+  std::string label;   // drawn inside the band when it fits
+  std::string detail;  // added to the hover read-out while the cursor is in the band
 };
 
 struct PlotView {
   bool log_x = true, log_y = false;
   double x0 = 1, x1 = 10, y0 = 0, y1 = 1;  // visible range (data units)
-  bool fitted = false;  // fit to data on the next draw
+  bool fitted = false;                     // fit to data on the next draw
+  ImVec4 frame{0, 0, 0, 0};  // where plot() drew the data area last (x0, y0, x1, y1; screen pixels)
 };
 
 struct PlotSpec {

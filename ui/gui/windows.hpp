@@ -1,6 +1,8 @@
 #pragma once
-// One window per file, each a render(AppState&) that only draws and edits state.
+// One window per file, each a render(AppState&) that only draws and edits
+// state; the work behind a button goes through actions (app_state.hpp).
 #include "ui/gui/app_state.hpp"
+#include "ui/gui/palette.hpp"
 
 namespace piezo::gui {
 
@@ -8,15 +10,12 @@ void render_instrument_window(AppState& s);
 void render_plan_window(AppState& s);
 void render_plots_window(AppState& s);
 void render_results_window(AppState& s);
+void render_diagnosis_window(AppState& s);
 
 // A button whose screen rectangle is recorded under its label (scripted tests click it).
 bool tracked_button(AppState& s, const char* label, ImVec2 size = ImVec2(0, 0));
 
-// Plot colours shared by the windows and the GUI test's pixel checks.
-inline constexpr ImU32 kColMeasured = IM_COL32(255, 200, 40, 255);   // amber
-inline constexpr ImU32 kColOriginal = IM_COL32(80, 160, 255, 255);   // blue
-inline constexpr ImU32 kColUpdated = IM_COL32(60, 220, 120, 255);    // green
-inline constexpr ImU32 kColFft = IM_COL32(200, 120, 255, 255);       // violet
-inline constexpr ImU32 kColXspec = IM_COL32(255, 110, 110, 255);     // red
+// A problem in red with its advice below it (error_advice.hpp).
+void show_problem(const Problem& p);
 
 }  // namespace piezo::gui

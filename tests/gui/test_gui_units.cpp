@@ -1,0 +1,172 @@
+// The GUI's parts that need no window: how errors are classified and what the
+// technician is told to do (error_advice), the residual plot built from a gap
+// diagnosis (residual_plot), and the task queue that keeps exports and the
+// instrument probe off the frame loop.
+#include <gtest/gtest.h>
+
+#include <atomic>
+#include <chrono>
+#include <stdexcept>
+#include <thread>
+
+#include "acquisition/capture.hpp"
+#include "drivers/scpi_client.hpp"
+#include "drivers/transport.hpp"
+#include "ui/gui/app_state.hpp"
+#include "ui/gui/error_advice.hpp"
+#include "ui/gui/palette.hpp"
+#include "ui/gui/residual_plot.hpp"
+
+using namespace piezo;
+using namespace piezo::gui;
+
+namespace {
+template <class E>
+Problem classify(const E& e, const std::string& stage) {
+  try {
+    throw e;
+  } catch (...) {
+    return problem_from_current_exception(stage);
+  }
+}
+}  // namespace
+
+TEST(ErrorAdvice, ClassifiesByExceptionType) {
+  using drivers::TransportError;
+  const auto conn = classify(
+      TransportError(TransportError::Kind::Io, "tcp://10.0.0.5:5025: cannot connect"), "connect");
+  EXPECT_EQ(conn.kind, ErrorKind::Connection);
+  EXPECT_EQ(conn.message, "tcp://10.0.0.5:5025: cannot connect");
+  EXPECT_EQ(conn.stage, "connect");
+  EXPECT_NE(conn.advice.find("PORT+1"), std::string::npos) << conn.advice;
+
+  const auto inst =
+      classify(drivers::InstrumentError("-222,\"Data out of range\""), "acquire: shot 1/8");
+  EXPECT_EQ(inst.kind, ErrorKind::Instrument);
+  EXPECT_NE(inst.advice.find("limits"), std::string::npos) << inst.advice;
+
+  const auto file =
+      classify(acq::CaptureError("x.h5", "/", "not a readable HDF5 file"), "open capture");
+  EXPECT_EQ(file.kind, ErrorKind::File);
+  EXPECT_NE(file.advice.find("piezo-capture/1"), std::string::npos) << file.advice;
+
+  // Bad input: the advice depends on where it was typed.
+  const auto addr = classify(std::invalid_argument("unknown scheme"), "connect");
+  const auto plan = classify(std::invalid_argument("shots must be > 0"), "acquire: shot 0/0");
+  EXPECT_EQ(addr.kind, ErrorKind::Input);
+  EXPECT_NE(addr.advice.find("usbtmc://"), std::string::npos) << addr.advice;
+  EXPECT_NE(plan.advice.find("plan"), std::string::npos) << plan.advice;
+
+  const auto other =
+      classify(std::runtime_error("update: the estimate has no low-frequency capacitance"),
+               "update: extended CMCM");
+  EXPECT_EQ(other.kind, ErrorKind::Other);
+  EXPECT_NE(other.advice.find("geometry"), std::string::npos) << other.advice;
+}
+
+TEST(ErrorAdvice, ResultProblemsNeedAction) {
+  ui::PipelineResult ok;
+  ok.stages = {
+      {"acquire", true, ""}, {"estimate", true, ""}, {"update", true, ""}, {"diagnose", true, ""}};
+  EXPECT_TRUE(result_problems(ok).empty());
+
+  ui::PipelineResult r;
+  r.stages = {{"update", false, "extended CMCM did NOT converge"},
+              {"diagnose", false, "failed: needs at least 3 repeated shots"}};
+  r.warnings = {"cancelled during acquisition; kept 2 shot(s)", "overlay estimators: too short"};
+  const auto p = result_problems(r);
+  ASSERT_EQ(p.size(), 3u);
+  for (const auto& x : p) {
+    EXPECT_EQ(x.kind, ErrorKind::Attention);
+    EXPECT_FALSE(x.advice.empty());
+  }
+  EXPECT_EQ(p[0].stage, "update");
+  EXPECT_EQ(p[1].stage, "diagnose");
+  EXPECT_NE(p[1].advice.find("Shots"), std::string::npos) << p[1].advice;
+  EXPECT_EQ(p[2].stage, "acquire");
+  // "diagnose: not requested" is a choice, not a problem.
+  ui::PipelineResult skipped;
+  skipped.stages = {{"diagnose", false, "not requested"}};
+  EXPECT_TRUE(result_problems(skipped).empty());
+}
+
+TEST(ResidualPlot, RegionsShadedByKindAndCurvesInKhz) {
+  update::GapDiagnosis d;
+  d.before.f_hz = {1e3, 2e3, 50e3};
+  d.before.residual_db = {0.1, -0.2, 1.5};
+  d.before.residual_deg = {1, 2, 3};
+  d.before.sigma_db = {0.05, 0.05, 0.5};
+  d.before.sigma_deg = {0.5, 0.5, 0.5};
+  d.after = d.before;
+  update::GapRegion cap;
+  cap.name = "capacitive band";
+  cap.f_lo_hz = 1e3;
+  cap.f_hi_hz = 40e3;
+  cap.points = 10;
+  cap.kind = "phase";
+  cap.share = 0.6;
+  update::GapRegion res = cap;
+  res.name = "resonance 1";
+  res.f_lo_hz = 40e3;
+  res.f_hi_hz = 60e3;
+  res.kind = "frequency shift";
+  res.shift_pct = 0.12;
+  update::GapRegion empty = cap;
+  empty.points = 0;  // no measured frequency in it: not drawn
+  d.regions = {cap, res, empty};
+
+  auto spec = residual_plot_spec(d, false);
+  ASSERT_EQ(spec.bands.size(), 2u);
+  EXPECT_EQ(spec.bands[0].color, kColRegionPhase);
+  EXPECT_EQ(spec.bands[1].color, kColRegionShift);
+  EXPECT_DOUBLE_EQ(spec.bands[1].x0, 40.0);  // kHz
+  EXPECT_NE(spec.bands[1].detail.find("+0.120 %"), std::string::npos) << spec.bands[1].detail;
+  // ±2σ (one listed, one not) and the base residual; no added effect, no second residual.
+  ASSERT_EQ(spec.series.size(), 3u);
+  EXPECT_DOUBLE_EQ(spec.series[0].y[2], 1.0);
+  EXPECT_DOUBLE_EQ(spec.series[1].y[2], -1.0);
+  EXPECT_FALSE(spec.series[1].listed);
+  EXPECT_EQ(spec.series[2].color, kColResidual);
+  EXPECT_DOUBLE_EQ(spec.series[2].x[2], 50.0);
+  EXPECT_DOUBLE_EQ(spec.series[2].y[1], -0.2);
+
+  d.added = {"series_resistance"};
+  spec = residual_plot_spec(d, true);
+  ASSERT_EQ(spec.series.size(), 4u);
+  EXPECT_EQ(spec.series[3].color, kColResidualAfter);
+  EXPECT_NE(spec.series[3].label.find("series_resistance"), std::string::npos);
+  EXPECT_DOUBLE_EQ(spec.series[2].y[2], 3.0);  // phase, degrees
+  EXPECT_EQ(spec.y_label, "deg");
+}
+
+TEST(Palette, BlendOverMatchesGlBlending) {
+  // 110/255 of orange over the plot background, per channel: bg + (fg − bg)·α.
+  const Rgb c = blend_over(kColRegionShift, kColPlotBg);
+  EXPECT_EQ(c.r, 20 + (255 - 20) * 110 / 255);
+  EXPECT_EQ(c.g, 22 + (150 - 22) * 110 / 255);
+  EXPECT_EQ(c.b, 28 + (0 - 28) * 110 / 255);
+}
+
+TEST(TaskQueue, RunsInOrderOffTheCallerAndAppliesOnDrain) {
+  AppState s;  // owns a TaskQueue; no window needed
+  const auto caller = std::this_thread::get_id();
+  std::atomic<bool> off_caller{true};
+  for (int i = 0; i < 5; ++i)
+    s.tasks.post("task " + std::to_string(i), [i, caller, &off_caller]() -> TaskQueue::Apply {
+      if (std::this_thread::get_id() == caller) off_caller = false;
+      return [i](AppState& st) { st.log.push_back("applied " + std::to_string(i)); };
+    });
+  s.tasks.post("throws", []() -> TaskQueue::Apply { throw std::runtime_error("disk full"); });
+  // Nothing reaches the state before drain().
+  EXPECT_TRUE(s.log.empty());
+  for (int k = 0; k < 500 && !s.tasks.idle(); ++k) {
+    s.tasks.drain(s);
+    std::this_thread::sleep_for(std::chrono::milliseconds(2));
+  }
+  ASSERT_TRUE(s.tasks.idle());
+  EXPECT_TRUE(off_caller);
+  ASSERT_EQ(s.log.size(), 6u);
+  for (int i = 0; i < 5; ++i)
+    EXPECT_EQ(s.log[static_cast<std::size_t>(i)], "applied " + std::to_string(i));
+  EXPECT_EQ(s.log[5], "throws failed: disk full");
+}

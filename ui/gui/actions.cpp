@@ -1,0 +1,174 @@
+// What the buttons do: start or replay a job, connect to the instruments,
+// export. Each hands its work to the Job or TaskQueue thread and returns at
+// once; outcomes come back into the AppState on the UI thread.
+#include <sstream>
+
+#include "model/effects.hpp"
+#include "model/material_presets.hpp"
+#include "ui/bench_probe.hpp"
+#include "ui/gui/app_state.hpp"
+#include "ui/gui/calibration_prompt.hpp"
+#include "ui/report_export.hpp"
+
+namespace piezo::gui {
+
+namespace {
+// "series_resistance=15, channel_skew=1e-7" → an EffectSet; throws
+// std::invalid_argument naming the bad item (model/effects.hpp).
+model::EffectSet parse_sim_effects(const std::string& text) {
+  model::EffectSet set;
+  std::stringstream ss(text);
+  std::string item;
+  while (std::getline(ss, item, ',')) {
+    const auto b = item.find_first_not_of(" \t"), e = item.find_last_not_of(" \t");
+    if (b == std::string::npos) continue;
+    model::apply_effect_assignment(set, item.substr(b, e - b + 1));
+  }
+  return set;
+}
+
+// The simulated bench's spec with the panel's effects; throws like parse_sim_effects.
+acq::SimSpec sim_spec(const AppState& s) {
+  acq::SimSpec sim = s.request.sim;
+  sim.effects = parse_sim_effects(s.instrument.sim_effects);
+  return sim;
+}
+}  // namespace
+
+void start_job(AppState& s, bool replay) {
+  if (s.job.running()) return;
+  ui::PipelineRequest req = s.request;  // committed copy: edits during the run do not leak in
+  req.instrument = s.instrument.awg;
+  req.daq = s.instrument.daq;
+  req.capture_out = s.capture_out;
+  const auto& presets = model::material_presets();
+  req.material = presets.at(static_cast<std::size_t>(s.material_index) % presets.size()).name;
+  req.plan.setup.material = req.material;
+  if (s.transducer_id[0]) req.plan.setup.transducer_id = std::string(s.transducer_id);
+  s.error.reset();
+  s.warnings.clear();
+  if (replay) {
+    req.replay_capture = s.replay_path;
+    if (req.replay_capture.empty()) {
+      s.error = Problem{ErrorKind::Input, "open capture", "no capture file given",
+                        "Type the path of a recorded capture (.h5) next to 'Replay capture'."};
+      return;
+    }
+  } else if (req.instrument == "sim") {
+    try {
+      req.sim = sim_spec(s);
+    } catch (...) {
+      s.error = problem_from_current_exception("simulated effects");
+      return;
+    }
+  }
+  if (!replay) attach_calibration(s.calibration, s.calibration_prompt, req);  // fixture standards first
+  if (!s.job.start(req)) return;
+  ++s.jobs_started;
+  s.frame_ms_jobs.emplace_back();
+  s.instrument.before_job = s.instrument.state;
+  if (!replay) s.instrument.state = InstrumentForm::State::Measuring;
+  s.log.push_back(replay ? "replay of " + req.replay_capture + " started"
+                         : "measure and update started on " + req.instrument);
+}
+
+bool collect_job(AppState& s) {
+  std::unique_ptr<ui::PipelineResult> res;
+  std::optional<Problem> problem;
+  const bool cancelled = s.job.cancel_requested();
+  if (!s.job.take(res, problem)) return false;
+  s.result = std::move(res);
+  s.error = std::move(problem);
+  s.warnings.clear();
+  s.mag_view.fitted = s.phase_view.fitted = s.sv_view.fitted = s.residual_view.fitted = false;
+  auto& in = s.instrument;
+  if (s.error) {
+    s.log.push_back("job failed at " + s.error->stage + ": " + s.error->message);
+    if (s.error->kind == ErrorKind::Connection || s.error->kind == ErrorKind::Instrument) {
+      in.state = InstrumentForm::State::Error;
+      in.problem = s.error;
+    } else if (in.state == InstrumentForm::State::Measuring) {
+      in.state = in.before_job;
+    }
+    return true;
+  }
+  const auto& r = *s.result;
+  s.log.push_back(cancelled ? "job cancelled" : "job finished");
+  for (const auto& st : r.stages)
+    s.log.push_back((st.ran ? "  ran " : "  skipped ") + st.name + ": " + st.note);
+  for (const auto& w : r.warnings) s.log.push_back("  warning: " + w);
+  s.warnings = result_problems(r);
+  if (r.awg_idn.empty()) {
+    in.state = InstrumentForm::State::Replay;
+  } else {
+    in.state = InstrumentForm::State::Connected;
+    in.idn_awg = r.awg_idn;
+    in.idn_daq = r.daq_idn;
+    in.problem.reset();
+  }
+  return true;
+}
+
+void connect_instruments(AppState& s) {
+  const std::string awg = s.instrument.awg, daq = s.instrument.daq;
+  const double r1 = s.request.plan.setup.divider_r1_ohm;
+  acq::SimSpec sim;
+  try {
+    if (awg == "sim") sim = sim_spec(s);
+  } catch (...) {
+    s.instrument.state = InstrumentForm::State::Error;
+    s.instrument.problem = problem_from_current_exception("simulated effects");
+    return;
+  }
+  s.instrument.state = InstrumentForm::State::Connecting;
+  s.instrument.problem.reset();
+  s.tasks.post("connect", [awg, daq, sim, r1]() -> TaskQueue::Apply {
+    try {
+      const ui::BenchProbe p = ui::probe_bench(awg, daq, sim, r1);
+      return [p](AppState& st) {
+        auto& in = st.instrument;
+        in.state = InstrumentForm::State::Connected;
+        in.idn_awg = p.awg_idn;
+        in.idn_daq = p.daq_idn;
+        in.description = p.description;
+        st.log.push_back("connected: " + p.description);
+      };
+    } catch (...) {
+      Problem pr = problem_from_current_exception("connect");
+      return [pr](AppState& st) {
+        auto& in = st.instrument;
+        in.state = InstrumentForm::State::Error;
+        in.idn_awg.clear();
+        in.idn_daq.clear();
+        in.problem = pr;
+        st.log.push_back("connect failed: " + pr.message);
+      };
+    }
+  });
+}
+
+void export_result(AppState& s, ExportFormat f) {
+  if (!s.result) return;
+  const std::string base = s.export_base;
+  const char* ext = f == ExportFormat::Csv          ? ".csv"
+                    : f == ExportFormat::Touchstone ? ".s1p"
+                                                    : ".json";
+  const std::string path = base + ext;
+  std::shared_ptr<const ui::PipelineResult> r = s.result;
+  s.tasks.post("export " + path, [r, f, path]() -> TaskQueue::Apply {
+    try {
+      if (f == ExportFormat::Csv) ui::export_csv(*r, path);
+      if (f == ExportFormat::Touchstone) ui::export_touchstone(*r, path);
+      if (f == ExportFormat::Json) ui::export_json(*r, path);
+      return [path](AppState& st) { st.log.push_back("exported " + path); };
+    } catch (...) {
+      Problem pr = problem_from_current_exception("export");
+      return [pr](AppState& st) {
+        st.error = pr;
+        st.log.push_back("export failed: " + pr.message);
+      };
+    }
+  });
+}
+
+}  // namespace piezo::gui
