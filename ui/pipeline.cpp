@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <filesystem>
 #include <map>
 
@@ -20,6 +21,7 @@
 #include "model/material_spec.hpp"
 #include "model/modal.hpp"
 #include "model/tube_model.hpp"
+#include "update/least_squares.hpp"
 #include "update/port_fit.hpp"
 #include "update/rayleigh.hpp"
 #include "update/updater.hpp"
@@ -341,12 +343,30 @@ UpdateOutcome update_stage(const PipelineRequest& req, const acq::Capture& cap, 
   uo.max_sweeps = 40;
   uo.sweep_tolerance = 1e-6;
   auto r = update::update_cmcm(tube, solver, cls, p0, feat, uo);
-  char note[200];
+  char note[480];
   std::snprintf(note, sizeof note, "extended CMCM %s: %d elastic + %d piezo iterations in %d sweeps, %.2f s%s",
                 r.ok() ? "converged" : "did NOT converge", r.iterations_elastic, r.iterations_piezo, r.sweeps,
                 r.seconds, r.ok() ? "" : (": " + r.message).c_str());
-  out.stages.push_back({"update", r.ok(), note});
-  if (!r.ok()) {
+  update::TubeParams updated = r.updated;
+  bool ok = r.ok();
+  if (!ok) {
+    // Second, independent updater on the same features (update/least_squares.hpp):
+    // no mode-shape pairing, so a start far from the answer (mode veering, an
+    // ambiguous MAC) does not stop it. Its answer is checked like CMCM's.
+    const auto lm = update::update_lm(tube, solver, cls, p0, feat);
+    char lm_note[240];
+    std::snprintf(lm_note, sizeof lm_note, "; least squares (LM) %s in %d iterations, %.2f s%s",
+                  lm.ok() ? "converged" : "did NOT converge", lm.iterations, lm.seconds,
+                  lm.ok() ? " - its result is used" : (": " + lm.message).c_str());
+    std::strncat(note, lm_note, sizeof note - std::strlen(note) - 1);
+    if (lm.ok()) {
+      updated = lm.updated;
+      ok = true;
+      out.warnings.push_back("CMCM did not converge (" + r.message + "); the least-squares update was used");
+    }
+  }
+  out.stages.push_back({"update", ok, note});
+  if (!ok) {
     out.warnings.push_back("model update did not converge: " + r.message);
     return {};
   }
@@ -358,20 +378,20 @@ UpdateOutcome update_stage(const PipelineRequest& req, const acq::Capture& cap, 
     if (truth.count(name)) p.truth = truth[name] * (std::string(name) == "epsT33_rel" ? 1.0 : scale);
     out.params.push_back(p);
   };
-  row("YE11", "Pa", r.original.y_e11, r.updated.y_e11, 1.0);
-  row("nu12", "-", r.original.nu12, r.updated.nu12, 1.0);
-  row("d31", "C/N", r.original.d31, r.updated.d31, 1.0);
-  out.params.push_back({"epsT33_rel", "-", r.original.eps_t33 / model::kEps0, r.updated.eps_t33 / model::kEps0,
+  row("YE11", "Pa", p0.y_e11, updated.y_e11, 1.0);
+  row("nu12", "-", p0.nu12, updated.nu12, 1.0);
+  row("d31", "C/N", p0.d31, updated.d31, 1.0);
+  out.params.push_back({"epsT33_rel", "-", p0.eps_t33 / model::kEps0, updated.eps_t33 / model::kEps0,
                         truth.count("epsT33_rel") ? std::optional(truth["epsT33_rel"]) : std::nullopt});
 
   // Model curves on the measurement's grid: original and updated.
   const auto& grid = out.curves.front().f_hz;
   const auto damping = damping_from_features(z, out);
   out.curves.push_back({"original model", grid, model_z(solver, cls.e_form(p0), grid, damping)});
-  out.curves.push_back({"updated model", grid, model_z(solver, cls.e_form(r.updated), grid, damping)});
+  out.curves.push_back({"updated model", grid, model_z(solver, cls.e_form(updated), grid, damping)});
   UpdateOutcome u;
   u.ok = true;
-  u.updated = r.updated;
+  u.updated = updated;
   u.damping = damping;
   if (!feat.resonances_hz.empty()) u.first_resonance_hz = feat.resonances_hz.front();
   return u;

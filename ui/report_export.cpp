@@ -80,7 +80,10 @@ nlohmann::json diagnosis_json(const update::GapDiagnosis& d) {
   const double dof = std::max(1, d.dof_fit);
   j["gap_before"] = d.gap_fit;
   j["noise_floor"] = std::sqrt(1.0 + std::max(3.0 * std::sqrt(2.0 / dof), 0.3));
-  j["verdict"] = {{"effect", d.verdict_effect}, {"holdout_shrink", opt(d.heldout_shrink)}, {"text", d.verdict}};
+  j["verdict"] = {{"effect", d.verdict_effect},
+                  {"holdout_shrink", opt(d.heldout_shrink)},
+                  {"alternatives", d.verdict_alternatives},
+                  {"text", d.verdict}};
   j["verdict_text"] = d.verdict;
   j["verdict_effect"] = d.verdict_effect;
   j["measured"] = nlohmann::json::array();
@@ -117,6 +120,7 @@ nlohmann::json diagnosis_json(const update::GapDiagnosis& d) {
       for (const auto& [n, v] : b)
         if (std::abs(v) > 0.01) r["aliases"].push_back(n);
     }
+    r["indistinguishable_from"] = e.indistinguishable_from;
     r["params"] = nlohmann::json::object();
     r["gap_after"] = nullptr;
     r["shrink"] = nullptr;

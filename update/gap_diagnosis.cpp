@@ -5,6 +5,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <map>
 #include <stdexcept>
 
 namespace piezo::update {
@@ -112,6 +113,7 @@ GapDiagnosis diagnose_gap(model::ModalSolver& solver, const MaterialClass& cls, 
   double chi_cur = base.chi2;
   std::optional<double> ho_cur = out.chi2_heldout;
   std::vector<std::string> pool = candidates;
+  std::map<std::string, Eigen::VectorXd> signature;  // first round: (I − P)·j of each candidate
   for (int round = 0; round < std::max(1, opt.max_effects); ++round) {
     std::vector<EffectReport> reports;
     for (std::size_t c = 0; c < pool.size(); ++c) {
@@ -142,6 +144,7 @@ GapDiagnosis diagnose_gap(model::ModalSolver& solver, const MaterialClass& cls, 
       const Eigen::VectorXd rest = v - a * coef;
       rep.alias_residual = v.norm() > 0 ? rest.norm() / v.norm() : 0.0;
       rep.detectability = rest.norm();
+      if (round == 0) signature[pool[c]] = rest;
       // A typical magnitude of the effect, fitted with the constants only,
       // moves them by −coef (x units are % for the material).
       rep.bias_y_e11_pct = -coef(0);
@@ -183,7 +186,20 @@ GapDiagnosis diagnose_gap(model::ModalSolver& solver, const MaterialClass& cls, 
       if (p.heldout_chi2_after && q.heldout_chi2_after) return *p.heldout_chi2_after < *q.heldout_chi2_after;
       return p.chi2_after < q.chi2_after;
     });
-    if (round == 0) out.effects = reports;
+    if (round == 0) {
+      // Pairs of identifiable candidates the data cannot tell apart.
+      for (auto& r : reports) {
+        if (r.alias) continue;
+        const Eigen::VectorXd& a = signature[r.name];
+        for (const auto& q : reports) {
+          if (q.alias || q.name == r.name) continue;
+          const Eigen::VectorXd& b = signature[q.name];
+          const double den = a.norm() * b.norm();
+          if (den > 0 && std::abs(a.dot(b)) / den >= opt.indistinguishable_cos) r.indistinguishable_from.push_back(q.name);
+        }
+      }
+      out.effects = reports;
+    }
     // Greedy step: the best identifiable effect, if it is significant on the
     // fit data and shrinks the held-out gap.
     const EffectReport* best = nullptr;
@@ -255,7 +271,15 @@ GapDiagnosis diagnose_gap(model::ModalSolver& solver, const MaterialClass& cls, 
     std::snprintf(buf, sizeof buf, "Gap explained by %s = %.4g +/- %.2g %s (held-out gap shrinks by %.0f %%)%s.",
                   s.name.c_str(), s.value, s.sigma, s.unit.c_str(),
                   100 * (out.heldout_shrink ? *out.heldout_shrink : s.shrink_fit), more.c_str());
-    out.verdict = buf + alias_note;
+    std::string twins;
+    for (const auto& e : out.effects)
+      if (e.name == s.name)
+        for (const auto& n : e.indistinguishable_from) {
+          twins += (twins.empty() ? "" : ", ") + n;
+          out.verdict_alternatives.push_back(n);
+        }
+    if (!twins.empty()) twins = " This data cannot tell it from " + twins + " (same signature).";
+    out.verdict = buf + twins + alias_note;
   } else {
     out.verdict_effect = "unexplained";
     const GapRegion* worst = nullptr;

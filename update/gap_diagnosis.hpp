@@ -47,6 +47,10 @@ struct EffectReport {
   bool significant = false;
   std::optional<double> heldout_chi2_after, heldout_shrink;
   TubeParams material;  // refitted with the effect
+  // Other candidates whose signature, after the constants took what they can,
+  // points the same way (|cos| >= GapOptions::indistinguishable_cos): this
+  // data cannot tell them from this one.
+  std::vector<std::string> indistinguishable_from;
   std::string note;
 };
 
@@ -82,6 +86,7 @@ struct GapDiagnosis {
   std::optional<double> heldout_shrink;  // of all added effects together
   GapCurve before, after;              // base model, and with the added effects
   std::string verdict_effect;          // "none", an effect name (first added), or "unexplained"
+  std::vector<std::string> verdict_alternatives;  // indistinguishable from the verdict's effect on this data
   std::string verdict;                 // one sentence for the technician
   double seconds = 0;
 };
@@ -95,6 +100,7 @@ struct GapOptions {
   double gap_tolerance = 0.3;           // χ²/N beyond 1 + this (and 3σ) is a gap      // an effect must shrink the held-out gap this much to be added
   double damping_ref_hz = 50e3;
   std::vector<MeasuredEffect> measured;  // fixed in the model, removed from the candidates
+  double indistinguishable_cos = 0.95;   // see EffectReport::indistinguishable_from
   GapFitOptions fit;
 };
 

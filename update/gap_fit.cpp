@@ -37,7 +37,11 @@ std::vector<double> gap_residuals(const GapModel& m, const GapData& d, const std
 
 double gap_chi2(const GapModel& m, const GapData& d, const std::vector<double>& x) {
   double c = 0;
-  for (double v : gap_residuals(m, d, x)) c += v * v;
+  try {
+    for (double v : gap_residuals(m, d, x)) c += v * v;
+  } catch (const std::invalid_argument&) {  // a non-physical material (coupling > 1, …): not a step to take
+    return std::numeric_limits<double>::infinity();
+  }
   return std::isfinite(c) ? c : std::numeric_limits<double>::infinity();
 }
 
@@ -117,10 +121,16 @@ GapFit fit_gap(GapModel& m, const GapData& d, const std::vector<double>& x0, con
     for (int i = 0; i < 4; ++i)
       if (free[static_cast<std::size_t>(i)]) far = true;
     if (!far || m.distance_from_linearisation(fit.x) < opt.relinearise_beyond) break;
-    m.relinearise(fit.x);
+    try {
+      m.relinearise(fit.x);
+    } catch (const std::invalid_argument& e) {  // the optimum sits at the edge of the physical domain
+      fit.message = std::string("kept the previous linearisation: ") + e.what();
+      break;
+    }
     fit.chi2 = gap_chi2(m, d, fit.x);
   }
-  if (!fit.converged) fit.message = "the gap fit did not converge in " + std::to_string(fit.iterations) + " iterations";
+  if (!fit.converged && fit.message.empty())
+    fit.message = "the gap fit did not converge in " + std::to_string(fit.iterations) + " iterations";
   fit.sigma_x.assign(info.size(), 0.0);
   if (p > 0 && jtj.rows() == p) {
     const Eigen::MatrixXd cov = jtj.completeOrthogonalDecomposition().pseudoInverse();

@@ -7,6 +7,7 @@
 // number of cases; the CI subset runs a fixed handful.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cstdlib>
 #include <filesystem>
 #include <map>
@@ -70,6 +71,7 @@ struct Tally {
   std::map<std::string, std::map<std::string, int>> confusion;  // injected → verdict
   int identifiable = 0, named = 0, controls = 0, controls_none = 0, aliased = 0, aliases_reported = 0;
   int undetectable = 0, undetectable_quiet = 0;  // below the noise: verdict none/unexplained is right
+  int named_with_twin = 0;  // verdict: another effect with the same signature, the injected one named beside it
   std::vector<double> shrinks;  // held-out shrink of correct verdicts
 };
 
@@ -109,6 +111,9 @@ void score(const Case& c, const ui::PipelineResult& r, Tally& t) {
     if (verdict == c.effect) {
       ++t.named;
       if (d.heldout_shrink) t.shrinks.push_back(*d.heldout_shrink);
+    } else if (std::find(d.verdict_alternatives.begin(), d.verdict_alternatives.end(), c.effect) !=
+               d.verdict_alternatives.end()) {
+      ++t.named_with_twin;
     }
   }
   std::printf("  %-22s %11.4g noise %.3f -> %-22s gap %.2f / held-out %.2f  signature %5.1f sigma %s\n",
@@ -130,9 +135,10 @@ void print(const Tally& t) {
     med = s[s.size() / 2];
   }
   std::printf("identifiable named %d/%d, controls none %d/%d, aliases reported %d/%d, below the noise without a false "
-              "claim %d/%d, held-out shrink of correct verdicts: median %.0f %%, min %.0f %%\n",
+              "claim %d/%d, named only beside an indistinguishable twin %d, held-out shrink of correct verdicts: "
+              "median %.0f %%, min %.0f %%\n",
               t.named, t.identifiable, t.controls_none, t.controls, t.aliases_reported, t.aliased,
-              t.undetectable_quiet, t.undetectable, 100 * med,
+              t.undetectable_quiet, t.undetectable, t.named_with_twin, 100 * med,
               t.shrinks.empty() ? 0.0 : 100 * *std::min_element(t.shrinks.begin(), t.shrinks.end()));
 }
 
