@@ -52,9 +52,10 @@ OwnedRecord average_shots(const Capture& cap, std::span<const Shot* const> shots
 
 void deskew_record(OwnedRecord& r, double skew_s) {
   // The drive leaves its idle level at the last pretrigger sample (t = -dt)
-  // and ramps to its first value at t = 0 (capture format: the AWG's samples
-  // are joined linearly, idle before): channel 2 is idle before that kink and
-  // is never interpolated across it.
+  // and ramps to its first value at t = 0 (the simulated AWG joins its samples
+  // linearly from idle; a real AWG's reconstruction is smoother still, and the
+  // capture format does not fix it): channel 2 is idle before that kink and is
+  // never interpolated across it.
   const std::size_t onset = r.pretrigger_samples > 0 ? r.pretrigger_samples - 1 : 0;
   r.v2 = dsp::deskew_channel(r.v2, r.sample_rate_hz, onset, skew_s);
   // The last samples of a late channel 2 would be extrapolated beyond its record
