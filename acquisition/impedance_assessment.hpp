@@ -28,15 +28,23 @@ namespace piezo::acq {
 
 enum class UncertaintySource { Auto, Shots, Noise, None };
 
+inline dsp::PronyImpedanceOptions ramped_onset() {
+  dsp::PronyImpedanceOptions o;
+  o.ramp_onset = true;
+  return o;
+}
+
 struct AssessmentOptions {
   std::string method = "prony";     // prony | fft | xspec
   std::optional<std::size_t> shot;  // one shot (capture index); empty: every transient dut shot
                                     // of the first one's drive, averaged (xspec: as segments)
   double fmin_hz = 0.0, fmax_hz = 0.0,
-         step_hz = 0.0;              // 0: step fmax/2000, fmin one step, fmax fs/4
-  dsp::PronyImpedanceOptions prony;  // band_hz and features.fmin_hz are filled from the grid
-  dsp::FftRatioOptions fft;          // fmin/fmax filled from the band
-  dsp::CrossSpectraOptions xspec;    // fmin/fmax filled from the band
+         step_hz = 0.0;  // 0: step fmax/2000, fmin one step, fmax fs/4
+  // band_hz and features.fmin_hz are filled from the grid. ramp_onset: the
+  // drive ramps from idle at −Δt onto its first sample (the bench's AWG).
+  dsp::PronyImpedanceOptions prony = ramped_onset();
+  dsp::FftRatioOptions fft;        // fmin/fmax filled from the band
+  dsp::CrossSpectraOptions xspec;  // fmin/fmax filled from the band
 
   bool compensate = true;                  // use the capture's calibration shots, when it has any
   std::optional<dsp::FixtureModel> model;  // empty: the most complete the standards allow

@@ -24,7 +24,10 @@ void accumulate(const std::vector<Feature>& ref, const std::vector<Feature>& fou
   for (std::size_t r = 0; r < ref.size(); ++r) {
     double best = kNaN, dist = 0.02 * ref[r].f_hz;
     for (const auto& f : found)
-      if (std::abs(f.f_hz - ref[r].f_hz) < dist) { dist = std::abs(f.f_hz - ref[r].f_hz); best = f.f_hz; }
+      if (std::abs(f.f_hz - ref[r].f_hz) < dist) {
+        dist = std::abs(f.f_hz - ref[r].f_hz);
+        best = f.f_hz;
+      }
     if (std::isfinite(best)) acc[r].push_back(best);
   }
 }
@@ -39,9 +42,21 @@ double stddev(const std::vector<double>& v) {
 }
 }  // namespace
 
+std::complex<double> PronyImpedance::transform(Eigen::Index k, std::complex<double> s) const {
+  std::complex<double> l = laplace(fit, k, s);
+  if (onset_dt_s > 0) {
+    // ∫_{−Δt}^0 v0 (1 + t/Δt) e^{−st} dt = v0 Δt (e^a − 1 − a)/a², a = sΔt
+    const std::complex<double> a = s * onset_dt_s;
+    const std::complex<double> g =
+        std::abs(a) < 1e-3 ? 0.5 + a / 6.0 + a * a / 24.0 : (std::exp(a) - 1.0 - a) / (a * a);
+    l += onset_v[static_cast<std::size_t>(k)] * onset_dt_s * g;
+  }
+  return l;
+}
+
 std::complex<double> PronyImpedance::z(double f_hz) const {
   const std::complex<double> s(0.0, kTwoPi * f_hz);
-  return r1_ohm * laplace(fit, 1, s) / (laplace(fit, 0, s) - laplace(fit, 1, s));
+  return r1_ohm * transform(1, s) / (transform(0, s) - transform(1, s));
 }
 
 std::complex<double> PronyImpedance::zero_or_pole(double f_hz, bool resonance) const {
@@ -49,7 +64,7 @@ std::complex<double> PronyImpedance::zero_or_pole(double f_hz, bool resonance) c
   // share the divider's poles, which sit next to the anti-resonances when R1
   // is large; in the ratio they cancel, so the iteration sees a smooth function.
   auto g = [&](std::complex<double> s) {
-    const std::complex<double> v2 = laplace(fit, 1, s), i = laplace(fit, 2, s);
+    const std::complex<double> v2 = transform(1, s), i = transform(2, s);
     return resonance ? v2 / i : i / v2;
   };
   const double scale = kTwoPi * f_hz;
@@ -112,7 +127,8 @@ void refine_features_to_modal(const PronyImpedance& m, ImpedanceFeatures& f) {
 PronyImpedance fit_prony_impedance(const DividerRecord& rec, const PronyImpedanceOptions& opt) {
   const DividerSignals s = prepare_divider(rec, "impedance_prony", opt.prep);
   const double span = s.i.maxCoeff() - s.i.minCoeff();
-  if (!(span > 1e-12 * std::max(s.v1.cwiseAbs().maxCoeff(), s.v2.cwiseAbs().maxCoeff()) / rec.r1_ohm))
+  if (!(span >
+        1e-12 * std::max(s.v1.cwiseAbs().maxCoeff(), s.v2.cwiseAbs().maxCoeff()) / rec.r1_ohm))
     throw std::invalid_argument("impedance_prony: no current flows (v1 == v2): Z is undefined");
   PronyImpedance out;
   out.r1_ohm = rec.r1_ohm;
@@ -125,6 +141,10 @@ PronyImpedance fit_prony_impedance(const DividerRecord& rec, const PronyImpedanc
     po.noise_mixing << s1, 0.0, 0.0, s2, s1 / rec.r1_ohm, -s2 / rec.r1_ohm;
   }
   out.fit = prony_ss(stack(s), s.sample_rate_hz, po);
+  if (opt.ramp_onset && rec.pretrigger_samples > 0) {
+    out.onset_dt_s = 1.0 / s.sample_rate_hz;
+    out.onset_v = {s.v1[0], s.v2[0], s.i[0]};
+  }
   return out;
 }
 
@@ -152,8 +172,9 @@ ImpedanceResult impedance_prony(const DividerRecord& rec, const Eigen::VectorXd&
 
   const double fmin = std::max(f_hz.minCoeff(), opt.features.fmin_hz);
   const double fmax = std::min(f_hz.maxCoeff(), opt.features.fmax_hz);
-  const double step = opt.feature_step_hz > 0 ? opt.feature_step_hz
-                                              : (f_hz.maxCoeff() - f_hz.minCoeff()) / double(f_hz.size() - 1) / 4.0;
+  const double step = opt.feature_step_hz > 0
+                          ? opt.feature_step_hz
+                          : (f_hz.maxCoeff() - f_hz.minCoeff()) / double(f_hz.size() - 1) / 4.0;
   auto features_of = [&](const PronyImpedance& m) {
     auto f = find_features([&m](double f) { return m.z(f); }, fmin, fmax, step, opt.features);
     refine_features_to_modal(m, f);
@@ -182,12 +203,15 @@ ImpedanceResult impedance_prony(const DividerRecord& rec, const Eigen::VectorXd&
       y.col(2) = (y.col(0) - y.col(1)) / rec.r1_ohm;
       PronyImpedance m2;
       m2.r1_ohm = rec.r1_ohm;
+      m2.onset_dt_s = model.onset_dt_s;
+      m2.onset_v = model.onset_v;
       try {
         m2.fit = prony_ss(y, s.sample_rate_hz, o2.prony);
       } catch (const std::invalid_argument&) {
         continue;  // a degenerate replicate carries no information
       }
-      for (Eigen::Index k = 0; k < f_hz.size(); ++k) zvar[k] += std::norm(m2.z(f_hz[k]) - r.z_ohm[k]);
+      for (Eigen::Index k = 0; k < f_hz.size(); ++k)
+        zvar[k] += std::norm(m2.z(f_hz[k]) - r.z_ohm[k]);
       ++good;
       const auto f2 = features_of(m2);
       accumulate(r.features.resonances, f2.resonances, res);
@@ -195,7 +219,8 @@ ImpedanceResult impedance_prony(const DividerRecord& rec, const Eigen::VectorXd&
       if (std::isfinite(f2.capacitance_f)) cap[0].push_back(f2.capacitance_f);
     }
     for (std::size_t k = 0; k < res.size(); ++k) r.features.resonances[k].sigma_hz = stddev(res[k]);
-    for (std::size_t k = 0; k < anti.size(); ++k) r.features.antiresonances[k].sigma_hz = stddev(anti[k]);
+    for (std::size_t k = 0; k < anti.size(); ++k)
+      r.features.antiresonances[k].sigma_hz = stddev(anti[k]);
     r.features.capacitance_sigma_f = stddev(cap[0]);
     if (good >= 2) r.z_sigma_ohm = (zvar / double(good)).cwiseSqrt();
   }

@@ -7,6 +7,7 @@
 // is evaluated from the pole–residue forms at s = jω on any grid: no leakage,
 // any resolution. The drive step at t = 0 is part of the one-sided transform:
 // the fit starts at the first sample of the excitation, so nothing is lost.
+#include <array>
 #include <complex>
 #include <cstdint>
 
@@ -27,11 +28,25 @@ struct PronyImpedanceOptions {
   // model on v1 and v2, at the chosen order. 0: no σ.
   std::size_t bootstrap = 0;
   std::uint64_t bootstrap_seed = 7;
+  // How the drive reaches its first sample. false: it steps at t = 0 (the
+  // seed's transient). true: it leaves its idle level at the last pretrigger
+  // sample and ramps linearly to the first one (an AWG joining its samples
+  // linearly, as the simulated bench's does): the [−Δt, 0) segment of every
+  // signal, linear from rest to its first sample, is added to the transforms.
+  // Leaving it out of a ramped drive reads as a channel-2 lead of Δt/2
+  // (2° at 110 kHz, 10 MS/s).
+  bool ramp_onset = false;
 };
 
 struct PronyImpedance {
   PronyFit fit;  // signals: 0 = v1, 1 = v2, 2 = i
   double r1_ohm = 0.0;
+  // The ramp onto the first samples (PronyImpedanceOptions::ramp_onset):
+  // onset_dt_s = Δt (0: none), onset_v = the signals' values at t = 0.
+  double onset_dt_s = 0.0;
+  std::array<double, 3> onset_v{};
+  // Laplace transform of signal k (0 = v1, 1 = v2, 2 = i) from the start of the drive.
+  std::complex<double> transform(Eigen::Index k, std::complex<double> s) const;
   std::complex<double> z(double f_hz) const;  // eq. 116 at s = j2πf
 
   // The zero (resonance) or pole (anti-resonance) of Z(s) nearest to the |Z|

@@ -165,6 +165,7 @@ dsp::ImpedanceResult estimate(const acq::Capture& cap, PipelineResult& out) {
                          static_cast<std::size_t>(std::max<std::int64_t>(0, first.pretrigger_samples)),
                          first.daq_range_v};
   dsp::PronyImpedanceOptions po;
+  po.ramp_onset = true;  // the AWG ramps from idle at -dt onto its first sample
   const std::size_t post = first.samples() - static_cast<std::size_t>(first.pretrigger_samples);
   po.prep.max_samples = std::min<std::size_t>(6000, post);
   po.prony.band_hz = fmax;
