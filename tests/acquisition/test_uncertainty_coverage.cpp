@@ -75,10 +75,9 @@ TEST(UncertaintyCoverage, BandCoversTheTruth) {
       PIEZO_COVERAGE_SEEDS, 100 * cov, 100.0 * covered_mag / points, 100.0 * covered_phase / points,
       100 * worst);
   // The line held (what was measured, not the target): 79.5 % over the 2 CI
-  // seeds (73.3 % over 50)
-  // once Prony adds the drive's ramp from −Δt (PronyImpedanceOptions::
-  // ramp_onset); 29 % without it, which read as a 50 ns channel-2 lead. A band
-  // without its bootstrap or standards part covers < 10 %.
+  // seeds (73.3 % over 50) once Prony adds the drive's ramp from −Δt
+  // (PronyImpedanceOptions::ramp_onset); 29 % without it, which read as a 50 ns
+  // channel-2 lead. A band without its bootstrap or standards part covers < 10 %.
   EXPECT_GT(cov, 0.60);
   fs::remove_all(dir);
 }
