@@ -60,6 +60,15 @@ nlohmann::json report_json(const PipelineResult& r) {
   j["stages"] = nlohmann::json::array();
   for (const auto& s : r.stages) j["stages"].push_back({{"name", s.name}, {"ran", s.ran}, {"note", s.note}});
   j["verdict"] = r.verdict;
+  if (r.fixture) {  // measured from the capture's calibration shots
+    const auto& f = *r.fixture;
+    auto o = [](const std::optional<double>& v) { return v ? nlohmann::json(*v) : nlohmann::json(nullptr); };
+    j["fixture"] = {{"model", r.fixture_model},
+                    {"fixture_capacitance_f", o(f.fixture_capacitance_f)},
+                    {"lead_resistance_ohm", o(f.lead_resistance_ohm)},
+                    {"r1_error", o(f.r1_error)},
+                    {"skew_s", o(f.skew_s)}};
+  }
   if (r.diagnosis) j["diagnosis"] = diagnosis_json(*r.diagnosis);
   j["warnings"] = r.warnings;
   return j;

@@ -72,31 +72,7 @@ void register_demo_command(CLI::App& app, Context& ctx) {
       ProgressBar bar("demo");
       auto res = ui::run_pipeline(req, [&](const ui::PipelineProgress& p) { bar.update(p.fraction, p.stage); }, cancel);
       bar.finish();
-      nlohmann::json j;
-      j["capture"] = res.capture_path;
-      j["shots"] = res.shots;
-      j["stages"] = nlohmann::json::array();
-      for (const auto& s : res.stages) j["stages"].push_back({{"name", s.name}, {"ran", s.ran}, {"note", s.note}});
-      j["resonances_hz"] = res.resonances_hz;
-      j["antiresonances_hz"] = res.antiresonances_hz;
-      j["parameters"] = nlohmann::json::array();
-      for (const auto& p : res.params) {
-        nlohmann::json r = {{"name", p.name}, {"unit", p.unit}, {"original", p.original}, {"updated", p.updated}};
-        if (p.truth) r["true"] = *p.truth;
-        j["parameters"].push_back(r);
-      }
-      j["verdict"] = res.verdict;
-      if (res.fixture) {
-        const auto& f = *res.fixture;
-        auto o = [](const std::optional<double>& v) { return v ? nlohmann::json(*v) : nlohmann::json(nullptr); };
-        j["fixture"] = {{"model", res.fixture_model},
-                        {"fixture_capacitance_f", o(f.fixture_capacitance_f)},
-                        {"lead_resistance_ohm", o(f.lead_resistance_ohm)},
-                        {"r1_error", o(f.r1_error)},
-                        {"skew_s", o(f.skew_s)}};
-      }
-      if (res.diagnosis) j["diagnosis"] = ui::diagnosis_json(*res.diagnosis);
-      j["warnings"] = res.warnings;
+      const nlohmann::json j = ui::report_json(res);  // the same report as replay and the GUI export
       if (ctx.json) {
         print_json(j);
         return;
