@@ -79,7 +79,7 @@ void DividerStateSpace::build_standard(const BenchCircuit& k) {
   if (na > 0) {
     const auto lu =
         sub(alg, alg).partialPivLu();  // every node reaches ground or v1 through a conductance
-    m_ad = -lu.solve(sub(alg, dyn));
+    if (nd > 0) m_ad = -lu.solve(sub(alg, dyn));  // (a purely resistive standard has no dynamic node)
     m_u = lu.solve(part(alg));
   }
   // Dynamic nodes: C_d·v_d' = −G_dd·v_d − G_da·v_a + b_d·u, in √C·v coordinates (balanced).
