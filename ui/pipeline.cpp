@@ -12,7 +12,6 @@
 #include "acquisition/divider_record.hpp"
 #include "acquisition/runner.hpp"
 #include "dsp/cross_spectra.hpp"
-#include "dsp/deskew.hpp"
 #include "dsp/fft_ratio.hpp"
 #include "dsp/prony_impedance.hpp"
 #include "dsp/shot_ensemble.hpp"
