@@ -15,6 +15,7 @@
 #include "model/modal.hpp"
 #include "model/tube_model.hpp"
 #include "tests/support/sim_capture.hpp"
+#include "tests/support/sim_truth.hpp"
 #include "update/gap_diagnosis.hpp"
 
 using namespace piezo;
@@ -33,17 +34,6 @@ acq::SimSpec target_spec() {
   s.set = "YE11=6.66e10,nu12=0.3333,d31=-210e-12,epsT33_rel=2294";
   return s;
 }
-
-model::ModalPortModel spec_port(const acq::SimSpec& s) {
-  auto mat = model::resolve_material({s.material, s.isotropic, s.set});
-  model::TubeGeometry g = s.geometry;
-  g.density_kg_m3 = mat.density_kg_m3;
-  model::TubeModel tube(g);
-  model::ModalSolver solver(tube);
-  model::ModalOptions mo;
-  mo.n_modes = s.modes;
-  return solver.port_model(model::to_e_form(mat.d), mo);
-}
 }  // namespace
 
 TEST(ShotEnsemble, EqualsTheBenchsExactResponseAndItsNoiseIsMeasured) {
@@ -59,7 +49,7 @@ TEST(ShotEnsemble, EqualsTheBenchsExactResponseAndItsNoiseIsMeasured) {
       for (const auto& s : cap.shots) recs.push_back(acq::divider_record(cap, s));
       auto e = dsp::impedance_shot_ensemble(recs);
       std::vector<double> f(e.f_hz.data(), e.f_hz.data() + e.f_hz.size());
-      auto z = model::bench_impedance(spec_port(spec), spec.damping, spec.effects, 3140.0, f);
+      auto z = model::bench_impedance(test::sim_port(spec), spec.damping, spec.effects, 3140.0, f);
       double worst = 0, chi2 = 0;
       for (std::size_t i = 0; i < f.size(); ++i) {
         const auto l = std::log(e.z_ohm[static_cast<Eigen::Index>(i)] / z[i]);
@@ -85,7 +75,7 @@ TEST(ShotEnsemble, EqualsTheBenchsExactResponseAndItsNoiseIsMeasured) {
 // effect whose signature another candidate shares is named together with it.
 namespace {
 update::GapData exact_gap_data(const model::EffectSet& fx, const std::string& what) {
-  const auto port = spec_port(target_spec());
+  const auto port = test::sim_port(target_spec());
   update::GapData d;
   for (double f = 1e3; f <= 120e3; f *= 1.02) d.f_hz.push_back(f);
   d.z_ohm = model::bench_impedance(port, {0.0, 1e-7}, fx, 3140.0, d.f_hz);
