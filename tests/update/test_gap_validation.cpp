@@ -60,7 +60,13 @@ ui::PipelineResult run_case(const Case& c, const fs::path& dir) {
   req.sim.damping = {0.0, c.beta};
   req.sim.noise_rel = c.noise;
   req.sim.seed = c.seed;
-  if (!c.effect.empty()) model::apply_effect_assignment(req.sim.effects, c.effect + "=" + std::to_string(c.value));
+  if (!c.effect.empty()) {
+    // %.17g: std::to_string prints 6 decimals, which made every skew (~1e-7 s)
+    // and fixture capacitance (~1e-10 F) of this study 0 — nothing injected.
+    char assignment[120];
+    std::snprintf(assignment, sizeof assignment, "%s=%.17g", c.effect.c_str(), c.value);
+    model::apply_effect_assignment(req.sim.effects, assignment);
+  }
   req.capture_out = (dir / "fit.h5").string();
   req.heldout_plan = test::chirp_plan(16);
   std::atomic<bool> cancel{false};
@@ -119,6 +125,13 @@ void score(const Case& c, const ui::PipelineResult& r, Tally& t) {
   std::printf("  %-22s %11.4g noise %.3f -> %-22s gap %.2f / held-out %.2f  signature %5.1f sigma %s\n",
               injected.c_str(), c.value, c.noise, verdict.c_str(), d.gap_fit, d.gap_heldout.value_or(0), detect_sigma,
               alias ? "(alias)" : undetectable ? "(below noise)" : "");
+  if (std::getenv("GAP_VERBOSE")) {  // every candidate's fit, for looking into a case
+    for (const auto& e : d.effects)
+      std::printf("      %-22s %s value %11.4g +- %9.3g  dchi2 %8.1f  shrink %5.2f  held-out shrink %5.2f%s\n",
+                  e.name.c_str(), e.alias ? "alias" : "     ", e.value, e.sigma, e.delta_chi2, e.shrink_fit,
+                  e.heldout_shrink.value_or(-9), e.significant ? " *" : "");
+    std::printf("      verdict: %s\n", d.verdict.c_str());
+  }
 }
 
 void print(const Tally& t) {
@@ -231,7 +244,22 @@ TEST(GapDiagnosisValidation, ThirtySixTransducers) {
   const char* env = std::getenv("GAP_CASES");
   const int n = env ? std::atoi(env) : 36;
   Tally t;
-  for (const auto& c : draw_cases(n, 2026)) {
+  // GAP_ONLY=i,j,...: only these case indices (0-based), for looking into them.
+  std::vector<int> only;
+  if (const char* o = std::getenv("GAP_ONLY"))
+    for (const char* p = o; *p;) {
+      only.push_back(std::atoi(p));
+      while (*p && *p != ',') ++p;
+      if (*p) ++p;
+    }
+  int index = -1;
+  for (auto c : draw_cases(n, 2026)) {
+    ++index;
+    // GAP_VALUE / GAP_NOISE: the drawn case with another magnitude or noise (looking into a case).
+    if (const char* v = std::getenv("GAP_VALUE")) c.value = std::atof(v);
+    if (const char* v = std::getenv("GAP_NOISE")) c.noise = std::atof(v);
+    if (!only.empty() && std::find(only.begin(), only.end(), index) == only.end()) continue;
+    std::printf("case %d:\n", index);
     auto r = run_case(c, tmp_dir("gap-validation"));
     if (!r.diagnosis) {  // counted as a miss, with the reason
       std::printf("  %-22s no diagnosis: %s\n", c.effect.c_str(), r.warnings.empty() ? "?" : r.warnings.back().c_str());
