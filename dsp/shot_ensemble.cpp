@@ -2,10 +2,12 @@
 
 #include <cmath>
 #include <complex>
+#include <optional>
 #include <stdexcept>
 #include <string>
 
 #include "dsp/fft.hpp"
+#include "dsp/record_tail.hpp"
 
 namespace piezo::dsp {
 
@@ -21,8 +23,22 @@ ShotEnsemble impedance_shot_ensemble(const std::vector<DividerRecord>& shots, co
   std::vector<Eigen::VectorXcd> x2(n), xi(n);
   double fs = 0, r1 = 0;
   Eigen::Index len = 0;
+  std::vector<DividerSignals> sigs;
+  for (int s = 0; s < n; ++s) sigs.push_back(prepare_divider(shots[s], "impedance_shot_ensemble", opt.prep));
+  // The record's end (dsp/record_tail.hpp): the drive's late-time decay from
+  // the shot-averaged v1, each shot's end levels fitted with it.
+  RecordTail tail;
+  if (opt.tail_correction && sigs.front().size() > 0) {
+    Eigen::VectorXd mean_v1 = Eigen::VectorXd::Zero(sigs.front().size());
+    bool same = true;
+    for (const auto& sg : sigs) {
+      if (sg.size() != mean_v1.size()) same = false;
+      else mean_v1 += sg.v1;
+    }
+    if (same) tail = measure_tail(mean_v1 / double(n));
+  }
   for (int s = 0; s < n; ++s) {
-    DividerSignals sig = prepare_divider(shots[s], "impedance_shot_ensemble", opt.prep);
+    DividerSignals& sig = sigs[static_cast<std::size_t>(s)];
     if (s == 0) {
       fs = sig.sample_rate_hz;
       r1 = sig.r1_ohm;
@@ -31,9 +47,16 @@ ShotEnsemble impedance_shot_ensemble(const std::vector<DividerRecord>& shots, co
       throw std::invalid_argument("impedance_shot_ensemble: shot " + std::to_string(s) +
                                   " differs from shot 0 in length, sample rate or R1");
     }
+    std::optional<TailCorrection> t2, ti;
+    if (opt.tail_correction) t2.emplace(sig.v2, tail), ti.emplace(sig.i, tail);
     difference_in_place(sig);
     x2[s] = rfft(sig.v2, static_cast<std::size_t>(len));
     xi[s] = rfft(sig.i, static_cast<std::size_t>(len));
+    if (opt.tail_correction)
+      for (Eigen::Index k = 0; k < x2[s].size(); ++k) {
+        x2[s][k] += t2->at_bin(k);
+        xi[s][k] += ti->at_bin(k);
+      }
   }
   const double df = fs / double(len);
   // Bin groups: single bins, or log bands of the requested relative width.

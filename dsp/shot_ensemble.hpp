@@ -25,6 +25,10 @@ struct ShotEnsembleOptions {
   // ±smooth_points neighbours (≈ (2k+1)(n−1) degrees of freedom). Otherwise
   // χ² weighted by 1/σ̂² would be inflated by (n−1)/(n−3) and heavy-tailed.
   int smooth_points = 4;
+  // Model the records' end (dsp/record_tail.hpp): the end level fitted over
+  // the last quarter instead of the last sample's noise in every bin, and the
+  // decay that continues past the record added back.
+  bool tail_correction = true;
 };
 
 struct ShotEnsemble {

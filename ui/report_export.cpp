@@ -92,6 +92,7 @@ nlohmann::json diagnosis_json(const update::GapDiagnosis& d) {
   j["verdict"] = {{"effect", d.verdict_effect},
                   {"holdout_shrink", opt(d.heldout_shrink)},
                   {"alternatives", d.verdict_alternatives},
+                  {"heldout_without_gap", d.heldout_without_gap},
                   {"text", d.verdict}};
   j["verdict_text"] = d.verdict;
   j["verdict_effect"] = d.verdict_effect;

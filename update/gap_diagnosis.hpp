@@ -85,6 +85,9 @@ struct GapDiagnosis {
   std::vector<EffectReport> steps;     // the fit of each added effect (in the model with the previous ones)
   std::optional<double> heldout_shrink;  // of all added effects together
   GapCurve before, after;              // base model, and with the added effects
+  // The held-out data showed no gap of their own: the verdict's effect was
+  // checked not to worsen them (no held-out shrink to report: heldout_shrink empty).
+  bool heldout_without_gap = false;
   std::string verdict_effect;          // "none", an effect name (first added), or "unexplained"
   std::vector<std::string> verdict_alternatives;  // indistinguishable from the verdict's effect on this data
   std::string verdict;                 // one sentence for the technician
