@@ -169,7 +169,15 @@ GapDiagnosis diagnose_gap(model::ModalSolver& solver, const MaterialClass& cls, 
       rep.delta_chi2 = chi_cur - f.chi2;
       rep.shrink_fit = 1.0 - excess_gap(f.chi2, f.dof) / std::max(1e-300, excess_gap(chi_cur, f.dof + 1));
       const double scale = std::max(1.0, f.chi2 / std::max(1, f.dof));
-      rep.significant = rep.delta_chi2 / scale > opt.significance;
+      // Significant: the misfit drops beyond the threshold AND the effect's
+      // own magnitude stands clear of zero (≥ opt.min_effect_sigma of its
+      // uncertainty). A refit that lowers χ² with the effect at its neutral
+      // value has only moved the constants to a better optimum (a base fit
+      // left in a poor basin by a failed update): no evidence for the effect.
+      const double xe = f.x[static_cast<std::size_t>(je)] - x0[static_cast<std::size_t>(je)];
+      const double sx = f.sigma_x[static_cast<std::size_t>(je)];
+      const bool stands_clear = sx > 0 ? std::fabs(xe) / sx >= opt.min_effect_sigma : xe != 0.0;
+      rep.significant = rep.delta_chi2 / scale > opt.significance && stands_clear;
       rep.material = m.material(f.x);
       if (!f.converged) rep.note = f.message;
       if (heldout) {

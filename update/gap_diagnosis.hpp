@@ -98,6 +98,7 @@ struct GapOptions {
   std::vector<std::string> candidates;  // empty: every effect the model supports
   int max_effects = 3;
   double alias_threshold = 0.05;        // alias_residual below this → alias
+  double min_effect_sigma = 3.0;         // |fitted effect − neutral| / σ needed to count (see gap_diagnosis.cpp)
   double significance = 25.0;           // Δχ² (1 dof) beyond this, scaled by χ²/dof if > 1
   double min_heldout_shrink = 0.3;
   double gap_tolerance = 0.3;           // χ²/N beyond 1 + this (and 3σ) is a gap      // an effect must shrink the held-out gap this much to be added

@@ -268,6 +268,10 @@ TEST(GapDiagnosisValidation, ThirtySixTransducers) {
     if (!only.empty() && std::find(only.begin(), only.end(), index) == only.end()) continue;
     std::printf("case %d:\n", index);
     auto r = run_case(c, tmp_dir("gap-validation"));
+    if (std::getenv("GAP_VERBOSE")) {
+      for (const auto& st : r.stages) std::printf("    [%s] %s\n", st.name.c_str(), st.note.c_str());
+      for (const auto& w : r.warnings) std::printf("    warning: %s\n", w.c_str());
+    }
     if (!r.diagnosis) {  // counted as a miss, with the reason
       std::printf("  %-22s no diagnosis: %s\n", c.effect.c_str(), r.warnings.empty() ? "?" : r.warnings.back().c_str());
       t.confusion[c.effect.empty() ? "none" : c.effect]["(failed)"]++;
