@@ -57,6 +57,12 @@ ShotEnsemble impedance_shot_ensemble(const std::vector<DividerRecord>& shots, co
         x2[s][k] += t2->at_bin(k);
         xi[s][k] += ti->at_bin(k);
       }
+    if (opt.linear_drive)  // i = (v1 − v2)/R1: the v1 part scaled by sinc²(f/fs)
+      for (Eigen::Index k = 1; k < x2[s].size(); ++k) {
+        const double x = M_PI * double(k) / double(len);
+        const double sinc2 = std::pow(std::sin(x) / x, 2);
+        xi[s][k] = sinc2 * xi[s][k] + (sinc2 - 1.0) * x2[s][k] / sig.r1_ohm;
+      }
   }
   const double df = fs / double(len);
   // Bin groups: single bins, or log bands of the requested relative width.

@@ -415,6 +415,7 @@ update::GapData gap_data(const acq::Capture& cap, const std::vector<const acq::S
   dsp::ShotEnsembleOptions o;
   o.fmin_hz = 1e3;
   o.fmax_hz = std::min(120e3, shots.front()->sample_rate_hz / 4);
+  o.linear_drive = true;  // the bench's AWG, as Prony's ramp_onset (estimate())
   const auto e = dsp::impedance_shot_ensemble(recs, o);
   update::GapData d;
   for (Eigen::Index i = 0; i < e.f_hz.size(); ++i) {
