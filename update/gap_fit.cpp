@@ -154,13 +154,23 @@ double predictive_chi2(const GapModel& m, const GapData& d, const GapFit& fit) {
   }
   const auto jc = gap_jacobian(m, d, fit.x, cols);
   const int p = static_cast<int>(cols.size());
-  double chi = 0;
-  Eigen::VectorXd ji(p);
-  for (std::size_t i = 0; i < r.size(); ++i) {
-    for (int c = 0; c < p; ++c) ji(c) = jc[static_cast<std::size_t>(c)][i];
-    chi += r[i] * r[i] / (1.0 + ji.dot(fit.covariance * ji));
-  }
-  return std::isfinite(chi) ? chi : std::numeric_limits<double>::infinity();
+  const auto n = static_cast<Eigen::Index>(r.size());
+  // The held-out residuals' covariance is I + J C Jᵀ (their own unit noise
+  // plus the fit's parameter uncertainty, which moves the prediction along a
+  // few COHERENT patterns J·δθ). χ² = rᵀ(I + J C Jᵀ)⁻¹ r by Woodbury:
+  //   rᵀr − (Jᵀr)ᵀ C (I + JᵀJ C)⁻¹ (Jᵀr).
+  // Dividing each point by its own predictive variance instead (1 + j_iᵀ C j_i)
+  // would count one poorly determined direction of the fit once per
+  // held-out point that sees it: a 2σ deviation along it read as a gap
+  // wherever the held-out drive is more sensitive than the fit's.
+  Eigen::MatrixXd j(n, p);
+  for (int c = 0; c < p; ++c) j.col(c) = Eigen::Map<const Eigen::VectorXd>(jc[static_cast<std::size_t>(c)].data(), n);
+  const Eigen::VectorXd rv = Eigen::Map<const Eigen::VectorXd>(r.data(), n);
+  const Eigen::VectorXd jr = j.transpose() * rv;
+  const Eigen::MatrixXd m_inner = Eigen::MatrixXd::Identity(p, p) + (j.transpose() * j) * fit.covariance;
+  const Eigen::VectorXd sol = m_inner.partialPivLu().solve(jr);
+  const double chi = rv.squaredNorm() - jr.dot(fit.covariance * sol);
+  return std::isfinite(chi) ? std::max(0.0, chi) : std::numeric_limits<double>::infinity();
 }
 
 }  // namespace piezo::update

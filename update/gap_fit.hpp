@@ -51,10 +51,10 @@ struct GapFitOptions {
 GapFit fit_gap(GapModel& m, const GapData& d, const std::vector<double>& x0, const std::vector<bool>& free,
                const GapFitOptions& opt = {});
 
-// χ² of `d` (data the fit never saw) under the fitted model, each residual's
-// variance widened by the fit's own parameter uncertainty (1 + j_iᵀ C j_i): a
-// held-out curve measured more precisely than the fit data must not call the
-// fit's statistical uncertainty a gap.
+// χ² of `d` (data the fit never saw) under the fitted model, with the
+// residuals' covariance widened by the fit's own parameter uncertainty
+// (I + J C Jᵀ, full, not per point): a held-out curve measured more precisely
+// than the fit data must not call the fit's statistical uncertainty a gap.
 double predictive_chi2(const GapModel& m, const GapData& d, const GapFit& fit);
 
 // Weighted Jacobian columns ∂r/∂x_j at x (central differences), for the alias analysis.

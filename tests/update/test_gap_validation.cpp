@@ -16,6 +16,10 @@
 #include "model/material_presets.hpp"
 #include "tests/support/capture_mutations.hpp"
 #include "tests/support/sim_capture.hpp"
+#include "acquisition/divider_record.hpp"
+#include "dsp/shot_ensemble.hpp"
+#include "model/bench_response.hpp"
+#include "tests/support/sim_truth.hpp"
 #include "ui/pipeline.hpp"
 
 using namespace piezo;
@@ -46,6 +50,27 @@ double draw_value(const std::string& e, std::mt19937_64& rng) {
   return 0;
 }
 
+// χ²/N of a capture's shot-ensemble estimate against the TRUE bench of the
+// case (test-only knowledge): tells a measurement problem from a fit problem
+// when looking into a case (GAP_VERBOSE).
+double truth_chi2(const acq::SimSpec& spec, const fs::path& capture) {
+  const auto cap = acq::read_capture(capture);
+  std::vector<dsp::DividerRecord> recs;
+  for (const auto& s : cap.shots) recs.push_back(acq::divider_record(cap, s));
+  dsp::ShotEnsembleOptions o;
+  o.linear_drive = true;
+  const auto e = dsp::impedance_shot_ensemble(recs, o);
+  std::vector<double> f(e.f_hz.data(), e.f_hz.data() + e.f_hz.size());
+  const auto z = model::bench_impedance(test::sim_port(spec), spec.damping, spec.effects, 3140.0, f);
+  double chi2 = 0;
+  for (std::size_t i = 0; i < f.size(); ++i) {
+    const auto l = std::log(e.z_ohm[static_cast<Eigen::Index>(i)] / z[i]);
+    chi2 += std::pow(l.real() / e.sigma_log_mag[static_cast<Eigen::Index>(i)], 2) +
+            std::pow(l.imag() / e.sigma_phase[static_cast<Eigen::Index>(i)], 2);
+  }
+  return chi2 / (2.0 * f.size());
+}
+
 ui::PipelineResult run_case(const Case& c, const fs::path& dir) {
   ui::PipelineRequest req;
   req.instrument = "sim";
@@ -70,7 +95,13 @@ ui::PipelineResult run_case(const Case& c, const fs::path& dir) {
   req.capture_out = (dir / "fit.h5").string();
   req.heldout_plan = test::chirp_plan(16);
   std::atomic<bool> cancel{false};
-  return ui::run_pipeline(req, {}, cancel);
+  auto r = ui::run_pipeline(req, {}, cancel);
+  if (std::getenv("GAP_VERBOSE")) {
+    const acq::SimSpec& spec = req.sim;
+    std::printf("    truth: chi2/N of the fit capture %.2f, of the held-out capture %.2f (estimates vs the true bench)\n",
+                truth_chi2(spec, dir / "fit.h5"), truth_chi2(spec, dir / "fit-heldout.h5"));
+  }
+  return r;
 }
 
 struct Tally {
@@ -260,7 +291,9 @@ TEST(GapDiagnosisValidation, ThirtySixTransducers) {
       if (*p) ++p;
     }
   int index = -1;
-  for (auto c : draw_cases(n, 2026)) {
+  // GAP_SEED: another draw of transducers (the study's own is 2026).
+  const std::uint64_t draw = std::getenv("GAP_SEED") ? std::strtoull(std::getenv("GAP_SEED"), nullptr, 10) : 2026;
+  for (auto c : draw_cases(n, draw)) {
     ++index;
     // GAP_VALUE / GAP_NOISE: the drawn case with another magnitude or noise (looking into a case).
     if (const char* v = std::getenv("GAP_VALUE")) c.value = std::atof(v);
