@@ -487,6 +487,7 @@ void diagnose_stage(const PipelineRequest& req, const acq::Capture& cap, const a
   go.candidates = req.gap_candidates;
   if (out.fixture) go.measured = measured_effects(*out.fixture, out.fixture_model);
   go.damping_ref_hz = u.first_resonance_hz;
+  go.other_starts = {model::isotropic_params(nominal.d)};  // where the update started
   auto d = update::diagnose_gap(
       solver, cls, u.updated, u.damping, cap.setup.divider_r1_ohm, fit, ho ? &*ho : nullptr, go,
       [&](double f, const std::string& s) { progress(0.7 + 0.29 * f, s); }, &cancel);

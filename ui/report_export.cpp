@@ -93,6 +93,7 @@ nlohmann::json diagnosis_json(const update::GapDiagnosis& d) {
                   {"holdout_shrink", opt(d.heldout_shrink)},
                   {"alternatives", d.verdict_alternatives},
                   {"heldout_without_gap", d.heldout_without_gap},
+                  {"base_from_other_start", d.base_from_other_start},
                   {"text", d.verdict}};
   j["verdict_text"] = d.verdict;
   j["verdict_effect"] = d.verdict_effect;

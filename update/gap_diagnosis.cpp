@@ -91,6 +91,34 @@ GapDiagnosis diagnose_gap(model::ModalSolver& solver, const MaterialClass& cls, 
   std::vector<bool> free_base(kBase, true);
   GapFit base = fit_gap(m, fit, m.reference_x(), free_base, opt.fit);
   if (!base.converged) throw std::runtime_error("gap diagnosis: " + base.message);
+  if (significant_gap(base.chi2, base.dof, opt.gap_tolerance) && !opt.other_starts.empty()) {
+    const std::vector<double> lin_base = base.x;  // where m is linearised now
+    bool moved = false;
+    for (const auto& p : opt.other_starts) {
+      if (cancelled()) return out;
+      say(0.02, "gap: refitting from another start (the updated constants leave a gap)");
+      std::vector<double> x = m.reference_x();
+      x[0] = std::log(p.y_e11 / start.y_e11) / 0.01;  // GapModel's material units (1 % per unit)
+      x[1] = std::log(p.nu12 / start.nu12) / 0.01;
+      x[2] = std::log(p.d31 / start.d31) / 0.01;
+      x[3] = std::log(p.eps_t33 / start.eps_t33) / 0.01;
+      if (!std::all_of(x.begin(), x.begin() + 4, [](double v) { return std::isfinite(v); })) continue;
+      try {
+        m.relinearise(x);
+        GapFit alt = fit_gap(m, fit, x, free_base, opt.fit);
+        if (alt.converged && alt.chi2 < base.chi2) {
+          base = alt;
+          moved = true;
+          out.base_from_other_start = true;
+        } else {
+          m.relinearise(base.x);
+        }
+      } catch (const std::exception&) {
+        m.relinearise(base.x);  // a start the FE cannot solve: keep the first fit
+      }
+    }
+    if (!moved) m.relinearise(lin_base);
+  }
   out.material_base = m.material(base.x);
   out.damping_base = m.damping(base.x);
   out.chi2_fit = base.chi2;
@@ -278,6 +306,9 @@ GapDiagnosis diagnose_gap(model::ModalSolver& solver, const MaterialClass& cls, 
     }
     alias_note += ".";
   }
+  if (out.base_from_other_start)
+    alias_note += " The constants were refitted from the nominal material: the updated ones left a gap that "
+                  "another start removes (the update had not found them; see its stage note).";
   char buf[512];
   if (!out.gap) {
     out.verdict_effect = "none";

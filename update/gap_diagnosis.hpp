@@ -88,6 +88,9 @@ struct GapDiagnosis {
   // The held-out data showed no gap of their own: the verdict's effect was
   // checked not to worsen them (no held-out shrink to report: heldout_shrink empty).
   bool heldout_without_gap = false;
+  // The base refit started from GapOptions::other_starts fitted better than
+  // from the updated constants (the update had failed to find them).
+  bool base_from_other_start = false;
   std::string verdict_effect;          // "none", an effect name (first added), or "unexplained"
   std::vector<std::string> verdict_alternatives;  // indistinguishable from the verdict's effect on this data
   std::string verdict;                 // one sentence for the technician
@@ -96,6 +99,12 @@ struct GapDiagnosis {
 
 struct GapOptions {
   std::vector<std::string> candidates;  // empty: every effect the model supports
+  // Other starting points of the material for the base refit (e.g. the
+  // nominal material the update started from), tried when the refit from the
+  // updated constants leaves a gap: an update that failed (a mode pairing the
+  // CMCM could not make, a least-squares fallback in another basin) must not
+  // become a gap that the diagnosis then blames on an effect.
+  std::vector<TubeParams> other_starts;
   int max_effects = 3;
   double alias_threshold = 0.05;        // alias_residual below this → alias
   double min_effect_sigma = 3.0;         // |fitted effect − neutral| / σ needed to count (see gap_diagnosis.cpp)

@@ -160,9 +160,11 @@ void score(const Case& c, const ui::PipelineResult& r, Tally& t) {
       if (d.heldout_without_gap) ++t.heldout_without_gap;
     }
   }
-  std::printf("  %-22s %11.4g noise %.3f -> %-22s gap %.2f / held-out %.2f  signature %5.1f sigma %s\n",
+  std::printf("  %-22s %11.4g noise %.3f -> %-22s gap %.2f / held-out %.2f  signature %5.1f sigma %s%s\n",
               injected.c_str(), c.value, c.noise, verdict.c_str(), d.gap_fit, d.gap_heldout.value_or(0), detect_sigma,
-              alias ? "(alias)" : undetectable ? "(below noise)" : "");
+              alias ? "(alias)" : undetectable ? "(below noise)" : "",
+              d.heldout_shrink ? (" held-out shrink " + std::to_string(int(std::lround(100 * *d.heldout_shrink))) + " %").c_str()
+              : d.heldout_without_gap ? " (no held-out gap to shrink)" : "");
   if (std::getenv("GAP_VERBOSE")) {  // every candidate's fit, for looking into a case
     for (const auto& e : d.effects)
       std::printf("      %-22s %s value %11.4g +- %9.3g  dchi2 %8.1f  shrink %5.2f  held-out shrink %5.2f%s\n",
