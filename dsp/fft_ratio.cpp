@@ -11,7 +11,7 @@ namespace piezo::dsp {
 ImpedanceResult impedance_fft(const DividerRecord& rec, const FftRatioOptions& opt) {
   DividerSignals s = prepare_divider(rec, "impedance_fft", opt.prep);
   // Channel noise is white on the recorded samples: measure it before the
-  // first difference, whose gain |1 − e^{−jω/fs}| then scales it per bin.
+  // first difference (its gain per bin below).
   const double n1 = estimate_noise_std(s.v1), n2 = estimate_noise_std(s.v2);
   if (opt.one_sided) {
     s.v1[0] *= 0.5;
@@ -26,9 +26,22 @@ ImpedanceResult impedance_fft(const DividerRecord& rec, const FftRatioOptions& o
   const Eigen::VectorXd w = make_window(opt.window, n);
   const Eigen::VectorXcd X1 = rfft(s.v1.cwiseProduct(w), nfft);
   const Eigen::VectorXcd X2 = rfft(s.v2.cwiseProduct(w), nfft);
-  // White noise σ on a channel gives E|δX|² = σ²·Σw² per bin.
-  const double wn = std::sqrt(w.squaredNorm());
-  const double e1 = n1 * wn, e2 = n2 * wn;
+  // White noise σ on a channel: with x_k scaled by b_k (½ at k = 0 when
+  // one-sided), differenced (d_k = b_k x_k − b_{k−1} x_{k−1}) and windowed, the
+  // noise of sample j enters bin θ = 2πk/nfft as b_j n_j (w_j − w_{j+1}e^{−jθ})
+  // (w_n = 0), so E|δX|² = σ²·(A + B − 2C·cos θ), A = Σ b_j²w_j²,
+  // B = Σ b_j²w_{j+1}², C = Σ b_j²w_j w_{j+1}; σ²·A without the difference.
+  // The B term is the last sample's noise, which the difference leaves whole in
+  // every bin: it, not |1 − e^{−jθ}|²·σ²·Σw², sets the noise of the lowest bins
+  // (below about fs/(2π·√n): 11 kHz for 20 000 samples at 10 MS/s).
+  double sa = 0, sb = 0, sc = 0;
+  for (Eigen::Index j = 0; j < n; ++j) {
+    const double b2 = (opt.one_sided && j == 0) ? 0.25 : 1.0;
+    const double wj = w[j], wn1 = j + 1 < n ? w[j + 1] : 0.0;
+    sa += b2 * wj * wj;
+    sb += b2 * wn1 * wn1;
+    sc += b2 * wj * wn1;
+  }
   const double df = s.sample_rate_hz / double(nfft);
   const double fmax = opt.fmax_hz > 0 ? opt.fmax_hz : s.sample_rate_hz / 2;
   ImpedanceResult r;
@@ -51,8 +64,9 @@ ImpedanceResult impedance_fft(const DividerRecord& rec, const FftRatioOptions& o
     r.z_ohm[q] = s.r1_ohm * X2[k] / d;
     // ∂Z/∂X1 = −Z/d, ∂Z/∂X2 = R1·X1/d²
     const double g1 = std::abs(r.z_ohm[q] / d), g2 = std::abs(s.r1_ohm * X1[k] / (d * d));
-    const double hd = opt.difference ? 2.0 * std::sin(M_PI * double(k) / double(nfft)) : 1.0;
-    r.z_sigma_ohm[q] = hd * std::sqrt(g1 * g1 * e1 * e1 + g2 * g2 * e2 * e2);
+    const double gain2 =
+        opt.difference ? sa + sb - 2.0 * sc * std::cos(2.0 * M_PI * double(k) / double(nfft)) : sa;
+    r.z_sigma_ohm[q] = std::sqrt(std::max(gain2, 0.0) * (g1 * g1 * n1 * n1 + g2 * g2 * n2 * n2));
   }
   r.features = find_features(r.f_hz, r.z_ohm, r.z_sigma_ohm, opt.features);
   return r;
