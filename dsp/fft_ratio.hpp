@@ -28,6 +28,14 @@ struct FftRatioOptions {
   // phase error ωΔt/2 of V1 against a continuous V2 (2° at 120 kHz, 10 MS/s).
   // Off by default: the plain DFT ratio is this estimator's reference form.
   bool one_sided = false;
+  // With `difference`, the record's last sample enters every bin whole (the
+  // difference telescopes: D = (1 − e^{−jθ})·X + x_{n−1} on the DFT bins), so
+  // its noise is common to all bins and, below fs/(2π·√n), most of their
+  // noise. end_fit_samples = M > 0: that sample is replaced by the value at
+  // the end of a quadratic least-squares fit to the last M samples, ~3/√M of
+  // the noise (M = 1000: 0.1 ms at 10 MS/s). Needs a record that is smooth
+  // over its last M samples (a decaying transient); 0: as recorded.
+  std::size_t end_fit_samples = 0;
   double fmin_hz = 0.0, fmax_hz = 0.0;  // bins kept; fmax 0: Nyquist
   FeatureOptions features;
 };

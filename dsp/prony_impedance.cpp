@@ -1,5 +1,6 @@
 #include "dsp/prony_impedance.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <numbers>
 #include <random>
@@ -42,6 +43,14 @@ double stddev(const std::vector<double>& v) {
 }
 }  // namespace
 
+void attach_direct_residual(PronyImpedance& m, const Eigen::MatrixXd& y, Eigen::Index n) {
+  if (n <= 0) {
+    m.direct_residual.resize(0, 3);
+    return;
+  }
+  m.direct_residual = y.topRows(n) - reconstruct(m.fit, n);
+}
+
 std::complex<double> PronyImpedance::transform(Eigen::Index k, std::complex<double> s) const {
   std::complex<double> l = laplace(fit, k, s);
   if (onset_dt_s > 0) {
@@ -50,6 +59,19 @@ std::complex<double> PronyImpedance::transform(Eigen::Index k, std::complex<doub
     const std::complex<double> g =
         std::abs(a) < 1e-3 ? 0.5 + a / 6.0 + a * a / 24.0 : (std::exp(a) - 1.0 - a) / (a * a);
     l += onset_v[static_cast<std::size_t>(k)] * onset_dt_s * g;
+  }
+  if (const Eigen::Index n = direct_residual.rows(); n > 0) {
+    // ∫ r(t) e^{−st} dt for r linear between r_k at t_k = kΔt, from r_0 at t = 0
+    // (the onset ramp covers t < 0) to 0 at t_n (the pole model holds from
+    // there): hat functions, the first one halved. Horner in e^{−sΔt}.
+    const double dt = fit.dt;
+    const std::complex<double> a = s * dt, e = std::exp(-a);
+    const bool small = std::abs(a) < 1e-3;
+    const std::complex<double> hat = small ? 1.0 + a * a / 12.0 : (1.0 / e - 2.0 + e) / (a * a);
+    const std::complex<double> half = small ? 0.5 - a / 6.0 + a * a / 24.0 : (a - 1.0 + e) / (a * a);
+    std::complex<double> acc = 0.0;
+    for (Eigen::Index j = n - 1; j >= 1; --j) acc = acc * e + direct_residual(j, k);
+    l += dt * (direct_residual(0, k) * half + hat * e * acc);
   }
   return l;
 }
@@ -140,11 +162,18 @@ PronyImpedance fit_prony_impedance(const DividerRecord& rec, const PronyImpedanc
     po.noise_mixing.resize(3, 2);
     po.noise_mixing << s1, 0.0, 0.0, s2, s1 / rec.r1_ohm, -s2 / rec.r1_ohm;
   }
-  out.fit = prony_ss(stack(s), s.sample_rate_hz, po);
+  const Eigen::MatrixXd y = stack(s);
+  const std::size_t want = opt.direct_samples == PronyImpedanceOptions::kDirectFilterLength
+                               ? 10 * decimation_factor(po, s.sample_rate_hz)
+                               : opt.direct_samples;
+  const auto direct = static_cast<Eigen::Index>(std::min<std::size_t>(want, s.size() / 2));
+  po.skip_samples = std::max<std::size_t>(po.skip_samples, static_cast<std::size_t>(direct));
+  out.fit = prony_ss(y, s.sample_rate_hz, po);
   if (opt.ramp_onset && rec.pretrigger_samples > 0) {
     out.onset_dt_s = 1.0 / s.sample_rate_hz;
     out.onset_v = {s.v1[0], s.v2[0], s.i[0]};
   }
+  attach_direct_residual(out, y, direct);
   return out;
 }
 
@@ -185,7 +214,9 @@ ImpedanceResult impedance_prony(const DividerRecord& rec, const Eigen::VectorXd&
   if (opt.bootstrap > 0) {
     // Parametric bootstrap: model + white noise of the fit's residual RMS on v1, v2.
     const DividerSignals s = prepare_divider(rec, "impedance_prony", opt.prep);
-    const Eigen::MatrixXd clean = reconstruct(model.fit, s.size());
+    Eigen::MatrixXd clean = reconstruct(model.fit, s.size());
+    const Eigen::Index direct = model.direct_residual.rows();
+    clean.topRows(direct) += model.direct_residual;  // the recorded early samples
     std::mt19937_64 rng(opt.bootstrap_seed);
     std::normal_distribution<double> nd;
     PronyImpedanceOptions o2 = opt;
@@ -206,7 +237,10 @@ ImpedanceResult impedance_prony(const DividerRecord& rec, const Eigen::VectorXd&
       m2.onset_dt_s = model.onset_dt_s;
       m2.onset_v = model.onset_v;
       try {
-        m2.fit = prony_ss(y, s.sample_rate_hz, o2.prony);
+        PronyOptions p2 = o2.prony;
+        p2.skip_samples = std::max<std::size_t>(p2.skip_samples, static_cast<std::size_t>(direct));
+        m2.fit = prony_ss(y, s.sample_rate_hz, p2);
+        attach_direct_residual(m2, y, direct);
       } catch (const std::invalid_argument&) {
         continue;  // a degenerate replicate carries no information
       }

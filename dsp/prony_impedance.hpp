@@ -36,6 +36,17 @@ struct PronyImpedanceOptions {
   // Leaving it out of a ramped drive reads as a channel-2 lead of Δt/2
   // (2° at 110 kHz, 10 MS/s).
   bool ramp_onset = false;
+  // The first `direct_samples` samples from t = 0 enter the transforms as
+  // recorded: the poles and residues are fitted from sample direct_samples on
+  // (PronyOptions::skip_samples; the residues still refer to t = 0), and what
+  // the pole model leaves of the signals before that sample — the fast
+  // transient of modes above the band, which the decimated Hankel matrices
+  // cannot see — is integrated numerically (linear between samples) and added
+  // to V1, V2, I. 0: the pole model from t = 0 (the seed's estimator).
+  // kDirectFilterLength: 10·D, the length of the decimation filter (D from
+  // PronyOptions), i.e. the span before the first decimated sample.
+  static constexpr std::size_t kDirectFilterLength = static_cast<std::size_t>(-1);
+  std::size_t direct_samples = 0;
 };
 
 struct PronyImpedance {
@@ -45,6 +56,9 @@ struct PronyImpedance {
   // onset_dt_s = Δt (0: none), onset_v = the signals' values at t = 0.
   double onset_dt_s = 0.0;
   std::array<double, 3> onset_v{};
+  // PronyImpedanceOptions::direct_samples: the signals minus the pole model on
+  // the first samples (rows k = 0.., t = kΔt; empty: none), Δt = fit.dt.
+  Eigen::MatrixXd direct_residual;
   // Laplace transform of signal k (0 = v1, 1 = v2, 2 = i) from the start of the drive.
   std::complex<double> transform(Eigen::Index k, std::complex<double> s) const;
   std::complex<double> z(double f_hz) const;  // eq. 116 at s = j2πf
@@ -60,6 +74,10 @@ struct PronyImpedance {
 void refine_features_to_modal(const PronyImpedance& m, ImpedanceFeatures& f);
 
 PronyImpedance fit_prony_impedance(const DividerRecord& rec, const PronyImpedanceOptions& opt = {});
+
+// Sets m.direct_residual to the first n rows of y (v1, v2, i from t = 0) minus
+// m's pole model (n = 0: none).
+void attach_direct_residual(PronyImpedance& m, const Eigen::MatrixXd& y, Eigen::Index n);
 
 // Z on the grid f_hz (ascending, >= 0), features, order and singular values.
 ImpedanceResult impedance_prony(const DividerRecord& rec, const Eigen::VectorXd& f_hz,

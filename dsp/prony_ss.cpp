@@ -94,6 +94,13 @@ std::size_t select_order(const Eigen::VectorXd& s, double s_noise, std::size_t m
   return std::max<std::size_t>(p, 1);
 }
 
+std::size_t decimation_factor(const PronyOptions& opt, double sample_rate_hz) {
+  if (opt.decimation > 0) return opt.decimation;
+  return opt.band_hz > 0.0 ? std::max<std::size_t>(
+                                 1, static_cast<std::size_t>(sample_rate_hz / (5.0 * opt.band_hz)))
+                           : 1;
+}
+
 double estimate_noise_std(const Eigen::Ref<const Eigen::VectorXd>& x) {
   constexpr int kOrder = 6;
   constexpr double kBinom[kOrder + 1] = {1, -6, 15, -20, 15, -6, 1};  // Σ c² = C(12,6) = 924
@@ -138,11 +145,7 @@ PronyFit prony_ss(const Eigen::Ref<const Eigen::MatrixXd>& y, double sample_rate
   if (opt.noise_mixing.size() && opt.noise_mixing.rows() != m)
     fail("noise_mixing must have one row per signal");
 
-  std::size_t dec = opt.decimation;
-  if (dec == 0)
-    dec = opt.band_hz > 0.0 ? std::max<std::size_t>(1, static_cast<std::size_t>(
-                                                           sample_rate_hz / (5.0 * opt.band_hz)))
-                            : 1;
+  const std::size_t dec = decimation_factor(opt, sample_rate_hz);
   const bool automatic = !opt.order.has_value();
   if (automatic && k_used < 24)
     fail("too short for the automatic order: " + std::to_string(k_used) +

@@ -78,6 +78,10 @@ struct PronyFit {
 PronyFit prony_ss(const Eigen::Ref<const Eigen::MatrixXd>& y, double sample_rate_hz,
                   const PronyOptions& opt = {});
 
+// The decimation D prony_ss uses for `opt` at this rate (opt.decimation, or
+// the automatic choice from band_hz); 10·D + 1 is its low-pass filter's length.
+std::size_t decimation_factor(const PronyOptions& opt, double sample_rate_hz);
+
 // The automatic order rule on descending singular values s given the noise
 // Hankel's largest singular value.
 std::size_t select_order(const Eigen::VectorXd& s, double s_noise, std::size_t max_order,

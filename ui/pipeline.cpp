@@ -165,6 +165,10 @@ dsp::ImpedanceResult estimate(const acq::Capture& cap, PipelineResult& out) {
                          first.daq_range_v};
   dsp::PronyImpedanceOptions po;
   po.ramp_onset = true;  // the AWG ramps from idle at -dt onto its first sample
+  // The samples before the first decimated one enter Z as recorded: the tube's
+  // modes above the band, which the noise-set order leaves out (see
+  // acq::bench_prony_options).
+  po.direct_samples = dsp::PronyImpedanceOptions::kDirectFilterLength;
   const std::size_t post = first.samples() - static_cast<std::size_t>(first.pretrigger_samples);
   po.prep.max_samples = std::min<std::size_t>(6000, post);
   po.prony.band_hz = fmax;

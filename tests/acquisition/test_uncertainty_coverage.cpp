@@ -4,17 +4,18 @@
 // model order) contain the true transducer impedance, |Z| and phase both?
 // Target: >= 90 %. PIEZO_COVERAGE_SEEDS = 2 in CI, 50 in `make validate`.
 //
-// The band holds the estimate's random part and an allowance for its model
-// order; the bias of Prony-SS at the automatic order next to the 82 kHz
-// resonance (4–5 % on a fixture-free bench too) and the compensation's own
-// systematic error (~0.1 %, ~0.1–0.4°) are larger than that, so the target is
-// missed: the measured coverage is printed and quoted in dsp/README.md, and
-// the test holds the line at what was measured (a band that lost its bootstrap
-// or its standards' part would fall far below).
+// Measured: 93.2 % over 50 seeds, 100 % on the 2 CI seeds — the target is met
+// since the calibration standards' FFT ratio takes the record's last sample
+// from a fit (FftRatioOptions::end_fit_samples): its noise, common to every
+// bin, made a compensation error of up to 0.2 % / 0.1° at 1–20 kHz that the
+// standards' σ did not hold. The test holds the target; dsp/README.md quotes
+// the numbers.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cstdio>
 #include <filesystem>
+#include <vector>
 
 #include "acquisition/impedance_assessment.hpp"
 #include "fixture_study.hpp"
@@ -31,6 +32,7 @@ TEST(UncertaintyCoverage, BandCoversTheTruth) {
   fs::create_directories(dir);
   std::size_t covered = 0, points = 0, covered_mag = 0, covered_phase = 0;
   double worst = 1.0;
+  std::vector<double> width;  // full relative width of the |Z| band, 2·k·σ/|Z|, in %
   for (int seed = 1; seed <= PIEZO_COVERAGE_SEEDS; ++seed) {
     const auto spec = test::fixture_spec(s, static_cast<std::uint64_t>(seed));
     const auto cap = test::measure_capture(spec, 8, true, dir / "c.h5");
@@ -58,6 +60,7 @@ TEST(UncertaintyCoverage, BandCoversTheTruth) {
       in += c;
       ++n;
       const double k95 = a.band->coverage_factor;
+      width.push_back(200.0 * k95 * a.band->abs_sigma_ohm[k] / a.band->abs_ohm[k]);
       covered_mag += std::abs(std::abs(zt) - a.band->abs_ohm[k]) <= k95 * a.band->abs_sigma_ohm[k];
       covered_phase += std::abs(std::remainder(std::arg(zt) - a.band->phase_rad[k], 2 * M_PI)) <=
                        k95 * a.band->phase_sigma_rad[k];
@@ -69,16 +72,19 @@ TEST(UncertaintyCoverage, BandCoversTheTruth) {
                 100.0 * in / n, in, n, a.band->source.c_str());
   }
   const double cov = double(covered) / double(points);
+  std::nth_element(width.begin(), width.begin() + width.size() / 2, width.end());
   std::printf(
       "coverage over %d seeds: %.1f %% (|Z| alone %.1f %%, phase alone %.1f %%), worst seed %.1f "
-      "%% (target >= 90 %%)\n",
+      "%% (target >= 90 %%); median |Z| band width %.2f %% of |Z|\n",
       PIEZO_COVERAGE_SEEDS, 100 * cov, 100.0 * covered_mag / points, 100.0 * covered_phase / points,
-      100 * worst);
-  // The line held (what was measured, not the target): 79.5 % over the 2 CI
-  // seeds (73.3 % over 50) once Prony adds the drive's ramp from −Δt
-  // (PronyImpedanceOptions::ramp_onset); 29 % without it, which read as a 50 ns
-  // channel-2 lead. A band without its bootstrap or standards part covers < 10 %.
-  EXPECT_GT(cov, 0.60);
+      100 * worst, width[width.size() / 2]);
+  // The line held is the target. 50 seeds: 93.2 % (|Z| 97.3 %, phase 95.5 %,
+  // worst seed 75.3 %); 82.7 % with the standards' last sample as recorded,
+  // 73.3 % with Prony's pole model from t = 0 as well (its truncation bias next
+  // to the 82 kHz resonance; PronyImpedanceOptions::direct_samples), 27.7 %
+  // without the drive's ramp from −Δt. The 2 CI seeds: 100 % (80.2 % and
+  // 79.5 % in those earlier states).
+  EXPECT_GE(cov, 0.90);
   fs::remove_all(dir);
 }
 
