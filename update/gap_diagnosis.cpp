@@ -41,6 +41,18 @@ GapCurve curve_of(const GapModel& m, const GapData& d, const std::vector<double>
   return c;
 }
 
+// x's material coordinates for the material p (GapModel: 1 % per unit from
+// `ref`); false when p cannot be expressed (a sign change, say).
+bool material_coords(const TubeParams& p, const TubeParams& ref, std::vector<double>& x) {
+  const double v[4] = {std::log(p.y_e11 / ref.y_e11) / 0.01, std::log(p.nu12 / ref.nu12) / 0.01,
+                       std::log(p.d31 / ref.d31) / 0.01, std::log(p.eps_t33 / ref.eps_t33) / 0.01};
+  for (int i = 0; i < 4; ++i) {
+    if (!std::isfinite(v[i])) return false;
+    x[static_cast<std::size_t>(i)] = v[i];
+  }
+  return true;
+}
+
 std::vector<double> extend(const std::vector<double>& base, const GapModel& m) {
   std::vector<double> x = m.reference_x();
   for (std::size_t i = 0; i < base.size() && i < x.size(); ++i) x[i] = base[i];
@@ -51,7 +63,7 @@ std::vector<double> extend(const std::vector<double>& base, const GapModel& m) {
 std::vector<std::string> supported_gap_effects() {
   std::vector<std::string> out;
   for (const auto& e : model::effect_catalogue())
-    if (e.name != "mass_loading") out.emplace_back(e.name);
+    out.emplace_back(e.name);
   return out;
 }
 
@@ -98,11 +110,7 @@ GapDiagnosis diagnose_gap(model::ModalSolver& solver, const MaterialClass& cls, 
       if (cancelled()) return out;
       say(0.02, "gap: refitting from another start (the updated constants leave a gap)");
       std::vector<double> x = m.reference_x();
-      x[0] = std::log(p.y_e11 / start.y_e11) / 0.01;  // GapModel's material units (1 % per unit)
-      x[1] = std::log(p.nu12 / start.nu12) / 0.01;
-      x[2] = std::log(p.d31 / start.d31) / 0.01;
-      x[3] = std::log(p.eps_t33 / start.eps_t33) / 0.01;
-      if (!std::all_of(x.begin(), x.begin() + 4, [](double v) { return std::isfinite(v); })) continue;
+      if (!material_coords(p, start, x)) continue;
       try {
         m.relinearise(x);
         GapFit alt = fit_gap(m, fit, x, free_base, opt.fit);
@@ -208,6 +216,9 @@ GapDiagnosis diagnose_gap(model::ModalSolver& solver, const MaterialClass& cls, 
       rep.significant = rep.delta_chi2 / scale > opt.significance && stands_clear;
       rep.material = m.material(f.x);
       if (!f.converged) rep.note = f.message;
+      else if (rep.name == "mass_loading")  // tests/update/test_gap_validation, GAP_EFFECTS=mass_loading
+        rep.note = "its magnitude trades against the elastic constants (a lighter mass on a stiffer "
+                   "material): named in 7 of 8 simulated tubes, the fraction within a factor 3 only";
       if (heldout) {
         rep.heldout_chi2_after = predictive_chi2(m, *heldout, f);
         const double before = excess_gap(*ho_cur, out.n_heldout);

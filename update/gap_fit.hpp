@@ -44,7 +44,7 @@ double gap_chi2(const GapModel& m, const GapData& d, const std::vector<double>& 
 struct GapFitOptions {
   int max_iterations = 200;
   double chi2_tolerance = 1e-7;  // relative
-  int max_relinearisations = 4;
+  int max_relinearisations = 12;  // a 3 % end mass needs ~10 (GapDiagnosisExact.EndMass…)
   double relinearise_beyond = 0.3;  // x units (0.3 % of a material parameter)
 };
 

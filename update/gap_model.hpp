@@ -10,9 +10,9 @@
 //
 // Re-solving the FE modes for every trial would make a fit cost seconds, so
 // the port model (C0, C_res, per mode ω_k, p_k², κ_k) is linearised in the
-// four material coordinates around a reference point (the end-mass fraction
-// is not a coordinate yet, so mass_loading is not a gap candidate)
-// and re-linearised by the fitter when it moves away (GapModel::relinearise).
+// four material coordinates — and the end-mass fraction when mass_loading is
+// a parameter — around a reference point, and re-linearised by the fitter when
+// it moves away (GapModel::relinearise).
 #include <complex>
 #include <memory>
 #include <string>
@@ -77,6 +77,7 @@ class GapModel {
  private:
   struct Linear;
   model::ModalPortModel port_at(const TubeParams& p, double mass_fraction) const;
+  double mass_of(const std::vector<double>& x) const;  // end-mass fraction x stands for (fixed or fitted)
 
   model::ModalSolver* solver_;
   model::EffectSet fixed_;

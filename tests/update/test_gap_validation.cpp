@@ -47,6 +47,7 @@ double draw_value(const std::string& e, std::mt19937_64& rng) {
   if (e == "channel_gain") return s * (0.005 + 0.015 * u(rng));
   if (e == "r1_tolerance") return s * (0.01 + 0.02 * u(rng));
   if (e == "mechanical_damping") return 0.003 + 0.005 * u(rng);
+  if (e == "mass_loading") return 0.01 + 0.04 * u(rng);  // glue, lead wires, end caps: 1-5 % of the tube
   return 0;
 }
 
@@ -196,9 +197,21 @@ void print(const Tally& t) {
 }
 
 [[maybe_unused]] std::vector<Case> draw_cases(int n, std::uint64_t seed) {
-  const std::vector<std::string> effects = {"",           "series_resistance", "parallel_capacitance",
-                                            "daq_input_resistance", "dielectric_loss", "channel_skew",
-                                            "channel_gain", "r1_tolerance",      "mechanical_damping"};
+  std::vector<std::string> effects = {"",           "series_resistance", "parallel_capacitance",
+                                      "daq_input_resistance", "dielectric_loss", "channel_skew",
+                                      "channel_gain", "r1_tolerance",      "mechanical_damping"};
+  // GAP_EFFECTS=a,b,...: cycle over these instead ("none" for a control), e.g. mass_loading.
+  if (const char* env = std::getenv("GAP_EFFECTS")) {
+    effects.clear();
+    std::string list(env), item;
+    for (std::size_t i = 0; i <= list.size(); ++i)
+      if (i == list.size() || list[i] == ',') {
+        effects.push_back(item == "none" ? "" : item);
+        item.clear();
+      } else {
+        item += list[i];
+      }
+  }
   std::mt19937_64 rng(seed);
   std::uniform_real_distribution<double> u(0, 1);
   std::vector<Case> cases;
