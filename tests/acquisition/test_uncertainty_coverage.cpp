@@ -25,7 +25,15 @@ namespace {
 using namespace piezo;
 namespace fs = std::filesystem;
 
-TEST(UncertaintyCoverage, BandCoversTheTruth) {
+// One source, two programs: distinct suite names, or CTest (which keys test
+// properties by name) gives the CI program the validate program's label and
+// `make test` skips it.
+#if PIEZO_COVERAGE_SEEDS > 2
+#define PIEZO_COVERAGE_SUITE UncertaintyCoverageValidate
+#else
+#define PIEZO_COVERAGE_SUITE UncertaintyCoverage
+#endif
+TEST(PIEZO_COVERAGE_SUITE, BandCoversTheTruth) {
   const test::FixtureSetting s{"150pF_10ohm_R1+3pct_skew173ns", 150e-12, 10.0, 0.03, 173e-9};
   const auto dir =
       fs::temp_directory_path() / ("piezobench-coverage-" + std::to_string(::getpid()));
