@@ -83,8 +83,27 @@ TEST(ShotEnsemble, EqualsTheBenchsExactResponseAndItsNoiseIsMeasured) {
 // 0.3 % σ, no noise added): a lead resistance is named with its value, and an
 // effect whose signature another candidate shares is named together with it.
 namespace {
-update::GapData exact_gap_data(const model::EffectSet& fx, const std::string& what) {
-  const auto port = test::sim_port(target_spec());
+// The target tube's FE solver, with the end-mass fraction of the exact data.
+struct ExactTube {
+  acq::SimSpec spec = target_spec();
+  model::ResolvedMaterial mat = model::resolve_material({spec.material, spec.isotropic, spec.set});
+  model::TubeModel tube{geometry()};
+  model::ModalSolver solver{tube};
+  model::TubeGeometry geometry() const {
+    model::TubeGeometry g = spec.geometry;
+    g.density_kg_m3 = mat.density_kg_m3;
+    return g;
+  }
+  model::ModalPortModel port(double end_mass_fraction) {
+    model::ModalOptions mo;
+    mo.n_modes = spec.modes;
+    mo.end_mass_fraction = end_mass_fraction;
+    return solver.port_model(model::to_e_form(mat.d), mo);
+  }
+};
+
+update::GapData exact_gap_data(const model::ModalPortModel& port, const model::EffectSet& fx,
+                               const std::string& what) {
   update::GapData d;
   for (double f = 1e3; f <= 120e3; f *= 1.02) d.f_hz.push_back(f);
   d.z_ohm = model::bench_impedance(port, {0.0, 1e-7}, fx, 3140.0, d.f_hz);
@@ -94,22 +113,21 @@ update::GapData exact_gap_data(const model::EffectSet& fx, const std::string& wh
   return d;
 }
 
-update::GapDiagnosis diagnose_exact(const model::EffectSet& fx) {
-  const auto s = target_spec();
-  auto mat = model::resolve_material({s.material, s.isotropic, s.set});
-  model::TubeGeometry g = s.geometry;
-  g.density_kg_m3 = mat.density_kg_m3;
-  model::TubeModel tube(g);
-  model::ModalSolver solver(tube);
-  auto start = model::isotropic_params(mat.d);
-  start.nu12 *= 1.003;  // the update's answer is never exact
+// The diagnosis from a start near the true constants (the update's answer is never exact).
+update::GapDiagnosis diagnose_exact(ExactTube& t, const update::GapData& fit, const update::GapData& ho) {
+  auto start = model::isotropic_params(t.mat.d);
+  start.nu12 *= 1.003;
   start.d31 *= 0.998;
-  const auto fit = exact_gap_data(fx, "exact fit data"),
-             ho = exact_gap_data(fx, "exact held-out data");
   update::GapOptions o;
   o.damping_ref_hz = 50e3;
-  return update::diagnose_gap(solver, update::MaterialClass::isotropic(), start, {0.0, 1e-7},
-                              3140.0, fit, &ho, o);
+  return update::diagnose_gap(t.solver, update::MaterialClass::isotropic(), start, {0.0, 1e-7}, 3140.0, fit, &ho,
+                              o);
+}
+
+update::GapDiagnosis diagnose_exact(const model::EffectSet& fx) {
+  ExactTube t;
+  const auto port = t.port(0.0);
+  return diagnose_exact(t, exact_gap_data(port, fx, "exact fit data"), exact_gap_data(port, fx, "exact held-out data"));
 }
 }  // namespace
 
@@ -153,29 +171,9 @@ TEST(GapDiagnosisExact, ChannelGainIsNamedOrCalledIndistinguishable) {
 // gone there too); with 4 re-linearisations (the former default) it stopped at
 // 0.018, with a one-sided mass slope at 0.0276 after 20. The line held: 10 %.
 TEST(GapDiagnosisExact, EndMassIsNamedWithItsValue) {
-  const auto s = target_spec();
-  auto mat = model::resolve_material({s.material, s.isotropic, s.set});
-  model::TubeGeometry g = s.geometry;
-  g.density_kg_m3 = mat.density_kg_m3;
-  model::TubeModel tube(g);
-  model::ModalSolver solver(tube);
-  model::ModalOptions mo;
-  mo.n_modes = s.modes;
-  mo.end_mass_fraction = 0.03;
-  const auto loaded = solver.port_model(model::to_e_form(mat.d), mo);
-  update::GapData d;
-  for (double f = 1e3; f <= 120e3; f *= 1.02) d.f_hz.push_back(f);
-  d.z_ohm = model::bench_impedance(loaded, {0.0, 1e-7}, {}, 3140.0, d.f_hz);
-  d.sigma_log_mag.assign(d.size(), 3e-3);
-  d.sigma_phase.assign(d.size(), 3e-3);
-  d.description = "exact, 3 % end mass";
-  auto start = model::isotropic_params(mat.d);
-  start.nu12 *= 1.003;
-  start.d31 *= 0.998;
-  update::GapOptions o;
-  o.damping_ref_hz = 50e3;
-  const auto r = update::diagnose_gap(solver, update::MaterialClass::isotropic(), start, {0.0, 1e-7}, 3140.0,
-                                      d, &d, o);
+  ExactTube t;
+  const auto d = exact_gap_data(t.port(0.03), {}, "exact, 3 % end mass");
+  const auto r = diagnose_exact(t, d, d);
   std::printf("3 %% end mass on exact data -> %s\n", r.verdict.c_str());
   EXPECT_EQ(r.verdict_effect, "mass_loading") << r.verdict;
   ASSERT_FALSE(r.steps.empty());
