@@ -1,6 +1,7 @@
 #include "acquisition/capture.hpp"
 
 #include <cmath>
+#include <cstdio>
 
 namespace piezo::acq {
 
@@ -64,10 +65,36 @@ void validate_setup(const Setup& s, const std::string& file) {
       throw CaptureError(file, std::string("/setup/") + name, "must be positive and finite");
 }
 
-void validate_shot(const Shot& shot, const std::string& file, const std::string& p) {
+void validate_shot_attributes(const Shot& shot, std::size_t n, const std::string& file,
+                              const std::string& p) {
   if (!(std::isfinite(shot.sample_rate_hz) && shot.sample_rate_hz > 0))
     throw CaptureError(file, p + "/sample_rate_hz",
                        "must be a positive finite rate, got " + std::to_string(shot.sample_rate_hz));
+  if (!(shot.sample_rate_hz >= kMinRateHz && shot.sample_rate_hz <= kMaxRateHz)) {
+    char b[160];
+    std::snprintf(b, sizeof b, "implausible sample rate %.6g Hz (accepted: %.0g to %.0g Hz)",
+                  shot.sample_rate_hz, kMinRateHz, kMaxRateHz);
+    throw CaptureError(file, p + "/sample_rate_hz", b);
+  }
+  if (n > kMaxSamples)
+    throw CaptureError(file, p + "/v1",
+                       "implausible length: " + std::to_string(n) + " samples (this reader takes at most " +
+                           std::to_string(kMaxSamples) + " per signal)");
+  if (shot.pretrigger_samples < 0 || static_cast<std::size_t>(shot.pretrigger_samples) >= n)
+    throw CaptureError(file, p + "/pretrigger_samples",
+                       "must be in [0, N), got " + std::to_string(shot.pretrigger_samples));
+  for (auto [name, v] : {std::pair{"daq_range_v", &shot.daq_range_v},
+                         std::pair{"v1_range_v", &shot.v1_range_v},
+                         std::pair{"v2_range_v", &shot.v2_range_v}})
+    if (!positive_finite(*v))
+      throw CaptureError(file, p + "/" + name, "must be positive and finite");
+  if (shot.adc_bits && (*shot.adc_bits < 1 || *shot.adc_bits > 32))
+    throw CaptureError(file, p + "/adc_bits",
+                       "must be 1..32, got " + std::to_string(*shot.adc_bits));
+}
+
+void validate_shot(const Shot& shot, const std::string& file, const std::string& p) {
+  validate_shot_attributes(shot, shot.v1.size(), file, p);
   if (shot.v1.size() != shot.v2.size())
     throw CaptureError(file, p, "length mismatch: v1 has " + std::to_string(shot.v1.size()) +
                                     " samples, v2 has " + std::to_string(shot.v2.size()));
@@ -82,17 +109,23 @@ void validate_shot(const Shot& shot, const std::string& file, const std::string&
         throw CaptureError(file, p + "/" + ch,
                            std::string(std::isnan(v[i]) ? "NaN" : "Inf") + " at sample " +
                                std::to_string(i));
+    if (const auto range = shot.range_v(ch[1] == '1' ? 1 : 2)) {
+      const double limit = kRangeMargin * *range;
+      for (std::size_t i = 0; i < v.size(); ++i)
+        if (std::abs(v[i]) > limit) {
+          char b[200];
+          std::snprintf(b, sizeof b,
+                        "sample %zu is %.6g V, outside the declared range +-%.6g V (more than "
+                        "%.2f x full scale: no converter of that range records it)",
+                        i, v[i], *range, kRangeMargin);
+          throw CaptureError(file, p + "/" + ch, b);
+        }
+    }
   }
-  if (shot.pretrigger_samples < 0 ||
-      static_cast<std::size_t>(shot.pretrigger_samples) >= shot.v1.size())
-    throw CaptureError(file, p + "/pretrigger_samples",
-                       "must be in [0, N), got " + std::to_string(shot.pretrigger_samples));
   if (shot.role == Role::Load && !(shot.load_ohm && std::isfinite(*shot.load_ohm) && *shot.load_ohm > 0))
     throw CaptureError(file, p + "/load_ohm", "role 'load' needs a positive load_ohm");
   if (shot.load_parallel_f && !(std::isfinite(*shot.load_parallel_f) && *shot.load_parallel_f >= 0))
     throw CaptureError(file, p + "/load_parallel_f", "must be finite and >= 0");
-  if (shot.daq_range_v && !positive_finite(shot.daq_range_v))
-    throw CaptureError(file, p + "/daq_range_v", "must be positive and finite");
 }
 
 }  // namespace piezo::acq

@@ -15,6 +15,19 @@ namespace piezo::acq {
 inline constexpr std::string_view kFormatName = "piezo-capture";
 inline constexpr std::int64_t kFormatVersion = 1;
 inline constexpr std::size_t kMinSamples = 16;
+// Plausibility limits of the reader (not of the format): a signal longer than
+// kMaxSamples (1e8 samples, 0.8 GB per channel as float64) or a capture whose
+// shots hold more than kMaxCaptureSamples per channel in all is refused before
+// anything is allocated; a sample rate outside [kMinRateHz, kMaxRateHz] is
+// refused (1/rate and N/rate must be ordinary finite numbers). A sample beyond
+// kRangeMargin × the declared full scale (`v1_range_v`, `v2_range_v` or
+// `daq_range_v`) cannot come from that converter: its over-range codes reach
+// a few percent past full scale (an oscilloscope's ADC some 10-20 %, Infiniium:
+// 8 divisions shown of about 10 digitised); 1.25 leaves room for all of them.
+inline constexpr std::size_t kMaxSamples = 100'000'000;
+inline constexpr std::size_t kMaxCaptureSamples = 400'000'000;
+inline constexpr double kMinRateHz = 1.0, kMaxRateHz = 1e12;
+inline constexpr double kRangeMargin = 1.25;
 
 enum class Excitation { ExpDecay, Sine, Chirp, Noise, Arbitrary };
 enum class Role { Dut, Open, Short, Load };
@@ -49,6 +62,15 @@ struct Shot {
   // Extension attribute `daq_range_v` (allowed by the format's "writers may
   // add attributes"): the DAQ's symmetric full scale, for exact clip flags.
   std::optional<double> daq_range_v;
+  // Per-channel full scale and converter resolution, as other tools write them
+  // (`v1_range_v`, `v2_range_v`, `adc_bits`); a channel's own range wins over
+  // daq_range_v.
+  std::optional<double> v1_range_v, v2_range_v;
+  std::optional<std::int64_t> adc_bits;
+  std::optional<double> range_v(int channel) const {
+    const auto& own = channel == 1 ? v1_range_v : v2_range_v;
+    return own ? own : daq_range_v;
+  }
   std::vector<double> v1, v2;  // volts, same length N >= 16
 
   std::string name;  // "000003": set by the reader and the writer
@@ -82,6 +104,10 @@ class CaptureError : public std::runtime_error {
 // Checks a shot against the writer's rules (also used before writing).
 // Throws CaptureError with the given file name and the shot's path.
 void validate_shot(const Shot& shot, const std::string& file, const std::string& h5path);
+// The checks that need no samples (rate, length n, pretrigger, ranges): the
+// reader runs them before it allocates anything.
+void validate_shot_attributes(const Shot& shot, std::size_t n, const std::string& file,
+                              const std::string& h5path);
 void validate_setup(const Setup& setup, const std::string& file);
 
 }  // namespace piezo::acq

@@ -45,8 +45,9 @@ OwnedRecord average_shots(const Capture& cap, std::span<const Shot* const> shots
   r.r1_ohm = rec.r1_ohm;
   r.pretrigger_samples = rec.pretrigger_samples;
   for (const Shot* s : shots)  // one full scale only when every shot has the same
-    if (s->daq_range_v != first.daq_range_v) return r;
-  r.daq_range_v = first.daq_range_v;
+    if (s->range_v(1) != first.range_v(1) || s->range_v(2) != first.range_v(2)) return r;
+  r.daq_range_v = first.range_v(1);
+  r.v2_range_v = first.range_v(2);
   return r;
 }
 
@@ -72,9 +73,10 @@ void deskew_record(OwnedRecord& r, double skew_s) {
 namespace {
 
 bool clipped(const Shot& s) {
-  dsp::ClipDetection c;
-  c.range_v = s.daq_range_v;
-  return dsp::compute_stats(s.v1, c).clipped || dsp::compute_stats(s.v2, c).clipped;
+  dsp::ClipDetection c1, c2;
+  c1.range_v = s.range_v(1);
+  c2.range_v = s.range_v(2);
+  return dsp::compute_stats(s.v1, c1).clipped || dsp::compute_stats(s.v2, c2).clipped;
 }
 
 // The usable transient shots of one role, averaged: those matching the first

@@ -38,10 +38,10 @@ struct OwnedRecord {
   std::vector<double> v1, v2;
   double sample_rate_hz = 0.0, r1_ohm = 0.0;
   std::size_t pretrigger_samples = 0;
-  std::optional<double> daq_range_v;
+  std::optional<double> daq_range_v, v2_range_v;  // as in dsp::DividerRecord
   std::vector<std::string> shots;  // names of the shots in it
   dsp::DividerRecord view() const {
-    return {v1, v2, sample_rate_hz, r1_ohm, pretrigger_samples, daq_range_v};
+    return {v1, v2, sample_rate_hz, r1_ohm, pretrigger_samples, daq_range_v, v2_range_v};
   }
 };
 

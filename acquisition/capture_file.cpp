@@ -26,6 +26,8 @@ namespace {
 class Reader {
  public:
   explicit Reader(std::string file) : file_(std::move(file)) {}
+  // Samples per channel the shots still to be read may hold (kMaxCaptureSamples in all).
+  void limit_total(std::size_t* budget) { budget_ = budget; }
 
   [[noreturn]] void fail(const std::string& path, const std::string& problem) const {
     throw CaptureError(file_, path, problem);
@@ -136,6 +138,9 @@ class Reader {
     hsize_t n = 0;
     H5Sget_simple_extent_dims(space.get(), &n, nullptr);
     *n_out = static_cast<std::size_t>(n);
+    if (n > kMaxSamples)
+      fail(p, "implausible length: " + std::to_string(n) + " samples (this reader takes at most " +
+                  std::to_string(kMaxSamples) + " per signal)");
     std::vector<double> v;
     if (!load || n == 0) return v;
     v.resize(n);
@@ -179,25 +184,34 @@ class Reader {
     s.load_ohm = double_attr(g.get(), "load_ohm", p);
     s.load_parallel_f = double_attr(g.get(), "load_parallel_f", p);
     s.daq_range_v = double_attr(g.get(), "daq_range_v", p);
+    s.v1_range_v = double_attr(g.get(), "v1_range_v", p);
+    s.v2_range_v = double_attr(g.get(), "v2_range_v", p);
+    s.adc_bits = int_attr(g.get(), "adc_bits", p);
     std::size_t n1 = 0, n2 = 0;
-    s.v1 = signal(g.get(), "v1", p, load, &n1);
-    s.v2 = signal(g.get(), "v2", p, load, &n2);
+    signal(g.get(), "v1", p, false, &n1);  // shapes and attributes first: nothing allocated yet
+    signal(g.get(), "v2", p, false, &n2);
     if (n1 != n2)
       fail(p, "length mismatch: v1 has " + std::to_string(n1) + " samples, v2 has " +
                   std::to_string(n2));
     if (n1 < kMinSamples)
       fail(p + "/v1", "too short: " + std::to_string(n1) + " samples, need at least " +
                           std::to_string(kMinSamples));
+    validate_shot_attributes(s, n1, file_, p);
+    if (budget_ && n1 > *budget_)
+      fail(p, "implausible size: the capture's shots hold more than " +
+                  std::to_string(kMaxCaptureSamples) + " samples per channel in all");
+    if (budget_) *budget_ -= n1;
     if (load) {
+      s.v1 = signal(g.get(), "v1", p, true, &n1);
+      s.v2 = signal(g.get(), "v2", p, true, &n2);
       validate_shot(s, file_, p);
-    } else if (s.pretrigger_samples < 0 || static_cast<std::size_t>(s.pretrigger_samples) >= n1) {
-      fail(p + "/pretrigger_samples", "must be in [0, N)");
     }
     return s;
   }
 
  private:
   std::string file_;
+  std::size_t* budget_ = nullptr;
 };
 
 herr_t collect_names(hid_t, const char* name, const H5L_info_t*, void* data) {
@@ -338,6 +352,8 @@ Capture read_capture(const fs::path& path, const ReadOptions& opt) {
   std::erase_if(names, [](const std::string& n) { return !is_shot_name(n); });  // others ignored
   if (names.empty()) rd.fail("/shots", "no shots (empty group)");
   std::sort(names.begin(), names.end());
+  std::size_t budget = kMaxCaptureSamples;
+  rd.limit_total(&budget);
   for (const auto& n : names) {
     try {
       cap.shots.push_back(rd.shot(shots.get(), n, opt.load_samples));
@@ -448,6 +464,9 @@ std::string CaptureWriter::append(const Shot& shot) {
   write_opt(gid, "load_ohm", shot.load_ohm);
   write_opt(gid, "load_parallel_f", shot.load_parallel_f);
   write_opt(gid, "daq_range_v", shot.daq_range_v);
+  write_opt(gid, "v1_range_v", shot.v1_range_v);
+  write_opt(gid, "v2_range_v", shot.v2_range_v);
+  if (shot.adc_bits) write_int_attr(gid, "adc_bits", *shot.adc_bits);
   write_signal(gid, "v1", shot.v1, shot.store_float32);
   write_signal(gid, "v2", shot.v2, shot.store_float32);
   if (H5Olink(gid, impl_->shots.get(), name, H5P_DEFAULT, H5P_DEFAULT) < 0)

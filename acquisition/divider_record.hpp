@@ -9,7 +9,8 @@ namespace piezo::acq {
 
 inline dsp::DividerRecord divider_record(const Capture& cap, const Shot& s) {
   return {s.v1, s.v2, s.sample_rate_hz, cap.setup.divider_r1_ohm,
-          static_cast<std::size_t>(std::max<std::int64_t>(0, s.pretrigger_samples)), s.daq_range_v};
+          static_cast<std::size_t>(std::max<std::int64_t>(0, s.pretrigger_samples)), s.range_v(1),
+          s.range_v(2)};
 }
 
 }  // namespace piezo::acq

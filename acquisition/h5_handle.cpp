@@ -1,10 +1,17 @@
 #include "acquisition/h5_handle.hpp"
 
+#include <new>
+
 namespace piezo::acq::h5 {
 
 std::recursive_mutex& h5_mutex() {
   static std::recursive_mutex m;
   return m;
+}
+
+void renew_h5_mutex_in_forked_child() {
+  // The old object is not destroyed: its owner does not exist in this process.
+  new (&h5_mutex()) std::recursive_mutex();
 }
 
 void quiet_errors() {

@@ -12,6 +12,12 @@ namespace piezo::acq::h5 {
 
 std::recursive_mutex& h5_mutex();
 
+// In a child made by fork() while this thread held h5_mutex(): the child's copy
+// of the lock still names the parent's thread (glibc records the kernel thread
+// id, which the child's only thread does not have), so it is made anew,
+// unlocked. Call it first thing in the child, nowhere else.
+void renew_h5_mutex_in_forked_child();
+
 // Silences HDF5's own error printing (we report errors ourselves); idempotent.
 void quiet_errors();
 

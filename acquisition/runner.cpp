@@ -126,6 +126,7 @@ RunResult run_measurement(Bench& bench, const MeasurementPlan& plan, const std::
         // daq_range_v is one full scale for both channels: written only when they agree
         // (an autoranged standard's channel 2 differs; readers then use the flat-run test).
         if (r.range_v[0] == r.range_v[1]) s.daq_range_v = r.range_v[0];
+        else s.v1_range_v = r.range_v[0], s.v2_range_v = r.range_v[1];
         s.v1 = std::move(r.v1);
         s.v2 = std::move(r.v2);
         dsp::ClipDetection clip1, clip2;

@@ -49,9 +49,10 @@ DividerSignals prepare_divider(const DividerRecord& rec, const char* who, const 
       fail(std::string(v == &s.v1 ? "v1" : "v2") + " is constant after t = 0: no response to analyse");
   if (prep.refuse_clipped) {  // over the analysed span: the pretrigger may sit flat at an offset
     ClipDetection clip;
-    clip.range_v = rec.daq_range_v;
+    clip.range_v = rec.range_v(1);
     if (compute_stats(rec.v1.subspan(rec.pretrigger_samples, use), clip).clipped)
       fail("v1 is clipped (samples at the converter limit)");
+    clip.range_v = rec.range_v(2);
     if (compute_stats(rec.v2.subspan(rec.pretrigger_samples, use), clip).clipped)
       fail("v2 is clipped (samples at the converter limit)");
   }

@@ -23,7 +23,11 @@ struct DividerRecord {
   double sample_rate_hz = 0.0;
   double r1_ohm = 0.0;
   std::size_t pretrigger_samples = 0;
-  std::optional<double> daq_range_v;  // for exact clip detection
+  std::optional<double> daq_range_v;  // for exact clip detection (channel 1, or both)
+  std::optional<double> v2_range_v = std::nullopt;  // channel 2's own full scale, when it has one
+  std::optional<double> range_v(int channel) const {
+    return channel == 2 && v2_range_v ? v2_range_v : daq_range_v;
+  }
 };
 
 // A frequency with its standard uncertainty (NaN when unknown).

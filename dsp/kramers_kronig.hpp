@@ -25,6 +25,17 @@
 // Pass: rms(causality residual) ≤ threshold in both forms and, at every f,
 // −Re Z/|Z| ≤ threshold (+ noise_factor·σ/|Z| there), threshold =
 // max(threshold_rel, noise_factor × rms(σ/|Z|)) when σ is known.
+//
+// Cost. Vector fitting is O(N·P²) in memory-bound dense algebra for N points
+// and P poles, and P grows with the |Z| extrema found — on a noisy 10 000-bin
+// FFT grid thousands of them. So the rational models are FITTED on a thinned
+// grid of at most max_fit_points points, chosen by arc length of ln Z (points
+// crowd where Z turns — resonances, anti-resonances — and thin out where it is
+// smooth, always including both band edges), with at most max_pole_pairs
+// pairs; residuals and passivity are then EVALUATED on the full grid, O(N·P).
+// Each σ-weighted fitted point stands for the points it replaces (its weight
+// is scaled by √(points represented)), so the fit weighs the band as the full
+// grid would. Time and memory: O(N + M·P²) for M ≤ max_fit_points.
 #include <Eigen/Core>
 #include <string>
 
@@ -36,6 +47,8 @@ struct KramersKronigOptions {
   double threshold_rel = 0.005;  // rms relative residual for a pass without σ
   double noise_factor = 3.0;    // with σ: also pass while the residual is within this × the noise
   double max_pole_ratio = 0.0;  // 0: poles anywhere (see VectorFitOptions)
+  int max_fit_points = 600;     // the thinned grid the rational models are fitted on
+  int max_pole_pairs = 40;      // cap of the automatic (and of a given) pole count
 };
 
 struct KramersKronigResult {
@@ -50,6 +63,7 @@ struct KramersKronigResult {
   double max_passivity = 0.0, max_passivity_f_hz = 0.0;
   bool causal = false, passive = false;
   int pole_pairs = 0;
+  int fit_points = 0;  // points of the thinned grid the models were fitted on
   std::string note;  // which form failed, or why the test could not run
 };
 

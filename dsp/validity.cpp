@@ -15,9 +15,10 @@ namespace {
 using cd = std::complex<double>;
 
 bool is_clipped(const DividerRecord& r) {
-  ClipDetection c;
-  c.range_v = r.daq_range_v;
-  return compute_stats(r.v1, c).clipped || compute_stats(r.v2, c).clipped;
+  ClipDetection c1, c2;
+  c1.range_v = r.range_v(1);
+  c2.range_v = r.range_v(2);
+  return compute_stats(r.v1, c1).clipped || compute_stats(r.v2, c2).clipped;
 }
 }  // namespace
 

@@ -7,6 +7,7 @@
 #include <filesystem>
 #include <map>
 
+#include "acquisition/contained_read.hpp"
 #include "acquisition/capture_calibration.hpp"
 #include "acquisition/capture_file.hpp"
 #include "acquisition/divider_record.hpp"
@@ -40,7 +41,13 @@ acq::Capture acquire(const PipelineRequest& req, PipelineResult& out, const Stag
                      const std::atomic<bool>& cancel, std::shared_ptr<drivers::sim::SimBench>& sim) {
   if (!req.replay_capture.empty()) {
     progress(0.05, "reading " + req.replay_capture);
-    auto cap = acq::read_capture(req.replay_capture);
+    // A recorded capture is replayed with what it holds: a shot the reader refuses
+    // (clipped beyond its range, NaN, a wrong shape) is left out and flagged.
+    acq::ContainedReadOptions ro;
+    ro.read.skip_invalid_shots = true;
+    auto cap = req.replay_contained ? acq::read_capture_contained(req.replay_capture, ro)
+                                    : acq::read_capture(req.replay_capture, ro.read);
+    for (const auto& why : cap.rejected_shots) out.warnings.push_back("shot left out: " + why);
     out.capture_path = req.replay_capture;
     out.shots = static_cast<int>(cap.shots.size());
     out.stages.push_back({"acquire", false, "replay of " + req.replay_capture});
@@ -162,7 +169,7 @@ dsp::ImpedanceResult estimate(const acq::Capture& cap, PipelineResult& out) {
   out.shots_averaged = averaged;
   dsp::DividerRecord avg{v1, v2, first.sample_rate_hz, cap.setup.divider_r1_ohm,
                          static_cast<std::size_t>(std::max<std::int64_t>(0, first.pretrigger_samples)),
-                         first.daq_range_v};
+                         first.range_v(1), first.range_v(2)};
   dsp::PronyImpedanceOptions po;
   po.ramp_onset = true;  // the AWG ramps from idle at -dt onto its first sample
   // The samples before the first decimated one enter Z as recorded: the tube's
@@ -535,7 +542,8 @@ PipelineResult run_pipeline(const PipelineRequest& req, const std::function<void
     std::optional<acq::Capture> heldout;
     if (!req.heldout_capture.empty()) {
       out.heldout_path = req.heldout_capture;
-      heldout = acq::read_capture(req.heldout_capture);
+      heldout = req.replay_contained ? acq::read_capture_contained(req.heldout_capture)
+                                     : acq::read_capture(req.heldout_capture);
     } else if (req.heldout_plan && req.replay_capture.empty()) {
       progress(0.65, "acquire: held-out capture");
       heldout = acquire_heldout(req, *req.heldout_plan, sim, out, cancel);

@@ -26,6 +26,11 @@ struct PipelineRequest {
   acq::SimSpec sim;  // used when instrument == "sim"
   std::string capture_out = "capture.h5";
   std::string replay_capture;  // non-empty: skip acquisition
+  // Read replayed and held-out captures in a child process first
+  // (acquisition/contained_read.hpp: a crash of libhdf5 on a damaged file
+  // refuses the file instead of ending this process). Off where the caller is
+  // itself a disposable worker process (ui/replay).
+  bool replay_contained = true;
   std::string material = "apc850";  // nominal model to update
   bool isotropic = true;
   // Gap diagnosis (update/gap_diagnosis.hpp). Held-out data, in this order:

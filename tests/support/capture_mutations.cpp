@@ -38,6 +38,13 @@ const std::vector<DefectCase>& all_defects() {
       {Defect::InfSample, "inf_sample", "/shots/000001/v2", "Inf at sample 7"},
       {Defect::EmptyShots, "empty_shots", "/shots", "no shots"},
       {Defect::Truncated, "truncated", "/", "HDF5"},
+      // Issue 16: plausibility. One sample of 3.5e11 V on a channel declared +-2 V.
+      {Defect::OutOfRangeSample, "out_of_range_sample", "/shots/000001/v1",
+       "outside the declared range"},
+      {Defect::TinySampleRate, "tiny_rate", "/shots/000001/sample_rate_hz", "implausible sample rate"},
+      {Defect::HugeSampleRate, "huge_rate", "/shots/000001/sample_rate_hz", "implausible sample rate"},
+      {Defect::AbsurdLength, "absurd_length", "/shots/000001/v1", "implausible length"},
+      {Defect::BadAdcBits, "bad_adc_bits", "/shots/000001/adc_bits", "must be 1..32"},
       {Defect::NotHdf5, "not_hdf5", "/", "not a readable HDF5 file"},
       {Defect::Directory, "directory", "/", "is a directory"},
       {Defect::MissingPath, "missing_path", "/", "no such file"},
@@ -209,6 +216,32 @@ void make_capture_with_defect(const fs::path& file, Defect d) {
       v2[7] = -std::numeric_limits<double>::infinity();
       replace_dataset_f64(shot, "v2", v2);
       break;
+    case Defect::OutOfRangeSample:
+      set_double_attr(shot, "v1_range_v", 2.0);
+      v1[11] = 3.5e11;
+      replace_dataset_f64(shot, "v1", v1);
+      break;
+    case Defect::TinySampleRate: set_double_attr(shot, "sample_rate_hz", 1e-300); break;
+    case Defect::HugeSampleRate: set_double_attr(shot, "sample_rate_hz", 1e300); break;
+    case Defect::AbsurdLength: {
+      // Declared 2^40 samples (8 TiB as float64), never written: the reader
+      // must refuse it from the shape, before allocating anything.
+      for (const char* ch : {"v1", "v2"}) {
+        check(H5Ldelete(shot, ch, H5P_DEFAULT), ch);
+        hsize_t dim = hsize_t(1) << 40;
+        hid_t sp = H5Screate_simple(1, &dim, nullptr);
+        hid_t dcpl = H5Pcreate(H5P_DATASET_CREATE);
+        hsize_t chunk = 1024;
+        H5Pset_chunk(dcpl, 1, &chunk);
+        hid_t ds = H5Dcreate2(shot, ch, H5T_IEEE_F32LE, sp, H5P_DEFAULT, dcpl, H5P_DEFAULT);
+        if (ds < 0) throw std::runtime_error(std::string("capture_mutations: cannot create ") + ch);
+        H5Dclose(ds);
+        H5Pclose(dcpl);
+        H5Sclose(sp);
+      }
+      break;
+    }
+    case Defect::BadAdcBits: set_int_attr(shot, "adc_bits", 0); break;
     case Defect::EmptyShots:
       H5Gclose(shot);
       shot = -1;

@@ -35,6 +35,11 @@ enum class Defect {
   EmptyShots,
   Truncated,
   NotHdf5,
+  OutOfRangeSample,
+  TinySampleRate,
+  HugeSampleRate,
+  AbsurdLength,
+  BadAdcBits,
   Directory,
   MissingPath,
 };

@@ -4,6 +4,7 @@
 
 #include <array>
 #include <cstdio>
+#include <filesystem>
 #include <stdexcept>
 #include <string>
 
@@ -18,7 +19,7 @@ struct CliResult {
 // Runs `PIEZO_CLI args` through /bin/sh; args must be shell-quoted by the caller.
 inline CliResult run_cli(const std::string& args, const std::string& stdin_text = {}) {
   static int counter = 0;
-  const std::string errfile = "/tmp/piezobench-cli-err-" + std::to_string(::getpid()) + "-" +
+  const std::string errfile = std::filesystem::temp_directory_path().string() + "/piezobench-cli-err-" + std::to_string(::getpid()) + "-" +
                               std::to_string(counter++);
   std::string cmd = std::string(PIEZO_CLI) + " " + args + " 2>" + errfile;
   if (stdin_text.empty()) cmd += " </dev/null";

@@ -97,17 +97,25 @@ TEST(GapMeasuredFixture, CalibrationShotsTurnAliasesIntoMeasuredQuantities) {
   const double bias1 = eps_error_pct(cal);
   const double el0 = worst_elastic_pct(plain), el1 = worst_elastic_pct(cal);
   std::printf("worst of YE11, nu12, d31: without calibration %.3f %%, with %.3f %%\n", el0, el1);
-  // Lead R and skew bias the features (nu12, d31) without calibration; with
-  // the fixture in the port fit's circuit they are back near the noise.
-  EXPECT_GT(el0, 1.0);
+  // With the fixture in the port fit's circuit the elastic constants are back
+  // near the noise (their CRB at this noise and shot count is 0.2-0.6 %).
+  // Without calibration the lead R and skew bias them too, but by how much
+  // depends on the draw AND on the last bits of libm: this machine gives
+  // 1.18 %, the same binary with glibc's FMA/AVX2 code paths switched off
+  // (GLIBC_TUNABLES=glibc.cpu.hwcaps=-AVX2,-FMA, as on a CPU or VM without
+  // them) gives 0.80 % on the same capture. It is printed, not asserted (issue 16).
   EXPECT_LT(el1, 0.6);
   std::printf(
       "epsT33 error: without calibration %+.3f %%, with %+.3f %%; measured Cp %.1f pF, R1 error "
       "%+.3f %%; "
       "verdict with calibration: %s\n",
       bias0, bias1, cp * 1e12, 100 * r1, d.verdict_effect.c_str());
-  // Cp/C0 ≈ 1 % and R1 +2 % read as εT33 ≈ +3 % without calibration.
-  EXPECT_GT(std::abs(bias0), 1.0);
+  // The circuit alone predicts the alias: at low frequency the divider reads
+  // (C_T + Cp)(1 + e) for a true R1 of R1_nom (1 + e), i.e. εT33 high by
+  // (1 + Cp/C_T)(1 + e) - 1 ≈ 3.0 % (C_T = 2π ε L / ln(Do/Di) ≈ 14.9 nF,
+  // Cp = 150 pF, e = +2 %); a deterministic offset 30 times the noise's
+  // (measured: +3.80 %, the same under both libm code paths).
+  EXPECT_GT(bias0, 2.0);
   EXPECT_LT(std::abs(bias1), 0.3);
   EXPECT_EQ(d.verdict_effect, "none") << d.verdict;
   // The JSON carries them under "measured", in issue 7's shape.

@@ -4,6 +4,7 @@
 #include <iostream>
 
 #include "acquisition/capture_file.hpp"
+#include "acquisition/contained_read.hpp"
 #include "dsp/signal_stats.hpp"
 #include "ui/cli/cli_common.hpp"
 
@@ -43,10 +44,11 @@ nlohmann::json capture_info_json(const acq::Capture& cap) {
   j["setup"] = s;
   j["shots"] = nlohmann::json::array();
   for (const auto& sh : cap.shots) {
-    dsp::ClipDetection clip;
-    clip.range_v = sh.daq_range_v;
-    auto s1 = dsp::compute_stats(sh.v1, clip);
-    auto s2 = dsp::compute_stats(sh.v2, clip);
+    dsp::ClipDetection clip1, clip2;
+    clip1.range_v = sh.range_v(1);
+    clip2.range_v = sh.range_v(2);
+    auto s1 = dsp::compute_stats(sh.v1, clip1);
+    auto s2 = dsp::compute_stats(sh.v2, clip2);
     nlohmann::json o;
     o["name"] = sh.name;
     o["samples"] = sh.samples();
@@ -63,6 +65,9 @@ nlohmann::json capture_info_json(const acq::Capture& cap) {
     put(o, "load_ohm", sh.load_ohm);
     put(o, "load_parallel_f", sh.load_parallel_f);
     put(o, "daq_range_v", sh.daq_range_v);
+    put(o, "v1_range_v", sh.v1_range_v);
+    put(o, "v2_range_v", sh.v2_range_v);
+    if (sh.adc_bits) o["adc_bits"] = *sh.adc_bits;
     o["v1"] = stats_json(s1);
     o["v2"] = stats_json(s2);
     o["clipped"] = s1.clipped || s2.clipped;
@@ -117,7 +122,7 @@ void register_capture_commands(CLI::App& app, Context& ctx) {
   add_json_flag(capture, ctx);
   info->callback([&ctx, file] {
     ctx.exit_code = run_command(ctx, [&] {
-      auto cap = acq::read_capture(*file);
+      auto cap = acq::read_capture_contained(*file);  // a crash of libhdf5 costs the file only
       auto j = capture_info_json(cap);
       if (ctx.json)
         print_json(j);

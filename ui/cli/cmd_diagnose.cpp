@@ -15,6 +15,7 @@
 #include <map>
 
 #include "acquisition/capture_file.hpp"
+#include "acquisition/contained_read.hpp"
 #include "model/material_presets.hpp"
 #include "ui/cli/cli_common.hpp"
 #include "ui/cli/diagnosis_text.hpp"
@@ -52,9 +53,9 @@ std::pair<int, int> parse_size(const std::string& s) {
 }
 
 acq::Capture capture_attributes(const std::string& path) {
-  acq::ReadOptions ro;
-  ro.load_samples = false;  // attributes only: quick, and the file is validated
-  return acq::read_capture(path, ro);
+  acq::ContainedReadOptions ro;
+  ro.read.load_samples = false;  // attributes only: quick, and the file is validated
+  return acq::read_capture_contained(path, ro);  // a crash of libhdf5 costs the file only
 }
 
 // The diagnosis measures the noise from repeated shots: it needs at least 3

@@ -11,6 +11,7 @@
 #include <memory>
 
 #include "acquisition/capture_file.hpp"
+#include "acquisition/contained_read.hpp"
 #include "acquisition/divider_record.hpp"
 #include "acquisition/impedance_assessment.hpp"
 #include "dsp/deskew.hpp"
@@ -212,7 +213,7 @@ void print_text(const nlohmann::json& j) {
 
 void run(const ImpedanceArgs& a, Context& ctx) {
   if (int(a.csv) + int(a.s1p) + int(ctx.json) > 1) throw InputError("choose one of --json, --csv, --s1p");
-  const auto cap = acq::read_capture(a.file);
+  const auto cap = acq::read_capture_contained(a.file);  // a crash of libhdf5 costs the file only
   if (cap.shots.empty()) throw InputError("the capture holds no shot");
   const auto win = dsp::parse_window(a.window);
   if (!win) throw InputError("unknown window '" + a.window + "'");

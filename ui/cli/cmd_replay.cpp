@@ -61,6 +61,7 @@ void register_replay_commands(CLI::App& app, Context& ctx) {
     std::vector<std::string> inputs;
     std::string out, shard = "0/1", report, jsonl, material;
     std::size_t jobs = 1;
+    double timeout_s = 600.0;
     bool transverse = false;
   };
   auto a = std::make_shared<Args>();
@@ -68,8 +69,14 @@ void register_replay_commands(CLI::App& app, Context& ctx) {
       ->required();
   r->add_option("--out", a->out, "Results file (HDF5, piezo-replay/1); an existing one is resumed")
       ->required();
-  r->add_option("--jobs", a->jobs, "Captures replayed in parallel (threads)")
+  r->add_option("--jobs", a->jobs,
+                "Captures replayed in parallel (worker processes: a crash costs one capture)")
       ->capture_default_str();
+  r->add_option("--timeout", a->timeout_s,
+                "Seconds one capture may take before its worker is killed and the capture "
+                "recorded as hung")
+      ->capture_default_str()
+      ->check(CLI::Range(1.0, 1e6));
   r->add_option("--shard", a->shard,
                 "Replay shard I of N (0-based), e.g. $SLURM_ARRAY_TASK_ID/$SLURM_ARRAY_TASK_COUNT")
       ->capture_default_str();
@@ -87,6 +94,7 @@ void register_replay_commands(CLI::App& app, Context& ctx) {
       opt.inputs = a->inputs;
       opt.out = a->out;
       opt.jobs = a->jobs;
+      opt.capture_timeout_s = a->timeout_s;
       opt.shard = replay::parse_shard(a->shard);
       if (!a->report.empty()) opt.report_dir = a->report;
       if (!a->jsonl.empty()) opt.jsonl = a->jsonl;
@@ -130,6 +138,7 @@ void register_replay_commands(CLI::App& app, Context& ctx) {
                           {"replayed", c.ok},
                           {"failed", c.failed},
                           {"done_before", c.skipped},
+                          {"failed_before", c.failed_before},
                           {"wall_s", s.wall_s},
                           {"captures_per_s", c.ok + c.failed ? (c.ok + c.failed) / s.wall_s : 0.0},
                           {"jobs", opt.jobs},
@@ -143,9 +152,13 @@ void register_replay_commands(CLI::App& app, Context& ctx) {
         std::printf("replay: %zu capture(s) found, %zu in shard %s\n", s.found, c.total,
                     a->shard.c_str());
         std::printf(
-            "replay: %zu replayed, %zu failed (skipped), %zu done before; %.1f s, %.2f captures/s "
+            "replay: %zu replayed, %zu failed, %zu done before%s; %.1f s, %.2f captures/s "
             "with --jobs %zu\n",
-            c.ok, c.failed, c.skipped, s.wall_s, j["captures_per_s"].get<double>(), opt.jobs);
+            c.ok, c.failed, c.skipped,
+            c.failed_before
+                ? (" (" + std::to_string(c.failed_before) + " of them crashed or hung a worker)").c_str()
+                : "",
+            s.wall_s, j["captures_per_s"].get<double>(), opt.jobs);
         std::printf("results: %s%s%s\n", opt.out.string().c_str(),
                     opt.report_dir ? ", report: " : "",
                     opt.report_dir ? (*opt.report_dir / "summary.md").string().c_str() : "");
@@ -153,7 +166,7 @@ void register_replay_commands(CLI::App& app, Context& ctx) {
       }
       if (s.interrupted || s.report_errors)
         ctx.exit_code = kInternal;
-      else if (c.failed)
+      else if (c.failed || c.failed_before)
         ctx.exit_code = kBadInput;
     });
   });

@@ -3,13 +3,26 @@
 #include <chrono>
 #include <fstream>
 #include <map>
+#include <set>
 #include <mutex>
 #include <stdexcept>
 #include <thread>
 
+#include <fcntl.h>
+#include <poll.h>
+#include <sys/prctl.h>
+#include <signal.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <cerrno>
+#include <cstring>
+
 #include "acquisition/capture_file.hpp"
+#include "acquisition/contained_read.hpp"
 #include "acquisition/results_file.hpp"
 #include "ui/pipeline.hpp"
+#include "ui/replay/record_wire.hpp"
 #include "ui/replay/replay_record.hpp"
 #include "ui/replay/sha256.hpp"
 #include "ui/report/batch_summary.hpp"
@@ -39,6 +52,9 @@ class Sink {
     counts_.total = total;
     for (auto& e : results_.index()) {
       if (e.status == "ok") done_.emplace(e.key, e.input_path);
+      // A capture that crashed or hung a worker would do so again: the same bytes
+      // (the key holds the digest) are not retried. Other failures are.
+      if (e.status == "failed" && kept_failure(e.key)) failed_done_.insert(e.key);
       by_path_[e.input_path].push_back(e.key);
     }
     if (opt.jsonl) {
@@ -48,7 +64,9 @@ class Sink {
   }
 
   // done_ is only read after construction: no lock needed.
-  bool finished(const std::string& key) const { return done_.count(key) > 0; }
+  bool finished(const std::string& key) const {
+    return done_.count(key) > 0 || failed_done_.count(key) > 0;
+  }
 
   // A capture finished earlier: its stored line goes to this run's JSON lines.
   void skipped(const std::string& key) {
@@ -56,6 +74,7 @@ class Sink {
     if (jsonl_.is_open())
       if (auto rec = results_.get(key)) line(*rec);
     ++counts_.skipped;
+    if (failed_done_.count(key)) ++counts_.failed_before;
     step();
   }
 
@@ -111,7 +130,17 @@ class Sink {
   const ReplayCallbacks& cb_;
   std::mutex mu_;
   std::ofstream jsonl_;
+  bool kept_failure(const std::string& key) const {
+    const auto rec = results_.get(key);
+    if (!rec) return false;
+    const auto j = nlohmann::json::parse(rec->result_json, nullptr, false);
+    if (!j.is_object() || !j.contains("error") || !j["error"].is_object()) return false;
+    const auto kind = j["error"].value("kind", std::string());
+    return kind == "crashed" || kind == "hung";
+  }
+
   std::map<std::string, std::string> done_;  // key → path of finished ("ok") records
+  std::set<std::string> failed_done_;        // keys of captures that crashed or hung a worker
   std::map<std::string, std::vector<std::string>> by_path_;  // path → keys
   ReplayProgress counts_;
   std::size_t processed_ = 0;
@@ -119,79 +148,360 @@ class Sink {
   Clock::time_point t0_ = Clock::now();
 };
 
-struct Worker {
-  const ReplayOptions& opt;
-  Sink& sink;
-  const std::atomic<bool>& cancel;
-
-  void replay(const fs::path& file) {
-    const std::string path = file.string();
-    const auto t0 = Clock::now();
-    std::string sha;
-    try {
-      sha = sha256_file(file);
-    } catch (const std::exception& e) {
-      fail(path, "", "bad capture", naming(path, e.what()), t0);
-      return;
-    }
-    const std::string key = record_key(path, sha);
-    if (sink.finished(key)) {
-      sink.skipped(key);
-      return;
-    }
-    std::string material = opt.material;
-    ui::PipelineResult result;
-    try {
-      if (material.empty()) {
-        acq::ReadOptions ro;
-        ro.load_samples = false;  // attributes only: which nominal model to update
-        material = acq::read_capture(file, ro).setup.material.value_or("apc850");
-      }
-      ui::PipelineRequest req;
-      req.replay_capture = path;
-      req.material = material;
-      req.isotropic = opt.isotropic;
-      result = ui::run_pipeline(req, nullptr, cancel);
-    } catch (const acq::CaptureError& e) {
-      fail(path, sha, "bad capture", e.what(), t0);
-      return;
-    } catch (const std::invalid_argument& e) {
-      fail(path, sha, "bad input", naming(path, e.what()), t0);
-      return;
-    } catch (const std::exception& e) {
-      fail(path, sha, "failed", naming(path, e.what()), t0);
-      return;
-    }
-    if (cancel) return;  // a cancelled pipeline returns a partial result: not a finished capture
-    const double elapsed = seconds_since(t0);
-    std::optional<ReplayIssue> issue;
-    if (opt.report_dir) {
-      try {
-        report::write_capture_report(result, {path, sha, material, elapsed},
-                                     *opt.report_dir / report::capture_report_folder(path, key));
-      } catch (const std::exception& e) {
-        issue = ReplayIssue{path, "report", e.what()};
-      }
-    }
-    sink.put(ok_record(path, sha, material, result, elapsed), issue);
-  }
-
-  void fail(const std::string& path, const std::string& sha, const std::string& kind,
-            const std::string& msg, Clock::time_point t0) {
-    const double elapsed = seconds_since(t0);
-    std::optional<ReplayIssue> issue = ReplayIssue{path, kind, msg};
-    auto rec = failed_record(path, sha, kind, msg, elapsed);
+// ------------------------------------------------------------- one capture
+// Runs in a worker process: everything but the results file. `stage` tells the
+// batch what the worker is doing, so that a crash can be named.
+Outcome replay_capture(const fs::path& file, const ReplayOptions& opt, const Sink& sink,
+                       const std::atomic<bool>& cancel,
+                       const std::function<void(const char*, const std::string&)>& stage) {
+  const std::string path = file.string();
+  const auto t0 = Clock::now();
+  Outcome out;
+  auto fail = [&](const std::string& sha, const std::string& kind, const std::string& msg) {
+    out.record = failed_record(path, sha, kind, msg, seconds_since(t0));
+    out.key = out.record.key;
+    out.issue = WireIssue{path, kind, msg};
     if (opt.report_dir) {
       try {
         report::write_failed_capture_report(
-            {path, sha, "", elapsed}, msg,
-            *opt.report_dir / report::capture_report_folder(path, rec.key));
+            {path, sha, "", out.record.elapsed_s}, msg,
+            *opt.report_dir / report::capture_report_folder(path, out.key));
       } catch (const std::exception& e) {
-        sink.issue({path, "report", e.what()});
+        out.report_issue = WireIssue{path, "report", e.what()};
       }
     }
-    sink.put(rec, issue);
+    return out;
+  };
+  std::string sha;
+  try {
+    sha = sha256_file(file);
+  } catch (const std::exception& e) {
+    return fail("", "bad capture", naming(path, e.what()));
   }
+  out.key = record_key(path, sha);
+  if (sink.finished(out.key)) {
+    out.skipped = true;
+    return out;
+  }
+  std::string material = opt.material;
+  ui::PipelineResult result;
+  try {
+    stage("reading", sha);
+    if (material.empty()) {
+      acq::ReadOptions ro;
+      ro.load_samples = false;  // attributes only: which nominal model to update
+      ro.skip_invalid_shots = true;
+      material = acq::read_capture(file, ro).setup.material.value_or("apc850");
+    }
+    stage("processing", sha);
+    ui::PipelineRequest req;
+    req.replay_capture = path;
+    req.replay_contained = false;  // this worker process is the containment
+    req.material = material;
+    req.isotropic = opt.isotropic;
+    result = ui::run_pipeline(req, nullptr, cancel);
+  } catch (const acq::CaptureError& e) {
+    return fail(sha, "bad capture", e.what());
+  } catch (const std::invalid_argument& e) {
+    return fail(sha, "bad input", naming(path, e.what()));
+  } catch (const std::exception& e) {
+    return fail(sha, "failed", naming(path, e.what()));
+  }
+  if (cancel) {  // a cancelled pipeline returns a partial result: not a finished capture
+    out.cancelled = true;
+    return out;
+  }
+  const double elapsed = seconds_since(t0);
+  if (opt.report_dir) {
+    try {
+      report::write_capture_report(result, {path, sha, material, elapsed},
+                                   *opt.report_dir / report::capture_report_folder(path, out.key));
+    } catch (const std::exception& e) {
+      out.issue = WireIssue{path, "report", e.what()};
+    }
+  }
+  out.record = ok_record(path, sha, material, result, elapsed);
+  return out;
+}
+
+// ---------------------------------------------------------- worker processes
+// Each worker is a forked copy of this process that replays the captures the
+// batch sends it (their index in `files`, 8 bytes on its task pipe) and answers
+// with frames (record_wire.hpp) on its result pipe. The batch itself stays one
+// thread and is the only writer of the results file. A worker that dies (a
+// crash inside a library, e.g. libhdf5 on a damaged file) or overruns the
+// capture timeout costs that capture only: it is recorded as failed and a new
+// worker takes the next one.
+struct WorkerProc {
+  pid_t pid = -1;
+  int task_fd = -1, result_fd = -1;
+  std::string buf;
+  std::optional<std::size_t> task;
+  Clock::time_point started;
+  std::string stage, sha;
+};
+
+void write_all(int fd, const void* data, std::size_t n) {
+  const char* p = static_cast<const char*>(data);
+  while (n) {
+    const ssize_t w = ::write(fd, p, n);
+    if (w < 0 && errno == EINTR) continue;
+    if (w <= 0) throw std::runtime_error(std::string("pipe write: ") + std::strerror(errno));
+    p += w;
+    n -= static_cast<std::size_t>(w);
+  }
+}
+
+bool read_exact(int fd, void* data, std::size_t n) {
+  char* p = static_cast<char*>(data);
+  while (n) {
+    const ssize_t r = ::read(fd, p, n);
+    if (r < 0 && errno == EINTR) continue;
+    if (r <= 0) return false;
+    p += r;
+    n -= static_cast<std::size_t>(r);
+  }
+  return true;
+}
+
+// Closes every descriptor above stdio except a and b (in a forked worker).
+void keep_only_fds(int a, int b) {
+  const int lo = std::min(a, b), hi = std::max(a, b);
+  if (lo > 3) ::close_range(3, static_cast<unsigned>(lo - 1), 0);
+  if (hi - lo > 1) ::close_range(static_cast<unsigned>(lo + 1), static_cast<unsigned>(hi - 1), 0);
+  ::close_range(static_cast<unsigned>(hi + 1), ~0U, 0);
+}
+
+class WorkerPool {
+ public:
+  WorkerPool(const std::vector<fs::path>& files, const ReplayOptions& opt, Sink& sink,
+             const std::atomic<bool>& cancel)
+      : files_(files), opt_(opt), sink_(sink), cancel_(cancel) {}
+  ~WorkerPool() {
+    for (auto& w : workers_) stop(w, /*kill_it=*/true);
+  }
+
+  void run() {
+    const std::size_t n = std::min(opt_.jobs, std::max<std::size_t>(1, files_.size()));
+    workers_.resize(n);
+    for (auto& w : workers_) spawn(w);
+    std::size_t next = 0;
+    for (;;) {
+      if (cancel_) {  // interrupted: what is under way is not recorded (a rerun resumes it)
+        for (auto& w : workers_) stop(w, true);
+        return;
+      }
+      for (auto& w : workers_)
+        if (!w.task && next < files_.size()) {
+          if (w.pid < 0) spawn(w);
+          const std::uint64_t i = next++;
+          w.task = i;
+          w.started = Clock::now();
+          w.stage.clear();
+          w.sha.clear();
+          write_all(w.task_fd, &i, sizeof i);
+        }
+      bool busy = false;
+      for (const auto& w : workers_) busy |= w.task.has_value();
+      if (!busy) break;
+      wait_and_collect();
+    }
+    for (auto& w : workers_) stop(w, false);
+  }
+
+ private:
+  void spawn(WorkerProc& w) {
+    int task[2], result[2];
+    if (::pipe2(task, O_CLOEXEC) != 0) throw std::runtime_error("replay: pipe: " + std::string(std::strerror(errno)));
+    if (::pipe2(result, O_CLOEXEC) != 0) {
+      ::close(task[0]), ::close(task[1]);
+      throw std::runtime_error("replay: pipe: " + std::string(std::strerror(errno)));
+    }
+    const pid_t parent = ::getpid();
+    const pid_t pid = ::fork();
+    if (pid < 0) {
+      for (int fd : {task[0], task[1], result[0], result[1]}) ::close(fd);
+      throw std::runtime_error("replay: cannot start a worker process: " + std::string(std::strerror(errno)));
+    }
+    if (pid == 0) {
+      // The worker dies with the batch (a killed batch must not leave workers
+      // behind that hold its results file open and locked).
+      ::prctl(PR_SET_PDEATHSIG, SIGKILL);
+      if (::getppid() != parent) ::_exit(1);
+      // Only its own two pipe ends and stdio stay open: not the results file and
+      // its lock, not the JSON lines, not a sibling's pipe (whose write end kept
+      // here would hide that sibling's death from the batch).
+      keep_only_fds(task[0], result[1]);
+      worker_main(task[0], result[1]);
+    }
+    ::close(task[0]);
+    ::close(result[1]);
+    w.pid = pid;
+    w.task_fd = task[1];
+    w.result_fd = result[0];
+    w.buf.clear();
+    w.task.reset();
+  }
+
+  [[noreturn]] void worker_main(int task_fd, int result_fd) {
+    int code = 0;
+    try {
+      std::uint64_t i;
+      while (read_exact(task_fd, &i, sizeof i)) {
+        if (i >= files_.size()) break;
+        auto stage = [&](const char* what, const std::string& sha) {
+          const std::string f = frame('S', std::string(what) + '\0' + sha);
+          write_all(result_fd, f.data(), f.size());
+        };
+        const Outcome o = replay_capture(files_[i], opt_, sink_, cancel_, stage);
+        const std::string f = frame('O', encode_outcome(o));
+        write_all(result_fd, f.data(), f.size());
+      }
+    } catch (...) {
+      code = 1;
+    }
+    ::_exit(code);  // no atexit handlers: the batch's open files are not this process's to flush
+  }
+
+  void stop(WorkerProc& w, bool kill_it) {
+    if (w.pid < 0) return;
+    if (kill_it) ::kill(w.pid, SIGKILL);
+    if (w.task_fd >= 0) ::close(w.task_fd);  // EOF on its task pipe: the worker exits
+    if (w.result_fd >= 0) ::close(w.result_fd);
+    int status;
+    while (::waitpid(w.pid, &status, 0) < 0 && errno == EINTR) {
+    }
+    w.pid = -1;
+    w.task_fd = w.result_fd = -1;
+    w.task.reset();
+  }
+
+  void wait_and_collect() {
+    std::vector<pollfd> fds;
+    std::vector<WorkerProc*> who;
+    double wait_s = 0.2;  // the cancel flag is looked at this often
+    for (auto& w : workers_)
+      if (w.task) {
+        fds.push_back({w.result_fd, POLLIN, 0});
+        who.push_back(&w);
+        wait_s = std::min(wait_s, std::max(0.0, opt_.capture_timeout_s - seconds_since(w.started)));
+      }
+    const int r = ::poll(fds.data(), fds.size(), static_cast<int>(wait_s * 1000.0) + 1);
+    if (r < 0 && errno != EINTR) throw std::runtime_error(std::string("replay: poll: ") + std::strerror(errno));
+    for (std::size_t k = 0; r > 0 && k < fds.size(); ++k) {
+      if (!fds[k].revents) continue;
+      WorkerProc& w = *who[k];
+      char b[65536];
+      const ssize_t n = ::read(w.result_fd, b, sizeof b);
+      if (n < 0 && errno == EINTR) continue;
+      if (n <= 0) {
+        died(w);
+        continue;
+      }
+      w.buf.append(b, static_cast<std::size_t>(n));
+      char kind;
+      std::string payload;
+      try {
+        while (w.task && next_frame(w.buf, kind, payload)) {
+          if (kind == 'S') {
+            const auto z = payload.find('\0');
+            w.stage = payload.substr(0, z);
+            if (z != std::string::npos) w.sha = payload.substr(z + 1);
+          } else if (kind == 'O') {
+            apply(decode_outcome(payload));
+            w.task.reset();
+          }
+        }
+      } catch (const std::runtime_error&) {  // garbled frames: the worker is not trusted further
+        ::kill(w.pid, SIGKILL);
+        died(w);
+      }
+    }
+    for (auto& w : workers_)
+      if (w.task && seconds_since(w.started) > opt_.capture_timeout_s) {
+        ::kill(w.pid, SIGKILL);
+        char b[200];
+        std::snprintf(b, sizeof b,
+                      "replay did not finish within %.0f s (%s); the worker was killed and the "
+                      "capture left out",
+                      opt_.capture_timeout_s,
+                      w.stage == "reading" ? "the HDF5 library hung reading the file" : "hung");
+        lost(w, "hung", b, -1);
+      }
+  }
+
+  // The worker's pipe closed: it exited or died, maybe in the middle of a capture.
+  void died(WorkerProc& w) {
+    int status = 0;
+    ::close(w.task_fd);
+    ::close(w.result_fd);
+    while (::waitpid(w.pid, &status, 0) < 0 && errno == EINTR) {
+    }
+    w.pid = -1;
+    w.task_fd = w.result_fd = -1;
+    if (!w.task) return;
+    const std::size_t i = *w.task;
+    const std::string path = files_[i].string();
+    std::string how = WIFSIGNALED(status) ? acq::describe_signal(WTERMSIG(status))
+                                          : "exit code " + std::to_string(WEXITSTATUS(status));
+    std::string msg =
+        w.stage == "reading"
+            ? "the HDF5 library crashed reading " + path + " (" + how +
+                  "): the file is damaged or not a capture; it was left out"
+            : "the replay worker died (" + how + ") while processing " + path +
+                  (w.stage.empty() ? "" : " (stage: " + w.stage + ")") + "; the capture was left out";
+    record_lost(i, w.sha, "crashed", msg, seconds_since(w.started));
+    w.task.reset();
+  }
+
+  void lost(WorkerProc& w, const std::string& kind, const std::string& msg, int) {
+    const std::size_t i = *w.task;
+    const std::string sha = w.sha;
+    const double t = seconds_since(w.started);
+    stop(w, true);
+    record_lost(i, sha, kind, msg, t);
+  }
+
+  void record_lost(std::size_t i, std::string sha, const std::string& kind,
+                   const std::string& msg, double elapsed) {
+    const std::string path = files_[i].string();
+    if (sha.empty()) {
+      try {
+        sha = sha256_file(files_[i]);
+      } catch (const std::exception&) {
+        // unreadable bytes: the record is keyed by the path alone
+      }
+    }
+    auto rec = failed_record(path, sha, kind, msg, elapsed);
+    if (opt_.report_dir) {
+      try {
+        report::write_failed_capture_report(
+            {path, sha, "", elapsed}, msg,
+            *opt_.report_dir / report::capture_report_folder(path, rec.key));
+      } catch (const std::exception& e) {
+        sink_.issue({path, "report", e.what()});
+      }
+    }
+    sink_.put(rec, ReplayIssue{path, kind, msg});
+  }
+
+  void apply(const Outcome& o) {
+    if (o.cancelled) return;
+    if (o.skipped) {
+      sink_.skipped(o.key);
+      return;
+    }
+    if (o.report_issue) sink_.issue({o.report_issue->path, o.report_issue->kind, o.report_issue->message});
+    std::optional<ReplayIssue> issue;
+    if (o.issue) issue = ReplayIssue{o.issue->path, o.issue->kind, o.issue->message};
+    sink_.put(o.record, issue);
+  }
+
+  const std::vector<fs::path>& files_;
+  const ReplayOptions& opt_;
+  Sink& sink_;
+  const std::atomic<bool>& cancel_;
+  std::vector<WorkerProc> workers_;
 };
 
 }  // namespace
@@ -219,35 +529,13 @@ ReplaySummary run_replay(const ReplayOptions& opt, const ReplayCallbacks& cb,
   Sink sink(opt, cb, mine.size());
   if (cb.progress) cb.progress(sink.counts());
 
-  std::atomic<std::size_t> next{0};
-  std::mutex fatal_mu;
   std::exception_ptr fatal;
-  std::atomic<bool> stop{false};
-  auto work = [&] {
-    Worker w{opt, sink, cancel};
-    while (!cancel && !stop) {
-      const std::size_t i = next++;
-      if (i >= mine.size()) return;
-      try {
-        w.replay(mine[i]);
-      } catch (...) {  // the results file could not be written: stop the batch
-        std::lock_guard lock(fatal_mu);
-        if (!fatal) fatal = std::current_exception();
-        stop = true;
-      }
-    }
-  };
-  const std::size_t n_threads = std::min(opt.jobs, std::max<std::size_t>(1, mine.size()));
-  std::vector<std::thread> threads;
   try {
-    for (std::size_t k = 1; k < n_threads; ++k) threads.emplace_back(work);
-  } catch (...) {  // no thread to be had: stop those started, never leave one joinable
-    stop = true;
-    for (auto& t : threads) t.join();
-    throw;
+    WorkerPool pool(mine, opt, sink, cancel);
+    pool.run();
+  } catch (...) {  // the results file could not be written, or no worker could be started
+    fatal = std::current_exception();
   }
-  work();
-  for (auto& t : threads) t.join();
   if (fatal) {
     try {
       sink.close();

@@ -4,15 +4,20 @@
 // its record goes to the results file (acquisition/results_file.hpp) and,
 // optionally, a JSON line and a report folder.
 //
-// Workers are threads of this process. The FE/DSP work of a capture runs
-// outside any lock; every HDF5 call (reading a capture, writing a record)
-// takes acquisition's global HDF5 lock, which Debian's non-thread-safe
-// libhdf5 needs anyway. One process owns the one results file, so records
-// are appended without inter-process locking or a merge step, and a finished
-// capture leaves nothing in memory but its counters.
+// Workers are processes (forked copies of this one, --jobs of them): a
+// capture that crashes its worker — libhdf5 on a damaged file, which we
+// cannot fix — or hangs it past capture_timeout_s costs that capture only. It
+// is recorded as failed (error kind "crashed" or "hung", a message naming the
+// file and, when the worker was reading it, the HDF5 library), a new worker
+// takes the next capture, and the batch ends with exit 2. Each worker has its
+// own copy of libhdf5, so reading no longer serialises on one global lock.
+// The batch process alone owns the results file: workers send each record
+// back over a pipe (record_wire.hpp), so records are appended without
+// inter-process locking or a merge step.
 //
 // Resume: a capture whose key (path + SHA-256, replay_record.hpp) is already
-// in the results file with status "ok" is skipped; failed ones are retried;
+// in the results file with status "ok" is skipped, and so is one that crashed
+// or hung a worker (the same bytes would again); other failures are retried;
 // a record of the same path with another digest (the file changed) is
 // replaced.
 #include <atomic>
@@ -38,12 +43,16 @@ struct ReplayOptions {
   std::string material;  // nominal model; empty: the capture's /setup/material, else apc850
   bool isotropic = true;
   std::string software = "piezobench replay";
+  // A capture whose worker has not answered after this long is a hang: the
+  // worker is killed and the capture recorded as failed ("hung").
+  double capture_timeout_s = 600.0;
 };
 
 struct ReplayProgress {
   std::size_t total = 0;  // captures of this shard
   std::size_t done = 0;   // replayed + failed + skipped
   std::size_t ok = 0, failed = 0, skipped = 0;
+  std::size_t failed_before = 0;  // of the skipped: captures that crashed or hung a worker before
   double rate_per_s = 0;  // captures replayed (not skipped) per second of wall time
   double eta_s = -1;      // < 0: unknown yet
 };

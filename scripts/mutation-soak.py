@@ -1,0 +1,142 @@
+#!/usr/bin/python3
+"""Issue 16's soak test: damaged captures through `replay` and `capture info`.
+
+Makes N byte-mutated copies of a valid capture (1-8 random bytes overwritten
+each; most of them in the file's HDF5 metadata — superblock, object headers,
+B-trees, heaps — where libhdf5 has crashed on damaged files, the rest anywhere),
+then
+  1. replays them in batches of B (`piezobench replay BATCH --out R.h5 --jsonl
+     L --jobs J`), checks that every batch process ends with exit 0 or 2 (never
+     a signal, never 1), that every file of the batch has a record (ok, or failed
+     with a message), and that a second run of the same command (the resume)
+     completes with every file "done before" or replayed again;
+  2. runs `piezobench capture info FILE` on every mutant and checks that it
+     ends with exit 0 or 2, never a signal.
+Prints a summary and exits non-zero on any violation.
+
+  /usr/bin/python3 scripts/mutation-soak.py --cli build/ui/piezobench \
+      --capture CAP.h5 --count 10000 --batch 100 --jobs 2 --work /tmp/soak
+"""
+import argparse
+import json
+import os
+import random
+import shutil
+import subprocess
+import sys
+import time
+
+
+def raw_data_ranges(path):
+    """Byte ranges of the datasets' raw data (h5py), to tell metadata from samples."""
+    try:
+        import h5py
+    except ImportError:
+        return []
+    ranges = []
+    with h5py.File(path, "r") as f:
+        def visit(name, obj):
+            if isinstance(obj, h5py.Dataset):
+                off = obj.id.get_offset()
+                if off is not None:
+                    ranges.append((off, off + obj.id.get_storage_size()))
+        f.visititems(visit)
+    return sorted(ranges)
+
+
+def main():
+    ap = argparse.ArgumentParser()
+    ap.add_argument("--cli", required=True)
+    ap.add_argument("--capture", required=True)
+    ap.add_argument("--count", type=int, default=10000)
+    ap.add_argument("--batch", type=int, default=100)
+    ap.add_argument("--jobs", type=int, default=2)
+    ap.add_argument("--seed", type=int, default=16)
+    ap.add_argument("--work", required=True)
+    ap.add_argument("--metadata-share", type=float, default=0.9)
+    ap.add_argument("--skip-replay", action="store_true")
+    ap.add_argument("--skip-info", action="store_true")
+    a = ap.parse_args()
+
+    data = open(a.capture, "rb").read()
+    raw = raw_data_ranges(a.capture)
+    meta = [i for i in range(len(data)) if not any(lo <= i < hi for lo, hi in raw)] if raw else []
+    rng = random.Random(a.seed)
+    if os.path.exists(a.work):
+        shutil.rmtree(a.work)
+    os.makedirs(a.work)
+    batches = []
+    for b in range(0, a.count, a.batch):
+        d = os.path.join(a.work, "batch%04d" % (b // a.batch))
+        os.makedirs(d)
+        for k in range(b, min(a.count, b + a.batch)):
+            m = bytearray(data)
+            for _ in range(rng.randint(1, 8)):
+                pos = rng.choice(meta) if meta and rng.random() < a.metadata_share else rng.randrange(len(m))
+                m[pos] = rng.randrange(256)
+            open(os.path.join(d, "m%05d.h5" % k), "wb").write(m)
+        batches.append(d)
+    print("soak: %d mutants of %s (%d bytes, %d of metadata) in %d batches"
+          % (a.count, a.capture, len(data), len(meta), len(batches)), flush=True)
+
+    bad = []
+    if not a.skip_replay:
+        t0 = time.time()
+        counts = {"ok": 0, "failed": 0, "crashed": 0, "hung": 0}
+        for d in batches:
+            files = sorted(f for f in os.listdir(d) if f.endswith(".h5"))
+            out, jl = d + "-results.h5", d + ".jsonl"
+            cmd = [a.cli, "replay", d, "--out", out, "--jsonl", jl, "--jobs", str(a.jobs), "--json"]
+            p = subprocess.run(cmd, capture_output=True, text=True)
+            if p.returncode not in (0, 2):
+                bad.append("replay %s: exit %d: %s" % (d, p.returncode, p.stderr[-400:]))
+                continue
+            lines = [json.loads(x) for x in open(jl)]
+            seen = {os.path.basename(x["path"]) for x in lines}
+            missing = [f for f in files if f not in seen]
+            if missing:
+                bad.append("replay %s: no record for %s" % (d, missing[:5]))
+            for x in lines:
+                if x["status"] == "ok":
+                    counts["ok"] += 1
+                else:
+                    counts["failed"] += 1
+                    kind = x.get("error", {}).get("kind", "")
+                    if kind in counts:
+                        counts[kind] += 1
+                    if not x.get("error", {}).get("message"):
+                        bad.append("replay %s: failed record without a message" % x["path"])
+            p2 = subprocess.run(cmd, capture_output=True, text=True)  # the resume
+            if p2.returncode not in (0, 2):
+                bad.append("resume %s: exit %d: %s" % (d, p2.returncode, p2.stderr[-400:]))
+            else:
+                j = json.loads(p2.stdout)
+                if j["total"] != len(files) or j["done_before"] + j["replayed"] + j["failed"] != len(files):
+                    bad.append("resume %s: %s" % (d, p2.stdout.strip()))
+        print("replay: %d files in %.0f s: ok %d, failed %d (of which crashed %d, hung %d); batch deaths %d"
+              % (a.count, time.time() - t0, counts["ok"], counts["failed"], counts["crashed"],
+                 counts["hung"], sum(1 for x in bad if x.startswith("replay") and "exit" in x)), flush=True)
+
+    if not a.skip_info:
+        t0 = time.time()
+        codes = {}
+        for d in batches:
+            for f in sorted(os.listdir(d)):
+                if not f.endswith(".h5"):
+                    continue
+                p = subprocess.run([a.cli, "capture", "info", os.path.join(d, f)],
+                                   capture_output=True, text=True)
+                codes[p.returncode] = codes.get(p.returncode, 0) + 1
+                if p.returncode not in (0, 2):
+                    bad.append("capture info %s/%s: exit %d %s" % (d, f, p.returncode, p.stderr[-300:]))
+        print("capture info: %d files in %.0f s, exit codes %s"
+              % (sum(codes.values()), time.time() - t0, dict(sorted(codes.items()))), flush=True)
+
+    for x in bad[:20]:
+        print("VIOLATION:", x)
+    print("soak: %d violation(s)" % len(bad))
+    return 1 if bad else 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
