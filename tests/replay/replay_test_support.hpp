@@ -6,9 +6,11 @@
 #include <unistd.h>
 
 #include <filesystem>
+#include <fstream>
 #include <map>
 #include <nlohmann/json.hpp>
 #include <string>
+#include <vector>
 
 #include "acquisition/results_file.hpp"
 #include "tests/support/run_cli.hpp"
@@ -34,6 +36,14 @@ inline void make_capture(const fs::path& file, double ye11, int seed) {
                    " --noise 0.005 --seed " + std::to_string(seed) +
                    " --samples 8000 --shots 1 --overwrite --out '" + file.string() + "'");
   ASSERT_EQ(r.exit_code, 0) << r.err;
+}
+
+// The JSON lines of a --jsonl file.
+inline std::vector<nlohmann::json> read_lines(const fs::path& f) {
+  std::vector<nlohmann::json> out;
+  std::ifstream in(f);
+  for (std::string line; std::getline(in, line);) out.push_back(nlohmann::json::parse(line));
+  return out;
 }
 
 // A capture cut in half: a real file that no HDF5 reader accepts.

@@ -33,12 +33,6 @@ fs::path make_batch(const fs::path& dir, int good = 4, bool corrupt = true) {
   return in;
 }
 
-std::vector<nlohmann::json> read_lines(const fs::path& f) {
-  std::vector<nlohmann::json> out;
-  std::ifstream in(f);
-  for (std::string line; std::getline(in, line);) out.push_back(nlohmann::json::parse(line));
-  return out;
-}
 
 std::string sha256sum(const fs::path& f) {  // an independent digest: coreutils
   auto r = ::popen(("sha256sum '" + f.string() + "'").c_str(), "r");
@@ -80,7 +74,7 @@ TEST(CliReplay, BatchReportsAndSkipsACorruptedCaptureWritesReportsAndResumes) {
   EXPECT_NE(r.err.find("skipped: " + bad + ": /"), std::string::npos) << r.err;
 
   // One JSON line per capture, with its path and SHA-256.
-  auto lines = read_lines(jsonl);
+  auto lines = test::read_lines(jsonl);
   ASSERT_EQ(lines.size(), 5u);
   std::set<std::string> paths;
   for (const auto& l : lines) {
@@ -136,7 +130,7 @@ TEST(CliReplay, BatchReportsAndSkipsACorruptedCaptureWritesReportsAndResumes) {
   EXPECT_EQ(j2["replayed"], 0);
   EXPECT_EQ(j2["done_before"], 4);
   EXPECT_EQ(j2["failed"], 1);
-  EXPECT_EQ(read_lines(jsonl).size(),
+  EXPECT_EQ(test::read_lines(jsonl).size(),
             5u);  // this run's lines: the stored ones for skipped captures
   test::expect_same_content(content, test::read_content(out));
   fs::remove_all(dir);

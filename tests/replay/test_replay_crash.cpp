@@ -17,13 +17,6 @@ namespace {
 const fs::path kCrash1 = fs::path(PIEZO_SOURCE_DIR) / "fixtures/damaged/hdf5-segv-vlen.h5";
 const fs::path kCrash2 = fs::path(PIEZO_SOURCE_DIR) / "fixtures/damaged/hdf5-segv-2.h5";
 const fs::path kGood = fs::path(PIEZO_SOURCE_DIR) / "fixtures/h5py-exp-decay.h5";
-
-std::vector<nlohmann::json> lines_of(const fs::path& f) {
-  std::vector<nlohmann::json> out;
-  std::ifstream in(f);
-  for (std::string line; std::getline(in, line);) out.push_back(nlohmann::json::parse(line));
-  return out;
-}
 }  // namespace
 
 TEST(ContainedRead, ALibraryCrashRefusesTheFileAndThisProcessGoesOn) {
@@ -97,7 +90,7 @@ TEST(ReplayCrash, ABatchSurvivesFilesThatCrashTheLibraryAndResumesPastThem) {
   EXPECT_EQ(j["total"], 4);
   EXPECT_EQ(j["replayed"], 2);
   EXPECT_EQ(j["failed"], 2);
-  const auto lines = lines_of(jl);
+  const auto lines = test::read_lines(jl);
   ASSERT_EQ(lines.size(), 4u);
   for (const auto& l : lines) {
     const std::string path = l["path"];
