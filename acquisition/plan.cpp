@@ -2,7 +2,9 @@
 
 #include <algorithm>
 #include <cmath>
+#include <fstream>
 #include <random>
+#include <sstream>
 #include <stdexcept>
 #include <toml++/toml.h>
 
@@ -92,16 +94,25 @@ std::vector<double> synthesize(const ExcitationSpec& e, double fs, std::size_t n
 }
 
 MeasurementPlan load_plan_toml(const std::filesystem::path& file) {
+  std::ifstream in(file, std::ios::binary);
+  if (!in) throw std::invalid_argument("plan " + file.string() + ": cannot open the file");
+  std::ostringstream text;
+  text << in.rdbuf();
+  if (in.bad()) throw std::invalid_argument("plan " + file.string() + ": cannot read the file");
+  return parse_plan_toml(text.str(), file.string());
+}
+
+MeasurementPlan parse_plan_toml(std::string_view toml_text, const std::string& source) {
   toml::table t;
   try {
-    t = toml::parse_file(file.string());
+    t = toml::parse(toml_text, source);
   } catch (const toml::parse_error& e) {
-    throw std::invalid_argument("plan " + file.string() + ": " + std::string(e.description()) +
+    throw std::invalid_argument("plan " + source + ": " + std::string(e.description()) +
                                 " at line " + std::to_string(e.source().begin.line));
   }
   MeasurementPlan p;
   auto fail = [&](const std::string& key, const std::string& why) {
-    throw std::invalid_argument("plan " + file.string() + ": " + key + ": " + why);
+    throw std::invalid_argument("plan " + source + ": " + key + ": " + why);
   };
   auto num = [&](const toml::table& tb, const char* key, double& out, const std::string& where) {
     if (auto n = tb.get(key)) {
@@ -178,7 +189,7 @@ MeasurementPlan load_plan_toml(const std::filesystem::path& file) {
   try {
     p.validate();
   } catch (const std::invalid_argument& e) {
-    throw std::invalid_argument("plan " + file.string() + ": " + e.what());
+    throw std::invalid_argument("plan " + source + ": " + e.what());
   }
   return p;
 }

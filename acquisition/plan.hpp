@@ -4,6 +4,7 @@
 #include <cstdint>
 #include <filesystem>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "acquisition/capture.hpp"
@@ -40,7 +41,10 @@ struct MeasurementPlan {
 };
 
 // Reads a TOML plan; unknown keys are errors (a typo must not pass silently).
+// Throws std::invalid_argument naming the file and the key.
 MeasurementPlan load_plan_toml(const std::filesystem::path& file);
+// The same from TOML text; `source` names it in messages (and in TOML errors).
+MeasurementPlan parse_plan_toml(std::string_view toml_text, const std::string& source = "<string>");
 
 // The AWG samples for one step, normalised to [-1, 1], at the plan's rate,
 // covering the post-trigger part of the record.

@@ -68,8 +68,12 @@ std::pair<double, double> vertex(double x0, double y0, double x1, double y1, dou
 }  // namespace
 
 ImpedanceCurve read_impedance_csv(const std::string& path) {
+  auto in = open_in(path, "read_impedance_csv");
+  return parse_impedance_csv(in, path);
+}
+
+ImpedanceCurve parse_impedance_csv(std::istream& in, const std::string& path) {
   const char* fn = "read_impedance_csv";
-  auto in = open_in(path, fn);
   ImpedanceCurve c;
   std::string line;
   std::vector<double> v;
@@ -98,8 +102,12 @@ ImpedanceCurve read_impedance_csv(const std::string& path) {
 }
 
 ImpedanceCurve read_touchstone_s1p(const std::string& path) {
+  auto in = open_in(path, "read_touchstone_s1p");
+  return parse_touchstone_s1p(in, path);
+}
+
+ImpedanceCurve parse_touchstone_s1p(std::istream& in, const std::string& path) {
   const char* fn = "read_touchstone_s1p";
-  auto in = open_in(path, fn);
   double unit = 1e9, z0 = 50;
   std::string param = "s", format = "ma";
   bool option_seen = false;
