@@ -26,6 +26,13 @@ struct ExcitationSpec {
 };
 
 struct MeasurementPlan {
+  // Plausibility limits (not of the instruments): a plan beyond them is a
+  // typo, and would otherwise allocate or loop without bound. kMaxSamples is
+  // the capture reader's limit per signal; kMaxShots bounds steps × shots.
+  static constexpr std::size_t kMaxSamples = 100'000'000;
+  static constexpr std::size_t kMaxSteps = 100'000;
+  static constexpr int kMaxShots = 1'000'000;
+
   ExcitationSpec excitation;
   double sample_rate_hz = 1e7;
   std::size_t samples = 20000;  // record length per shot
