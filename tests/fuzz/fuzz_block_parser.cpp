@@ -91,6 +91,13 @@ std::size_t suffix_nodes(const std::string& p) { return static_cast<std::size_t>
 void check_commands(const Msg& m) {
   if (!m.has_block)
     FUZZ_CHECK(m.text.find('\n') == std::string::npos, "framed text holds a newline");
+  if (m.has_block) {  // a '#' inside a quoted string is text, never a block
+    char quote = 0;
+    for (char ch : m.text)
+      if (quote ? ch == quote : (ch == '"' || ch == '\''))
+        quote = quote ? 0 : ch;
+    FUZZ_CHECK(quote == 0, "a block started inside a quoted string: '%s'", m.text.c_str());
+  }
   auto parts = m.has_block ? std::vector<std::string>{m.text} : scpi::split_commands(m.text);
   for (const auto& text : parts) {
     const scpi::Command c = scpi::parse_command(text);

@@ -6,7 +6,11 @@
 // and the command to replay it printed); 2: usage error.
 //
 //   fuzz_<name> [--seconds S] [--runs N] [--seed K] [--max-len B] [--timeout S]
-//               [--dict FILE] [--artifact-dir DIR] [-v] [FILE|DIR ...]
+//               [--malloc-limit-mb M] [--dict FILE] [--artifact-dir DIR] [-v] [FILE|DIR ...]
+//
+// Findings: a crash (signal), an uncaught exception, an input running longer
+// than --timeout, and (builds without sanitizers) one operator new of more
+// than --malloc-limit-mb, as libFuzzer's -malloc_limit_mb.
 //
 // Without FILE/DIR arguments it uses the harness's corpus and regression
 // directories (compiled in); with them, only those (a single file: replay it).
@@ -27,6 +31,7 @@
 #include <fstream>
 #include <iterator>
 #include <memory>
+#include <new>
 #include <random>
 #include <string>
 #include <typeinfo>
@@ -119,6 +124,25 @@ void install_handlers() {
 #endif
 }
 
+// ------------------------------------------------------------ allocation limit
+// One allocation beyond the limit is a finding (a length taken from the input
+// and trusted); reported before the memory is touched. Not with sanitizers:
+// they replace the allocator themselves.
+std::size_t g_malloc_limit = 0;  // 0: off (until main() sets it)
+
+void* checked_alloc(std::size_t n) {
+  if (g_malloc_limit && n > g_malloc_limit && g_running) {
+    char msg[128];
+    std::snprintf(msg, sizeof msg, "\nfuzz_" PIEZO_FUZZ_NAME ": FINDING: one allocation of %zu bytes (limit %zu)\n",
+                  n, g_malloc_limit);
+    write_str(msg);
+    save_current_input();
+    std::abort();
+  }
+  if (void* p = std::malloc(n ? n : 1)) return p;
+  throw std::bad_alloc();
+}
+
 std::string demangle(const char* name) {
   int st = 0;
   char* d = abi::__cxa_demangle(name, nullptr, nullptr, &st);
@@ -134,6 +158,7 @@ struct Options {
   std::uint64_t seed = 1;
   std::size_t max_len = 4096;
   unsigned timeout_s = 20;
+  std::size_t malloc_limit_mb = 256;
   std::string dict;
   fs::path artifact_dir = ".";
   bool verbose = false;
@@ -143,7 +168,8 @@ struct Options {
 [[noreturn]] void usage(const char* why) {
   std::fprintf(stderr,
                "fuzz_%s: %s\nusage: fuzz_%s [--seconds S] [--runs N] [--seed K] [--max-len B] "
-               "[--timeout S] [--dict FILE] [--artifact-dir DIR] [-v] [FILE|DIR ...]\n",
+               "[--timeout S] [--malloc-limit-mb M] [--dict FILE] [--artifact-dir DIR] [-v] "
+               "[FILE|DIR ...]\n",
                PIEZO_FUZZ_NAME, why, PIEZO_FUZZ_NAME);
   std::exit(2);
 }
@@ -165,6 +191,7 @@ Options parse_args(int argc, char** argv) {
       else if (a == "--seed") o.seed = std::stoull(value());
       else if (a == "--max-len") o.max_len = std::stoul(value());
       else if (a == "--timeout") o.timeout_s = static_cast<unsigned>(std::stoul(value()));
+      else if (a == "--malloc-limit-mb") o.malloc_limit_mb = std::stoul(value());
       else if (a == "--dict") o.dict = value();
       else if (a == "--artifact-dir") o.artifact_dir = value();
       else if (a == "-v" || a == "--verbose") o.verbose = true;
@@ -380,9 +407,19 @@ bool run_one(const Bytes& in, const std::string& label, const Options& o) {
 
 }  // namespace
 
+#ifndef PIEZO_FUZZ_SANITIZED
+void* operator new(std::size_t n) { return checked_alloc(n); }
+void* operator new[](std::size_t n) { return checked_alloc(n); }
+void operator delete(void* p) noexcept { std::free(p); }
+void operator delete[](void* p) noexcept { std::free(p); }
+void operator delete(void* p, std::size_t) noexcept { std::free(p); }
+void operator delete[](void* p, std::size_t) noexcept { std::free(p); }
+#endif
+
 int main(int argc, char** argv) {
   const Options o = parse_args(argc, argv);
   install_handlers();
+  g_malloc_limit = o.malloc_limit_mb << 20;
   std::error_code ec;
   fs::create_directories(o.artifact_dir, ec);
 
