@@ -26,7 +26,10 @@ void check_curve(const ImpedanceCurve& c, const std::string& path, const char* f
   if (c.f_hz.size() < 5)
     throw std::invalid_argument(std::string(fn) + ": fewer than 5 points in '" + path + "'");
   for (std::size_t i = 0; i < c.f_hz.size(); ++i) {
-    if (!(c.f_hz[i] >= 0) || !std::isfinite(c.z_ohm[i].real()) || !std::isfinite(c.z_ohm[i].imag()))
+    // Finite frequency (a Touchstone unit can overflow it) and finite |Z|
+    // (features work in dB of |Z|; re and im near 1.8e308 overflow it).
+    if (!(c.f_hz[i] >= 0) || !std::isfinite(c.f_hz[i]) || !std::isfinite(c.z_ohm[i].real()) ||
+        !std::isfinite(c.z_ohm[i].imag()) || !std::isfinite(std::abs(c.z_ohm[i])))
       throw std::invalid_argument(std::string(fn) + ": bad value on data row " +
                                   std::to_string(i + 1));
     if (i > 0 && !(c.f_hz[i] > c.f_hz[i - 1]))
