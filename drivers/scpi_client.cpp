@@ -95,9 +95,9 @@ std::vector<std::uint8_t> ScpiClient::query_block(const std::string& cmd) {
     throw TransportError(e.kind(), std::string(e.what()) + " (reading the block of '" + cmd + "')");
   }
   // The header's length is the instrument's word, not yet data: grow the
-  // buffer as bytes arrive (1 MiB at a time), so a corrupt "#9999999999"
+  // buffer as bytes arrive (64 KiB at a time), so a corrupt "#9999999999"
   // costs what was received, not a gigabyte up front.
-  constexpr std::size_t kStep = std::size_t{1} << 20;
+  constexpr std::size_t kStep = std::size_t{1} << 16;
   std::vector<std::uint8_t> payload;
   payload.reserve(std::min(h->payload_len, kStep));
   try {
