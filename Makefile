@@ -48,3 +48,19 @@ fixtures: deps
 
 clean:
 	rm -rf $(BUILD) $(ASAN)
+
+# libFuzzer runs of the fuzz harnesses (tests/fuzz/README.md): a clang build
+# with ASan + UBSan in $(FUZZ_BUILD), then FUZZ_SECONDS per harness; crashes
+# are written to tests/fuzz/regressions/<name>/. `make test` needs none of
+# this: it runs the same harnesses briefly with gcc (CTest label fuzz).
+FUZZ_BUILD   ?= build-fuzz
+FUZZ_SECONDS ?= 600
+FUZZ_TARGETS ?= capture block_parser plan impedance_file
+.PHONY: fuzz
+fuzz:
+	@bash scripts/install-deps.sh fuzz
+	cmake -S . -B $(FUZZ_BUILD) -DCMAKE_C_COMPILER=clang -DCMAKE_CXX_COMPILER=clang++ \
+	      -DCMAKE_BUILD_TYPE=RelWithDebInfo -DPIEZO_FUZZ=ON -DBUILD_TESTING=OFF \
+	      -DPIEZO_BUILD_GUI=OFF -DPIEZO_BUILD_BENCH=OFF
+	nice -n 10 cmake --build $(FUZZ_BUILD) -j$(JOBS) --target $(addprefix fuzz_,$(FUZZ_TARGETS))
+	bash scripts/run-fuzz.sh $(FUZZ_BUILD) $(FUZZ_SECONDS) $(FUZZ_TARGETS)

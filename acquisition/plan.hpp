@@ -4,6 +4,7 @@
 #include <cstdint>
 #include <filesystem>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "acquisition/capture.hpp"
@@ -25,6 +26,13 @@ struct ExcitationSpec {
 };
 
 struct MeasurementPlan {
+  // Plausibility limits (not of the instruments): a plan beyond them is a
+  // typo, and would otherwise allocate or loop without bound. kMaxSamples is
+  // the capture reader's limit per signal; kMaxShots bounds steps × shots.
+  static constexpr std::size_t kMaxSamples = 100'000'000;
+  static constexpr std::size_t kMaxSteps = 100'000;
+  static constexpr int kMaxShots = 1'000'000;
+
   ExcitationSpec excitation;
   double sample_rate_hz = 1e7;
   std::size_t samples = 20000;  // record length per shot
@@ -40,7 +48,10 @@ struct MeasurementPlan {
 };
 
 // Reads a TOML plan; unknown keys are errors (a typo must not pass silently).
+// Throws std::invalid_argument naming the file and the key.
 MeasurementPlan load_plan_toml(const std::filesystem::path& file);
+// The same from TOML text; `source` names it in messages (and in TOML errors).
+MeasurementPlan parse_plan_toml(std::string_view toml_text, const std::string& source = "<string>");
 
 // The AWG samples for one step, normalised to [-1, 1], at the plan's rate,
 // covering the post-trigger part of the record.

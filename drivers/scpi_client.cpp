@@ -94,12 +94,22 @@ std::vector<std::uint8_t> ScpiClient::query_block(const std::string& cmd) {
   } catch (const TransportError& e) {
     throw TransportError(e.kind(), std::string(e.what()) + " (reading the block of '" + cmd + "')");
   }
-  std::vector<std::uint8_t> payload(h->payload_len);
+  // The header's length is the instrument's word, not yet data: grow the
+  // buffer as bytes arrive (64 KiB at a time), so a corrupt "#9999999999"
+  // costs what was received, not a gigabyte up front.
+  constexpr std::size_t kStep = std::size_t{1} << 16;
+  std::vector<std::uint8_t> payload;
+  payload.reserve(std::min(h->payload_len, kStep));
   try {
-    read_exact(payload.data(), payload.size());
+    while (payload.size() < h->payload_len) {
+      const std::size_t have = payload.size();
+      const std::size_t want = std::min(h->payload_len - have, kStep);
+      payload.resize(have + want);
+      read_exact(payload.data() + have, want);
+    }
   } catch (const TransportError& e) {
     throw TransportError(e.kind(), std::string(e.what()) + " (block of '" + cmd + "' after " +
-                                       "a partial read of " + std::to_string(payload.size()) +
+                                       "a partial read of " + std::to_string(h->payload_len) +
                                        " bytes expected)");
   }
   // Consume the message terminator that follows the block, if it is there already.

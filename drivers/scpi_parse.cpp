@@ -2,6 +2,8 @@
 
 #include <algorithm>
 #include <cctype>
+#include <limits>
+#include <stdexcept>
 
 #include "drivers/ieee488_block.hpp"
 
@@ -12,32 +14,58 @@ void InputFramer::feed(std::span<const std::uint8_t> bytes) {
 }
 
 std::optional<ProgramMessage> InputFramer::next() {
-  // Scan for '\n' outside a binary block.
-  std::size_t i = 0;
+  // Scan for '\n' outside a binary block, from where the last call stopped.
+  std::size_t& i = scan_;
   while (i < buf_.size()) {
-    std::uint8_t c = buf_[i];
-    if (c == '#') {
-      auto h = parse_block_header(std::span<const std::uint8_t>(buf_).subspan(i));
-      if (!h) return std::nullopt;  // need more bytes
-      std::size_t end = i + h->header_len + h->payload_len;
-      if (buf_.size() < end) return std::nullopt;
-      ProgramMessage m;
-      m.text.assign(buf_.begin(), buf_.begin() + static_cast<std::ptrdiff_t>(i));
-      m.block.assign(buf_.begin() + static_cast<std::ptrdiff_t>(i + h->header_len),
-                     buf_.begin() + static_cast<std::ptrdiff_t>(end));
-      m.has_block = true;
-      // the terminator follows the block
-      std::size_t stop = end;
-      while (stop < buf_.size() && buf_[stop] != '\n') ++stop;
-      if (stop == buf_.size()) return std::nullopt;
-      buf_.erase(buf_.begin(), buf_.begin() + static_cast<std::ptrdiff_t>(stop + 1));
-      return m;
+    const std::uint8_t c = buf_[i];
+    if (quote_) {  // '#' inside a string is text; a newline still ends the message
+      if (c == quote_) quote_ = 0;
+      if (c != '\n') {
+        ++i;
+        continue;
+      }
+    } else if (c == '"' || c == '\'') {
+      quote_ = static_cast<char>(c);
+      ++i;
+      continue;
+    }
+    if (c == '#' && !quote_) {
+      if (i + 1 >= buf_.size()) return std::nullopt;  // block or text: the next byte decides
+      std::optional<BlockHeader> h;
+      const std::uint8_t n = buf_[i + 1];
+      if (n >= '1' && n <= '9') {
+        try {
+          h = parse_block_header(std::span<const std::uint8_t>(buf_).subspan(i));
+          if (!h) return std::nullopt;  // need more bytes of the header
+        } catch (const std::invalid_argument&) {
+          h.reset();  // "#2x..": not a block header; the '#' is text
+        }
+      }
+      if (h) {
+        const std::size_t end = i + h->header_len + h->payload_len;
+        if (buf_.size() < end) return std::nullopt;
+        // the terminator follows the block
+        std::size_t stop = end;
+        while (stop < buf_.size() && buf_[stop] != '\n') ++stop;
+        if (stop == buf_.size()) return std::nullopt;
+        ProgramMessage m;
+        m.text.assign(buf_.begin(), buf_.begin() + static_cast<std::ptrdiff_t>(i));
+        m.block.assign(buf_.begin() + static_cast<std::ptrdiff_t>(i + h->header_len),
+                       buf_.begin() + static_cast<std::ptrdiff_t>(end));
+        m.has_block = true;
+        buf_.erase(buf_.begin(), buf_.begin() + static_cast<std::ptrdiff_t>(stop + 1));
+        i = 0;
+        quote_ = 0;
+        return m;
+      }
     }
     if (c == '\n') {
       ProgramMessage m;
       m.text.assign(buf_.begin(), buf_.begin() + static_cast<std::ptrdiff_t>(i));
       if (!m.text.empty() && m.text.back() == '\r') m.text.pop_back();
       buf_.erase(buf_.begin(), buf_.begin() + static_cast<std::ptrdiff_t>(i + 1));
+      i = 0;
+      quote_ = 0;
       return m;
     }
     ++i;
@@ -145,7 +173,14 @@ bool match_nodes(const std::vector<Node>& nodes, std::size_t ni, const std::vect
     if (n.suffix) {
       std::size_t d = s.size();
       while (d > 0 && std::isdigit(static_cast<unsigned char>(s[d - 1]))) --d;
-      if (d < s.size()) suffix = std::stoi(s.substr(d));
+      if (d < s.size()) {
+        long long v = 0;
+        for (std::size_t k = d; k < s.size(); ++k) {
+          v = v * 10 + (s[k] - '0');
+          if (v > std::numeric_limits<int>::max()) return false;  // no such suffix
+        }
+        suffix = static_cast<int>(v);
+      }
       s = s.substr(0, d);
     }
     if (s == n.long_form || s == n.short_form) {

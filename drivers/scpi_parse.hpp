@@ -20,6 +20,10 @@ struct ProgramMessage {
 };
 
 // Accumulates bytes and yields complete messages terminated by '\n'.
+// A '#' starts a definite-length block only outside quoted strings and when a
+// well-formed "#<n><len>" header follows; otherwise it is text ("#H1F" is a
+// hexadecimal number in SCPI, "Ch#1" a string). Never throws: how the bytes
+// were cut into feed() calls does not change the messages.
 class InputFramer {
  public:
   void feed(std::span<const std::uint8_t> bytes);
@@ -27,6 +31,8 @@ class InputFramer {
 
  private:
   std::vector<std::uint8_t> buf_;
+  std::size_t scan_ = 0;  // bytes of buf_ already scanned for the current message
+  char quote_ = 0;        // the quote open at scan_, or 0
 };
 
 struct Command {
@@ -39,7 +45,8 @@ struct Command {
 Command parse_command(const std::string& text);
 std::vector<std::string> split_commands(const std::string& text);
 
-// Header match; on success fills the numeric suffixes met at '#' nodes.
+// Header match; on success fills the numeric suffixes met at '#' nodes. A
+// suffix too large for an int does not match (never throws).
 bool match(const std::string& pattern, const std::string& header, std::vector<int>* suffixes = nullptr);
 
 }  // namespace piezo::drivers::scpi

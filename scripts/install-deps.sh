@@ -3,6 +3,8 @@
 # Idempotent: `dpkg -s` decides; apt-get runs only when something is absent.
 # Nothing is downloaded at configure or build time; this script is the only
 # place the project reaches a package registry.
+#   scripts/install-deps.sh        what the build and `make test` need (gcc)
+#   scripts/install-deps.sh fuzz   that, plus the libFuzzer toolchain of `make fuzz`
 set -euo pipefail
 
 PACKAGES=(
@@ -16,6 +18,11 @@ PACKAGES=(
   xvfb xauth libgl1-mesa-dri
   python3-numpy python3-h5py
 )
+# `make fuzz` only: clang, its compiler-rt (Debian 12 ships libFuzzer and the
+# sanitizer runtimes for clang 14 in libclang-rt-14-dev) and llvm (for
+# /usr/bin/llvm-symbolizer: symbolized sanitizer reports).
+FUZZ_PACKAGES=(clang libclang-rt-14-dev llvm)
+if [ "${1:-}" = fuzz ]; then PACKAGES+=("${FUZZ_PACKAGES[@]}"); fi
 
 missing=()
 for p in "${PACKAGES[@]}"; do

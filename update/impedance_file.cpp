@@ -26,7 +26,10 @@ void check_curve(const ImpedanceCurve& c, const std::string& path, const char* f
   if (c.f_hz.size() < 5)
     throw std::invalid_argument(std::string(fn) + ": fewer than 5 points in '" + path + "'");
   for (std::size_t i = 0; i < c.f_hz.size(); ++i) {
-    if (!(c.f_hz[i] >= 0) || !std::isfinite(c.z_ohm[i].real()) || !std::isfinite(c.z_ohm[i].imag()))
+    // Finite frequency (a Touchstone unit can overflow it) and finite |Z|
+    // (features work in dB of |Z|; re and im near 1.8e308 overflow it).
+    if (!(c.f_hz[i] >= 0) || !std::isfinite(c.f_hz[i]) || !std::isfinite(c.z_ohm[i].real()) ||
+        !std::isfinite(c.z_ohm[i].imag()) || !std::isfinite(std::abs(c.z_ohm[i])))
       throw std::invalid_argument(std::string(fn) + ": bad value on data row " +
                                   std::to_string(i + 1));
     if (i > 0 && !(c.f_hz[i] > c.f_hz[i - 1]))
@@ -68,8 +71,12 @@ std::pair<double, double> vertex(double x0, double y0, double x1, double y1, dou
 }  // namespace
 
 ImpedanceCurve read_impedance_csv(const std::string& path) {
+  auto in = open_in(path, "read_impedance_csv");
+  return parse_impedance_csv(in, path);
+}
+
+ImpedanceCurve parse_impedance_csv(std::istream& in, const std::string& path) {
   const char* fn = "read_impedance_csv";
-  auto in = open_in(path, fn);
   ImpedanceCurve c;
   std::string line;
   std::vector<double> v;
@@ -98,8 +105,12 @@ ImpedanceCurve read_impedance_csv(const std::string& path) {
 }
 
 ImpedanceCurve read_touchstone_s1p(const std::string& path) {
+  auto in = open_in(path, "read_touchstone_s1p");
+  return parse_touchstone_s1p(in, path);
+}
+
+ImpedanceCurve parse_touchstone_s1p(std::istream& in, const std::string& path) {
   const char* fn = "read_touchstone_s1p";
-  auto in = open_in(path, fn);
   double unit = 1e9, z0 = 50;
   std::string param = "s", format = "ma";
   bool option_seen = false;

@@ -6,6 +6,7 @@
 //   CSV:        f_hz,re_ohm,im_ohm   (header line and '#' comments allowed)
 //   Touchstone: .s1p, option line "# <Hz|kHz|MHz|GHz> <S|Z> <RI|MA|DB> R <Z0>"
 #include <complex>
+#include <istream>
 #include <string>
 #include <vector>
 
@@ -21,6 +22,9 @@ struct ImpedanceCurve {
 // Throw std::invalid_argument (bad content) or std::runtime_error (cannot open).
 ImpedanceCurve read_impedance_csv(const std::string& path);
 ImpedanceCurve read_touchstone_s1p(const std::string& path);
+// The same from a stream; `name` stands for the file in messages.
+ImpedanceCurve parse_impedance_csv(std::istream& in, const std::string& name);
+ImpedanceCurve parse_touchstone_s1p(std::istream& in, const std::string& name);
 ImpedanceCurve read_impedance_file(const std::string& path);  // by extension (.s1p, else CSV)
 void write_impedance_csv(const std::string& path, const ImpedanceCurve& c);
 

@@ -1,0 +1,159 @@
+#!/usr/bin/python3
+"""Writes the seed corpus of the fuzz harnesses: tests/fuzz/corpus/<name>/.
+
+Deterministic (fixed seeds); run from anywhere:
+    /usr/bin/python3 tests/fuzz/make_corpus.py
+Small valid inputs, a few KB each: instrument byte streams and replies, the
+README's plan and one per excitation, CSV and Touchstone impedance files of a
+Butterworth-Van Dyke resonator, and capture recipes (fuzz_capture reads its
+input as decisions; a zero byte is always the ordinary valid choice, so the
+empty recipe is a valid one-shot capture and sparse recipes are mostly valid).
+"""
+import cmath
+import math
+import os
+import random
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+
+
+def write(harness, name, data):
+    d = os.path.join(HERE, "corpus", harness)
+    os.makedirs(d, exist_ok=True)
+    if isinstance(data, str):
+        data = data.encode()
+    with open(os.path.join(d, name), "wb") as f:
+        f.write(data)
+
+
+# ---------------------------------------------------------------- block_parser
+# Layout: byte 0 = k, then k control bytes, then the stream. Control bytes, in
+# order: framer cut count and cut sizes; client piece count and sizes, EOM
+# bits, op count - 1, ops (0 query, 1 query_double, 2 query_block,
+# 3 check_errors, 4 configure, 5 identify).
+def stream(ctl, s):
+    return bytes([len(ctl)]) + bytes(ctl) + (s.encode("latin-1") if isinstance(s, str) else s)
+
+
+QUERY_BLOCK = [0, 0, 0, 0, 2]  # no cuts, no pieces, no EOM bits, one op: query_block
+block = {
+    "idn_reply": stream([0, 0, 0, 0, 5], "Keysight Technologies,33522B,MY52001234,4.03-1.19-2.00-52-00\n"),
+    "block_small": stream(QUERY_BLOCK, "#15hello\n"),
+    "block_newlines": stream(QUERY_BLOCK, "#211ab\ncd\nef\ngh\n"),
+    "block_words": stream(QUERY_BLOCK, b"#216" + bytes(range(16)) + b"\n"),
+    "block_leading_zeros": stream([2, 3, 5, 2, 7, 0x55, 1, 2, 2], "#800000004abcd\n#10\n"),
+    "error_queue": stream([0, 0, 0, 0, 3], '-113,"Undefined header"\n-222,"Data out of range"\n+0,"No error"\n'),
+    "configure_ok": stream([0, 0, 0, 0, 4], '1\n+0,"No error"\n'),
+    "number_reply": stream([0, 0, 0, 1, 1, 1], "+1.00000000E+07\n-0.5\n"),
+    "awg_session": stream([0],
+                          "*IDN?\n*RST;*CLS\nFORM:BORD SWAP\nSOUR1:DATA:VOL:CLE\n"
+                          "SOUR1:DATA:ARB PIEZO,#216" + "\x00\x00\x80\x3f" * 4 + "\n"
+                          "SOUR1:FUNC:ARB PIEZO\nSOUR1:FUNC:ARB:SRAT 1E7\nSOUR1:VOLT 2.0\n"
+                          "OUTP1 ON\nTRIG1:SOUR BUS\n*TRG\n*OPC?\nSYST:ERR?\n"),
+    "daq_session": stream([3, 5, 17, 40],
+                          ":ACQ:POIN:ANAL 20000;:ACQ:SRAT:ANAL 1e7\r\nCHAN1:RANG 2.5\nCHAN2:RANG?\n"
+                          "WAV:SOUR CHAN2\nWAV:FORM WORD\nWAV:BYT LSBF\n:SING\n:ADER?\nWAV:DATA?\n"),
+    "strings_and_hash": stream([0], 'DISP:TEXT "Ch#1 ok; done"\nSOUR:VOLT #H1F\nSYST:COMM \'a#2b\'\n'),
+    "usbtmc_header": stream([0], bytes([2, 0, 0xFF, 0, 5, 0, 0, 0, 1, 0, 0, 0]) + b"hello\n"),
+}
+
+# ---------------------------------------------------------------- plan
+README_PLAN = """[excitation]
+kind = "exp_decay"      # exp_decay | sine | chirp | noise
+amplitude_v = 1.0
+decay_per_s = 3000.0
+
+[acquisition]
+sample_rate_hz = 1e7
+samples = 20000
+pretrigger_samples = 200
+shots = 4
+
+[setup]
+r1_ohm = 3140.0
+transducer_id = "T-017"
+material = "apc850"
+"""
+plans = {
+    "readme.toml": README_PLAN,
+    "sine.toml": '[excitation]\nkind = "sine"\namplitude_v = 0.5\nfrequency_hz = 48000.0\n'
+                 "[acquisition]\nsample_rate_hz = 2e6\nsamples = 4096\npretrigger_samples = 0\n",
+    "stepped_sine.toml": '[excitation]\nkind = "sine"\nfrequency_hz = 40e3\nf_start_hz = 40e3\n'
+                         "f_stop_hz = 60e3\nf_step_hz = 500.0\n[acquisition]\nsample_rate_hz = 1e6\n"
+                         "samples = 2000\npretrigger_samples = 16\nshots = 2\n",
+    "chirp.toml": '[excitation]\nkind = "chirp"\nf_start_hz = 1e3\nf_stop_hz = 120e3\nburst_fraction = 0.5\n'
+                  "[acquisition]\nsample_rate_hz = 1e7\nsamples = 16\npretrigger_samples = 2\nrange_v = 2.5\n",
+    "noise.toml": '[excitation]\nkind = "noise"\nseed = 42\nburst_fraction = 0.25\namplitude_v = 10\n'
+                  "[acquisition]\nsamples = 1024\n",
+    "setup_geometry.toml": "[setup]\nr1_ohm = 50\ninner_diameter_m = 0.016\nouter_diameter_m = 0.019\n"
+                           'length_m = 0.02\ndensity_kg_m3 = 7600\nnotes = """two\nlines"""\n',
+    "inline_tables.toml": 'excitation = { kind = "exp_decay", decay_per_s = 1.5e4 }\n'
+                          "acquisition = { samples = 0x100, pretrigger_samples = 0o10, shots = 1_0 }\n",
+    "empty.toml": "",
+}
+
+# ---------------------------------------------------------------- impedance_file
+def bvd(f):
+    """Z of a BVD resonator: C0 parallel with R-L-C (resonance ~ 50 kHz)."""
+    w = 2 * math.pi * f
+    c0, r, l, c = 2e-9, 40.0, 0.05, 2.026e-10
+    ym = 1 / (r + 1j * w * l + 1 / (1j * w * c))
+    return 1 / (1j * w * c0 + ym)
+
+
+freqs = [1000.0 * k for k in range(1, 101)]  # 1..100 kHz: resonance 50 kHz, anti-resonance 52.5 kHz
+csv = "f_hz,re_ohm,im_ohm\n# BVD resonator\n" + "".join(
+    f"{f:.6g},{bvd(f).real:.9g},{bvd(f).imag:.9g}\n" for f in freqs)
+csv_band = "f_hz,re_ohm,im_ohm,re_lo,re_hi\n" + "".join(
+    f"{f:.6g},{bvd(f).real:.9g},{bvd(f).imag:.9g},0,0\r\n" for f in freqs[::3])
+
+
+def s11(z, z0=50.0):
+    return (z - z0) / (z + z0)
+
+
+ts_z_ri = "! Touchstone 1.0, one port\n# Hz Z RI R 1\n" + "".join(
+    f"{f:.6g} {bvd(f).real:.9g} {bvd(f).imag:.9g}\n" for f in freqs[::2])
+ts_s_ma = "# kHz S MA R 50\n" + "".join(
+    f"{f / 1e3:.6g} {abs(s11(bvd(f))):.9g} {math.degrees(cmath.phase(s11(bvd(f)))):.9g} ! point\n"
+    for f in freqs[::2])
+ts_s_db = "!comment\n  # MHz S DB R 75\n" + "".join(
+    f"  {f / 1e6:.9g}\t{20 * math.log10(abs(s11(bvd(f), 75))):.9g}  "
+    f"{math.degrees(cmath.phase(s11(bvd(f), 75))):.9g}\n" for f in freqs[::4])
+impedance = {
+    "bvd.csv": csv,
+    "bvd_band.csv": csv_band,
+    "bvd_z_ri.s1p": ts_z_ri,
+    "bvd_s_ma.s1p": ts_s_ma,
+    "bvd_s_db.s1p": ts_s_db,
+    "minimal.csv": "1,1,-1\n2,1,-0.5\n3,1,-0.3\n4,1,-0.2\n5,1,-0.1\n",
+}
+
+# ---------------------------------------------------------------- capture
+def recipes():
+    rng = random.Random(16)
+    out = {"empty": b"", "three_shots_sparse": bytes([0] * 40 + [2] + [0] * 200)}
+    for k in range(8):  # mostly zero: mostly valid captures with a few odd choices
+        n = rng.choice([128, 256, 512, 1024])
+        b = bytearray(n)
+        for _ in range(rng.randrange(2, n // 16)):
+            b[rng.randrange(n)] = rng.randrange(256)
+        out[f"sparse_{k}"] = bytes(b)
+    for k in range(4):  # every decision random: mostly refused files
+        out[f"dense_{k}"] = bytes(rng.randrange(256) for _ in range(rng.choice([64, 256, 1024])))
+    return out
+
+
+def main():
+    for name, data in block.items():
+        write("block_parser", name, data)
+    for name, data in plans.items():
+        write("plan", name, data)
+    for name, data in impedance.items():
+        write("impedance_file", name, data)
+    for name, data in recipes().items():
+        write("capture", name, data)
+
+
+if __name__ == "__main__":
+    main()
