@@ -338,13 +338,12 @@ std::size_t pick_length(ByteReader& r, bool allow_huge) {
     case 11: return 16 + r.u16() % 2000;
     case 12: return 1000;
     case 13: return 4096;
-    case 14:
-      if (allow_huge) {
-        static constexpr std::size_t kHuge[] = {std::size_t{1} << 20, std::size_t{1} << 27,
-                                                std::size_t{1} << 31, std::size_t{1} << 40};
-        return kHuge[r.pick(4)];
-      }
-      return 64;
+    case 14: {  // the same bytes are read either way: a recipe means one file layout everywhere
+      static constexpr std::size_t kHuge[] = {std::size_t{1} << 20, std::size_t{1} << 27,
+                                              std::size_t{1} << 31, std::size_t{1} << 40};
+      const std::size_t huge = kHuge[r.pick(4)];
+      return allow_huge ? huge : 64;
+    }
     default: return kTable[r.pick(8)];
   }
 }
@@ -563,10 +562,7 @@ void write_shot(ByteReader& r, hid_t shot, ExpectedShot& e, bool allow_huge, std
   }
   // Extensions newer readers check against the samples: no expectation.
   for (const char* ext : {"daq_range_v", "v1_range_v", "v2_range_v"})
-    if (r.pick(6) == 5) {
-      num_attr(r, shot, ext, 2.0, notes);
-      e.attrs = worst(e.attrs, Verdict::Unknown);
-    }
+    if (r.pick(6) == 5 && num_attr(r, shot, ext, 2.0, notes).present) e.attrs = worst(e.attrs, Verdict::Unknown);
   if (r.pick(8) == 7) {
     int_attr(r, shot, "adc_bits", static_cast<std::int64_t>(r.pick(40)), false, notes);
     e.attrs = worst(e.attrs, Verdict::Unknown);

@@ -99,7 +99,17 @@ void save_current_input() {
 }
 
 void on_fatal_signal(int sig) {
-  if (sig == SIGALRM) write_str("\nfuzz_" PIEZO_FUZZ_NAME ": FINDING: timeout (one input ran too long)\n");
+  if (g_running) {
+    const char* what = sig == SIGALRM   ? "timeout (one input ran too long)"
+                       : sig == SIGABRT ? "abort (a failed check or std::terminate)"
+                       : sig == SIGSEGV ? "SIGSEGV"
+                       : sig == SIGBUS  ? "SIGBUS"
+                       : sig == SIGFPE  ? "SIGFPE"
+                                        : "SIGILL";
+    write_str("\nfuzz_" PIEZO_FUZZ_NAME ": FINDING: ");
+    write_str(what);
+    write_str("\n");
+  }
   save_current_input();
   ::signal(sig == SIGALRM ? SIGABRT : sig, SIG_DFL);
   ::raise(sig == SIGALRM ? SIGABRT : sig);
@@ -130,6 +140,7 @@ void install_handlers() {
 // they replace the allocator themselves.
 std::size_t g_malloc_limit = 0;  // 0: off (until main() sets it)
 
+#ifndef PIEZO_FUZZ_SANITIZED
 void* checked_alloc(std::size_t n) {
   if (g_malloc_limit && n > g_malloc_limit && g_running) {
     char msg[128];
@@ -142,6 +153,7 @@ void* checked_alloc(std::size_t n) {
   if (void* p = std::malloc(n ? n : 1)) return p;
   throw std::bad_alloc();
 }
+#endif
 
 std::string demangle(const char* name) {
   int st = 0;
