@@ -91,6 +91,10 @@ void validate_shot_attributes(const Shot& shot, std::size_t n, const std::string
   if (shot.adc_bits && (*shot.adc_bits < 1 || *shot.adc_bits > 32))
     throw CaptureError(file, p + "/adc_bits",
                        "must be 1..32, got " + std::to_string(*shot.adc_bits));
+  if (shot.role == Role::Load && !(shot.load_ohm && std::isfinite(*shot.load_ohm) && *shot.load_ohm > 0))
+    throw CaptureError(file, p + "/load_ohm", "role 'load' needs a positive load_ohm");
+  if (shot.load_parallel_f && !(std::isfinite(*shot.load_parallel_f) && *shot.load_parallel_f >= 0))
+    throw CaptureError(file, p + "/load_parallel_f", "must be finite and >= 0");
 }
 
 void validate_shot(const Shot& shot, const std::string& file, const std::string& p) {
@@ -122,10 +126,6 @@ void validate_shot(const Shot& shot, const std::string& file, const std::string&
         }
     }
   }
-  if (shot.role == Role::Load && !(shot.load_ohm && std::isfinite(*shot.load_ohm) && *shot.load_ohm > 0))
-    throw CaptureError(file, p + "/load_ohm", "role 'load' needs a positive load_ohm");
-  if (shot.load_parallel_f && !(std::isfinite(*shot.load_parallel_f) && *shot.load_parallel_f >= 0))
-    throw CaptureError(file, p + "/load_parallel_f", "must be finite and >= 0");
 }
 
 }  // namespace piezo::acq

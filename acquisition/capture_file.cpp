@@ -141,6 +141,21 @@ class Reader {
     if (n > kMaxSamples)
       fail(p, "implausible length: " + std::to_string(n) + " samples (this reader takes at most " +
                   std::to_string(kMaxSamples) + " per signal)");
+    // A signal must be recorded: a dataset that declares N samples but stores
+    // fewer bytes than they need (never written, or cut short) is refused
+    // before anything is allocated. Compressed chunks may store less, but no
+    // HDF5 filter shrinks data by more than deflate's ~1030:1.
+    if (n > 0) {
+      h5::Id dcpl = h5::plist(H5Dget_create_plist(ds.get()));
+      const int filters = dcpl ? H5Pget_nfilters(dcpl.get()) : 0;
+      const double stored = static_cast<double>(H5Dget_storage_size(ds.get()));
+      const double needed = static_cast<double>(n) * static_cast<double>(sz);
+      if (stored * (filters > 0 ? 1100.0 : 1.0) < needed)
+        fail(p, "declares " + std::to_string(n) + " samples but the file stores " +
+                    std::to_string(static_cast<long long>(stored)) + " of the " +
+                    std::to_string(static_cast<long long>(needed)) +
+                    " bytes they need (never written, or truncated)");
+    }
     std::vector<double> v;
     if (!load || n == 0) return v;
     v.resize(n);

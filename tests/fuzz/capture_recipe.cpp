@@ -486,6 +486,10 @@ Signal signal(ByteReader& r, hid_t shot, const char* name, std::size_t n, std::v
   } else if (!huge && dt < 26) {  // never written: the fill value everywhere
     expect.assign(elems, f32 ? static_cast<double>(to_float(fill)) : fill);
   }
+  // Never written (layout 7: only the fill value): no acquired samples. The
+  // format says signals are stored as acquired; the reader refuses a signal
+  // whose dataset stores fewer bytes than its samples need (README, Capture files).
+  if (!write && !huge && numeric_ftype && elems > 0) out.attrs = worst(out.attrs, Verdict::Invalid);
   if (out.attrs == Verdict::Valid && !huge) {
     for (double x : expect)
       if (!std::isfinite(x)) out.samples = Verdict::Invalid;
