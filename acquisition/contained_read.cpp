@@ -125,13 +125,16 @@ void probe_capture(const std::filesystem::path& path, const ContainedReadOptions
                   opt.timeout_s);
     throw CaptureError(file, "/", b);
   }
-  if (WIFSIGNALED(status))
+  const int code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  // The child ends itself only with 0, kRefused or kOther: a signal, or any other
+  // exit code (a sanitizer's handler turns a SIGSEGV into exit code 1), is a crash.
+  if (WIFSIGNALED(status) || (code != 0 && code != kRefused && code != kOther))
     throw CaptureError(file, "/",
                        "the HDF5 library crashed reading this file (" +
-                           describe_signal(WTERMSIG(status)) +
+                           (WIFSIGNALED(status) ? describe_signal(WTERMSIG(status))
+                                                : "exit code " + std::to_string(code)) +
                            "): the file is damaged or not a capture; it is unreadable and was left "
                            "out");
-  const int code = WIFEXITED(status) ? WEXITSTATUS(status) : kOther;
   if (code == 0) return;
   if (code == kRefused) {
     const auto z = msg.find('\0');
