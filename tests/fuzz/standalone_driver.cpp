@@ -390,7 +390,7 @@ bool run_one(const Bytes& in, const std::string& label, const Options& o) {
   // The buffer is copied so that a harness reading past the end is caught by
   // sanitizers exactly as under libFuzzer (heap block of the exact size).
   std::unique_ptr<std::uint8_t[]> copy(new std::uint8_t[in.size() ? in.size() : 1]);
-  std::memcpy(copy.get(), in.data(), in.size());
+  if (!in.empty()) std::memcpy(copy.get(), in.data(), in.size());  // an empty input has no data()
   g_data = copy.get();
   g_size = in.size();
   std::snprintf(g_artifact, sizeof g_artifact, "%s/fuzz-%s-finding-%016llx", o.artifact_dir.c_str(),
