@@ -4,9 +4,7 @@
 #include <fstream>
 #include <map>
 #include <set>
-#include <mutex>
 #include <stdexcept>
-#include <thread>
 
 #include <fcntl.h>
 #include <poll.h>
@@ -44,7 +42,8 @@ std::string naming(const std::string& path, const std::string& what) {
   return what.rfind(path, 0) == 0 ? what : path + ": " + what;
 }
 
-// Everything the workers share: the results file, the JSON lines, counters.
+// What the batch process keeps (one thread; workers send it their outcomes):
+// the results file, the JSON lines, counters.
 class Sink {
  public:
   Sink(const ReplayOptions& opt, const ReplayCallbacks& cb, std::size_t total)
@@ -70,7 +69,6 @@ class Sink {
 
   // A capture finished earlier: its stored line goes to this run's JSON lines.
   void skipped(const std::string& key) {
-    std::lock_guard lock(mu_);
     if (jsonl_.is_open())
       if (auto rec = results_.get(key)) line(*rec);
     ++counts_.skipped;
@@ -79,7 +77,6 @@ class Sink {
   }
 
   void put(const acq::ResultRecord& rec, const std::optional<ReplayIssue>& issue) {
-    std::lock_guard lock(mu_);
     results_.put(rec);
     // Older records of this path with another digest describe a file that has changed since.
     for (const auto& old : by_path_[rec.input_path])
@@ -92,12 +89,11 @@ class Sink {
     step();
   }
 
-  void report_issue(const ReplayIssue& i) {  // caller holds mu_ or is single-threaded
+  void report_issue(const ReplayIssue& i) {
     issues_.push_back(i);
     if (cb_.issue) cb_.issue(i);
   }
   void issue(const ReplayIssue& i) {
-    std::lock_guard lock(mu_);
     report_issue(i);
   }
 
@@ -128,7 +124,6 @@ class Sink {
 
   acq::ResultsFile results_;
   const ReplayCallbacks& cb_;
-  std::mutex mu_;
   std::ofstream jsonl_;
   bool kept_failure(const std::string& key) const {
     const auto rec = results_.get(key);
@@ -426,7 +421,7 @@ class WorkerPool {
                       "capture left out",
                       opt_.capture_timeout_s,
                       w.stage == "reading" ? "the HDF5 library hung reading the file" : "hung");
-        lost(w, "hung", b, -1);
+        kill_and_record(w, "hung", b);
       }
   }
 
@@ -454,7 +449,7 @@ class WorkerPool {
     w.task.reset();
   }
 
-  void lost(WorkerProc& w, const std::string& kind, const std::string& msg, int) {
+  void kill_and_record(WorkerProc& w, const std::string& kind, const std::string& msg) {
     const std::size_t i = *w.task;
     const std::string sha = w.sha;
     const double t = seconds_since(w.started);

@@ -71,7 +71,7 @@ struct ReplaySummary {
 };
 
 struct ReplayCallbacks {
-  std::function<void(const ReplayProgress&)> progress;  // after each capture (under the sink lock)
+  std::function<void(const ReplayProgress&)> progress;  // after each capture, in the batch process
   std::function<void(const ReplayIssue&)> issue;        // as it happens
 };
 
