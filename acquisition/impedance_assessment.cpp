@@ -139,27 +139,23 @@ ImpedanceAssessment assess_impedance(const Capture& cap, const AssessmentOptions
   }
   out.model_description = dsp::describe(out.model);
 
-  std::vector<OwnedRecord> raw, ready;
+  // The records are not altered by the calibration (below), so the estimate
+  // before compensation and deskew is the same estimate: computed once.
+  std::vector<OwnedRecord> ready;
   for (const Shot* s : shots) {
-    raw.push_back(single(cap, *s));
-    ready.push_back(raw.back());
+    ready.push_back(single(cap, *s));
     // Channel 2's delay is removed from Z below (T = T_m·e^{+jωτ}), not from
     // the records: resampling channel 2 interpolates its response across the
     // drive's kinks at its onset and at t = 0 (-0.3 ... -2.8 points of |Z|
     // error near 84 kHz in test_fixture_acceptance).
   }
-  // Deskewing drops the last few samples: a sample count meant for the whole
-  // recorded span follows it (one beyond the recorded span stays an error).
-  AssessmentOptions o2 = opt;
-  const std::size_t avail_raw = raw.front().v1.size() - raw.front().pretrigger_samples;
-  const std::size_t avail_ready = ready.front().v1.size() - ready.front().pretrigger_samples;
-  for (auto* p : {&o2.prony.prep, &o2.fft.prep, &o2.xspec.prep})
-    if (p->max_samples > avail_ready && p->max_samples <= avail_raw) p->max_samples = avail_ready;
+  const AssessmentOptions& o2 = opt;
   const std::size_t boot_noise = opt.method == "prony" ? opt.prony.bootstrap : 0;
-  out.uncompensated = estimate(opt.method, raw, b, opt, std::nullopt, 0);
   out.result = estimate(opt.method, ready, b, o2, std::nullopt, boot_noise);
+  out.uncompensated = out.result;  // its band (z_sigma_ohm) belongs to the corrected estimate
+  out.uncompensated.z_sigma_ohm.resize(0);
   const bool zdesk = opt.deskew && out.skew_applied_s != 0.0;
-  if (zdesk) dsp::deskew_impedance(out.result, raw.front().r1_ohm, out.skew_applied_s);
+  if (zdesk) dsp::deskew_impedance(out.result, ready.front().r1_ohm, out.skew_applied_s);
   const std::optional<std::size_t> order =
       out.result.prony ? std::optional<std::size_t>(out.result.prony->order) : std::nullopt;
   std::optional<dsp::FixtureCompensation> comp;
@@ -194,7 +190,7 @@ ImpedanceAssessment assess_impedance(const Capture& cap, const AssessmentOptions
                                             std::vector<OwnedRecord> pick;
                                             for (auto i : idx) pick.push_back(ready[i]);
                                             auto r = estimate(opt.method, pick, b, o2, order, 0);
-                                            if (zdesk) dsp::deskew_impedance(r, raw.front().r1_ohm, out.skew_applied_s);
+                                            if (zdesk) dsp::deskew_impedance(r, ready.front().r1_ohm, out.skew_applied_s);
                                             if (comp)
                                               for (Eigen::Index k = 0; k < r.f_hz.size(); ++k)
                                                 r.z_ohm[k] = comp->correct(r.f_hz[k], r.z_ohm[k]);
@@ -246,7 +242,7 @@ ImpedanceAssessment assess_impedance(const Capture& cap, const AssessmentOptions
       if (q < 1) continue;
       try {
         auto r = estimate(opt.method, ready, b, o2, static_cast<std::size_t>(q), 0);
-        if (zdesk) dsp::deskew_impedance(r, raw.front().r1_ohm, out.skew_applied_s);
+        if (zdesk) dsp::deskew_impedance(r, ready.front().r1_ohm, out.skew_applied_s);
         if (comp)
           for (Eigen::Index k = 0; k < n; ++k) r.z_ohm[k] = comp->correct(r.f_hz[k], r.z_ohm[k]);
         for (Eigen::Index k = 0; k < n; ++k) {
@@ -282,7 +278,7 @@ ImpedanceAssessment assess_impedance(const Capture& cap, const AssessmentOptions
   // Per-shot validity, on the records as recorded.
   if (opt.validity) {
     std::vector<dsp::DividerRecord> v;
-    for (const auto& r : raw) v.push_back(r.view());
+    for (const auto& r : ready) v.push_back(r.view());
     dsp::ShotValidityOptions vo = opt.validity_options;
     vo.fmin_hz = b.fmin;
     vo.fmax_hz = b.fmax;

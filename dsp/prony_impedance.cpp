@@ -146,34 +146,72 @@ void refine_features_to_modal(const PronyImpedance& m, ImpedanceFeatures& f) {
   refine(f.antiresonances, false);
 }
 
-PronyImpedance fit_prony_impedance(const DividerRecord& rec, const PronyImpedanceOptions& opt) {
-  const DividerSignals s = prepare_divider(rec, "impedance_prony", opt.prep);
+namespace {
+
+// What fit_prony_impedance fits: the divider's v1, v2, i stacked, with the
+// Prony options completed (noise model, skipped direct samples).
+struct PronyProblem {
+  DividerSignals s;
+  Eigen::MatrixXd y;
+  PronyOptions po;
+  Eigen::Index direct = 0;
+};
+
+PronyProblem prony_problem(const DividerRecord& rec, const PronyImpedanceOptions& opt,
+                           bool automatic) {
+  PronyProblem p{prepare_divider(rec, "impedance_prony", opt.prep), {}, opt.prony, 0};
+  const DividerSignals& s = p.s;
   const double span = s.i.maxCoeff() - s.i.minCoeff();
   if (!(span >
         1e-12 * std::max(s.v1.cwiseAbs().maxCoeff(), s.v2.cwiseAbs().maxCoeff()) / rec.r1_ohm))
     throw std::invalid_argument("impedance_prony: no current flows (v1 == v2): Z is undefined");
-  PronyImpedance out;
-  out.r1_ohm = rec.r1_ohm;
-  PronyOptions po = opt.prony;
-  if (!po.order && po.noise_mixing.size() == 0 && s.size() >= 24) {
+  if (automatic && p.po.noise_mixing.size() == 0 && s.size() >= 24) {
     // Noise model of the divider: independent n1, n2 on the measured channels,
     // the current's noise is (n1 − n2)/R1 (not a third independent source).
     const double s1 = estimate_noise_std(s.v1), s2 = estimate_noise_std(s.v2);
-    po.noise_mixing.resize(3, 2);
-    po.noise_mixing << s1, 0.0, 0.0, s2, s1 / rec.r1_ohm, -s2 / rec.r1_ohm;
+    p.po.noise_mixing.resize(3, 2);
+    p.po.noise_mixing << s1, 0.0, 0.0, s2, s1 / rec.r1_ohm, -s2 / rec.r1_ohm;
   }
-  const Eigen::MatrixXd y = stack(s);
+  p.y = stack(s);
   const std::size_t want = opt.direct_samples == PronyImpedanceOptions::kDirectFilterLength
-                               ? 10 * decimation_factor(po, s.sample_rate_hz)
+                               ? 10 * decimation_factor(p.po, s.sample_rate_hz)
                                : opt.direct_samples;
-  const auto direct = static_cast<Eigen::Index>(std::min<std::size_t>(want, s.size() / 2));
-  po.skip_samples = std::max<std::size_t>(po.skip_samples, static_cast<std::size_t>(direct));
-  out.fit = prony_ss(y, s.sample_rate_hz, po);
+  p.direct = static_cast<Eigen::Index>(std::min<std::size_t>(want, s.size() / 2));
+  p.po.skip_samples = std::max<std::size_t>(p.po.skip_samples, static_cast<std::size_t>(p.direct));
+  return p;
+}
+
+PronyImpedance finish(const PronyProblem& p, const DividerRecord& rec,
+                      const PronyImpedanceOptions& opt, PronyFit fit) {
+  PronyImpedance out;
+  out.r1_ohm = rec.r1_ohm;
+  out.fit = std::move(fit);
   if (opt.ramp_onset && rec.pretrigger_samples > 0) {
-    out.onset_dt_s = 1.0 / s.sample_rate_hz;
-    out.onset_v = {s.v1[0], s.v2[0], s.i[0]};
+    out.onset_dt_s = 1.0 / p.s.sample_rate_hz;
+    out.onset_v = {p.s.v1[0], p.s.v2[0], p.s.i[0]};
   }
-  attach_direct_residual(out, y, direct);
+  attach_direct_residual(out, p.y, p.direct);
+  return out;
+}
+
+}  // namespace
+
+PronyImpedance fit_prony_impedance(const DividerRecord& rec, const PronyImpedanceOptions& opt) {
+  const PronyProblem p = prony_problem(rec, opt, !opt.prony.order);
+  return finish(p, rec, opt, prony_ss(p.y, p.s.sample_rate_hz, p.po));
+}
+
+std::vector<std::optional<PronyImpedance>> fit_prony_impedance_orders(
+    const DividerRecord& rec, const PronyImpedanceOptions& opt,
+    const std::vector<std::size_t>& orders) {
+  bool automatic = false;
+  for (std::size_t q : orders) automatic = automatic || q == 0;
+  const PronyProblem p = prony_problem(rec, opt, automatic);
+  std::vector<std::optional<PronyImpedance>> out;
+  for (auto& f : prony_ss_orders(p.y, p.s.sample_rate_hz, p.po, orders)) {
+    if (f.fit) out.push_back(finish(p, rec, opt, std::move(*f.fit)));
+    else out.emplace_back();
+  }
   return out;
 }
 

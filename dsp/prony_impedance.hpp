@@ -1,4 +1,5 @@
 #pragma once
+#include <optional>
 // The proposed Laplace-domain impedance estimator (seed §4.2, §4.3.2): v1, v2 and
 // the current i = (v1 − v2)/R1 from t = 0 are decomposed together by the
 // multi-signal Prony-SS method (one set of global poles, so the output holds the
@@ -74,6 +75,14 @@ struct PronyImpedance {
 void refine_features_to_modal(const PronyImpedance& m, ImpedanceFeatures& f);
 
 PronyImpedance fit_prony_impedance(const DividerRecord& rec, const PronyImpedanceOptions& opt = {});
+
+// The same fit at several orders (0: automatic; opt.prony.order is ignored)
+// from one Hankel SVD (dsp::prony_ss_orders): one entry per order, empty
+// where the data cannot carry that order. Throws like fit_prony_impedance for
+// a record that cannot be fitted at all.
+std::vector<std::optional<PronyImpedance>> fit_prony_impedance_orders(
+    const DividerRecord& rec, const PronyImpedanceOptions& opt,
+    const std::vector<std::size_t>& orders);
 
 // Sets m.direct_residual to the first n rows of y (v1, v2, i from t = 0) minus
 // m's pole model (n = 0: none).

@@ -4,6 +4,7 @@
 #include <Eigen/QR>
 #include <Eigen/SVD>
 #include <algorithm>
+#include <memory>
 #include <cmath>
 #include <numbers>
 #include <random>
@@ -115,19 +116,37 @@ double estimate_noise_std(const Eigen::Ref<const Eigen::VectorXd>& x) {
   return 1.482602218505602 * d[d.size() / 2] / std::sqrt(924.0);
 }
 
-PronyFit prony_ss(const Eigen::Ref<const Eigen::MatrixXd>& y, double sample_rate_hz,
-                  const PronyOptions& opt) {
+namespace {
+
+// Step 1 of prony_ss for one data set: the scaled (and decimated) signals'
+// Hankel matrices and the SVD of H(0), computed once for every order asked of
+// them (the realization of order p uses the leading p singular triplets only).
+struct Decomposition {
+  Eigen::Index k_total = 0, k_used = 0, skip = 0, rank_cap = 0;
+  std::size_t dec = 1;
+  bool automatic_possible = false;
+  double noise_singular_value = 0;  // automatic order only
+  std::unique_ptr<BlockHankel> h;
+  Svd svd;
+  Eigen::MatrixXd h1v;  // H(1)·V over the computed columns, filled on first use
+};
+
+Decomposition decompose(const Eigen::Ref<const Eigen::MatrixXd>& y, double sample_rate_hz,
+                        const PronyOptions& opt, std::size_t highest_order, bool automatic,
+                        bool highest_must_fit) {
   if (!(sample_rate_hz > 0.0) || !std::isfinite(sample_rate_hz))
     fail("sample rate must be positive");
   const Eigen::Index m = y.cols();
   if (m < 1) fail("no signal");
   if (!y.allFinite()) fail("signals contain NaN or Inf");
-  const auto skip = static_cast<Eigen::Index>(opt.skip_samples);
-  const Eigen::Index k_total = y.rows();
-  const Eigen::Index k_used = k_total - skip;
+  Decomposition d;
+  d.skip = static_cast<Eigen::Index>(opt.skip_samples);
+  d.k_total = y.rows();
+  d.k_used = d.k_total - d.skip;
+  const Eigen::Index k_used = d.k_used;
   if (k_used < 8)
-    fail("too short: " + std::to_string(k_total) + " samples (after skipping " +
-         std::to_string(skip) + "), need at least 8");
+    fail("too short: " + std::to_string(d.k_total) + " samples (after skipping " +
+         std::to_string(d.skip) + "), need at least 8");
 
   // Per-signal scaling (to unit RMS) so that volts and amperes weigh alike.
   Eigen::MatrixXd ys = y.bottomRows(k_used);
@@ -146,7 +165,7 @@ PronyFit prony_ss(const Eigen::Ref<const Eigen::MatrixXd>& y, double sample_rate
     fail("noise_mixing must have one row per signal");
 
   const std::size_t dec = decimation_factor(opt, sample_rate_hz);
-  const bool automatic = !opt.order.has_value();
+  d.dec = dec;
   if (automatic && k_used < 24)
     fail("too short for the automatic order: " + std::to_string(k_used) +
          " samples, need at least 24 (or give the order)");
@@ -177,57 +196,75 @@ PronyFit prony_ss(const Eigen::Ref<const Eigen::MatrixXd>& y, double sample_rate
     fail("Hankel matrix " + std::to_string(xi) + " x " + std::to_string(eta) +
          " does not fit in " + std::to_string(k_hankel) + " samples (rows + cols <= samples" +
          (dec > 1 ? ", after decimation by " + std::to_string(dec) : std::string()) + ")");
-  const Eigen::Index rank_cap = std::min<Eigen::Index>(m * xi, eta) - 1;
-  if (opt.order) {
-    if (*opt.order < 1) fail("order must be >= 1");
-    if (static_cast<Eigen::Index>(*opt.order) > rank_cap)
-      fail("Hankel matrix too small for order " + std::to_string(*opt.order) + ": H(0) is " +
+  d.rank_cap = std::min<Eigen::Index>(m * xi, eta) - 1;
+  if (static_cast<Eigen::Index>(highest_order) > d.rank_cap) {
+    if (highest_must_fit)
+      fail("Hankel matrix too small for order " + std::to_string(highest_order) + ": H(0) is " +
            std::to_string(m * xi) + " x " + std::to_string(eta) + ", order must be < " +
-           std::to_string(rank_cap + 1) + " (give more samples or larger rows/cols)");
+           std::to_string(d.rank_cap + 1) + " (give more samples or larger rows/cols)");
+    highest_order = static_cast<std::size_t>(std::max<Eigen::Index>(d.rank_cap, 1));
   }
 
-  BlockHankel h(ys, xi, eta);
+  d.h = std::make_unique<BlockHankel>(ys, xi, eta);
+  const BlockHankel& h = *d.h;
+  // The sketch is as wide as the highest order asked for needs (the automatic
+  // rule may pick up to max_order) plus the oversampling.
   const Eigen::Index want = static_cast<Eigen::Index>(
-      std::max<std::size_t>(opt.order.value_or(0), opt.max_order) + opt.oversampling);
+      std::max<std::size_t>(highest_order, automatic ? opt.max_order : 0) + opt.oversampling);
   SvdMethod method = opt.svd;
   if (method == SvdMethod::Auto)
     method = (double(h.rows()) * double(h.cols()) <= 2.5e5 ||
               want >= std::min(h.rows(), h.cols()) / 2)
                  ? SvdMethod::Full
                  : SvdMethod::Randomized;
-  Svd svd = method == SvdMethod::Full
-                ? full_svd(h)
-                : randomized_svd(h, std::min<Eigen::Index>(want, std::min(h.rows(), h.cols())),
-                                 opt.power_iterations, opt.seed);
-
-  PronyFit fit;
-  fit.dt = 1.0 / sample_rate_hz;
-  fit.samples = k_total;
-  fit.decimation = dec;
-  fit.singular_values = svd.s;
-  if (!(svd.s[0] > 0.0)) fail("the Hankel matrix is zero");
-  fit.order_automatic = automatic;
+  d.svd = method == SvdMethod::Full
+              ? full_svd(h)
+              : randomized_svd(h, std::min<Eigen::Index>(want, std::min(h.rows(), h.cols())),
+                               opt.power_iterations, opt.seed);
+  if (!(d.svd.s[0] > 0.0)) fail("the Hankel matrix is zero");
   if (automatic) {
     BlockHankel hn(noise, xi, eta);
-    fit.noise_singular_value =
+    d.noise_singular_value =
         randomized_svd(hn, std::min<Eigen::Index>(8, std::min(hn.rows(), hn.cols())), 4, opt.seed).s[0];
-    fit.order = select_order(svd.s, fit.noise_singular_value,
-                             std::min<std::size_t>(opt.max_order, static_cast<std::size_t>(rank_cap)),
+  }
+  d.automatic_possible = automatic;
+  return d;
+}
+
+// Steps 2-3 at order p (0: the automatic order) from a decomposition.
+PronyFit realize(Decomposition& d, const Eigen::Ref<const Eigen::MatrixXd>& y,
+                 double sample_rate_hz, const PronyOptions& opt, std::size_t order) {
+  PronyFit fit;
+  fit.dt = 1.0 / sample_rate_hz;
+  fit.samples = d.k_total;
+  fit.decimation = d.dec;
+  fit.singular_values = d.svd.s;
+  fit.order_automatic = order == 0;
+  if (order == 0) {
+    fit.noise_singular_value = d.noise_singular_value;
+    fit.order = select_order(d.svd.s, d.noise_singular_value,
+                             std::min<std::size_t>(opt.max_order, static_cast<std::size_t>(d.rank_cap)),
                              opt.noise_threshold);
   } else {
-    fit.order = *opt.order;
+    if (static_cast<Eigen::Index>(order) > d.rank_cap)
+      fail("Hankel matrix too small for order " + std::to_string(order) + ": H(0) is " +
+           std::to_string(d.h->rows()) + " x " + std::to_string(d.h->cols()) +
+           ", order must be < " + std::to_string(d.rank_cap + 1) +
+           " (give more samples or larger rows/cols)");
+    fit.order = order;
   }
   const auto p = static_cast<Eigen::Index>(fit.order);
-  if (p > svd.s.size()) fail("order exceeds the singular values computed");
-  if (!(svd.s[p - 1] > 1e-14 * svd.s[0]))
+  if (p > d.svd.s.size()) fail("order exceeds the singular values computed");
+  if (!(d.svd.s[p - 1] > 1e-14 * d.svd.s[0]))
     fail("order " + std::to_string(p) + " exceeds the numerical rank of the Hankel matrix (s_p/s_1 = " +
-         std::to_string(svd.s[p - 1] / svd.s[0]) + "): choose a smaller order");
+         std::to_string(d.svd.s[p - 1] / d.svd.s[0]) + "): choose a smaller order");
 
-  // Realization (eq. 143): A = Σ1^-1/2 U1ᵀ H(1) V1 Σ1^-1/2.
-  const Eigen::VectorXd sinv = svd.s.head(p).cwiseSqrt().cwiseInverse();
-  const Eigen::MatrixXd u1 = svd.u.leftCols(p), v1 = svd.v.leftCols(p);
-  const Eigen::MatrixXd h1v1 = h.apply(1, v1);  // H(1)·V1 (FFT product; exact to rounding)
-  const Eigen::MatrixXd a = sinv.asDiagonal() * (u1.transpose() * h1v1) * sinv.asDiagonal();
+  // Realization (eq. 143): A = Σ1^-1/2 U1ᵀ H(1) V1 Σ1^-1/2; the realization of
+  // order p is the leading p × p block of the one over all computed columns.
+  if (d.h1v.cols() < p) d.h1v = d.h->apply(1, d.svd.v);  // H(1)·V (FFT product)
+  const Eigen::VectorXd sinv = d.svd.s.head(p).cwiseSqrt().cwiseInverse();
+  const Eigen::MatrixXd a =
+      sinv.asDiagonal() * (d.svd.u.leftCols(p).transpose() * d.h1v.leftCols(p)) * sinv.asDiagonal();
   Eigen::EigenSolver<Eigen::MatrixXd> es(a, false);
   if (es.info() != Eigen::Success) fail("eigenvalues of the realization did not converge");
   fit.z.resize(p);
@@ -235,15 +272,16 @@ PronyFit prony_ss(const Eigen::Ref<const Eigen::MatrixXd>& y, double sample_rate
   for (Eigen::Index n = 0; n < p; ++n) {
     const std::complex<double> zd = es.eigenvalues()[n];
     if (std::abs(zd) == 0.0) fail("a pole sits at z = 0 (order too high for the data)");
-    fit.lambda[n] = std::log(zd) * (sample_rate_hz / double(dec));  // eq. 164 at Δt·D
-    fit.z[n] = std::exp(fit.lambda[n] / sample_rate_hz);              // full-rate z
+    fit.lambda[n] = std::log(zd) * (sample_rate_hz / double(d.dec));  // eq. 164 at Δt·D
+    fit.z[n] = std::exp(fit.lambda[n] / sample_rate_hz);                // full-rate z
   }
 
   // Residues (eq. 155) on the unscaled data, columns scaled for conditioning.
+  const Eigen::Index k_used = d.k_used;
   Eigen::MatrixXcd vand(k_used, p);
   for (Eigen::Index n = 0; n < p; ++n) {
     const std::complex<double> lz = fit.lambda[n] / sample_rate_hz;
-    for (Eigen::Index k = 0; k < k_used; ++k) vand(k, n) = std::exp(lz * double(k + skip));
+    for (Eigen::Index k = 0; k < k_used; ++k) vand(k, n) = std::exp(lz * double(k + d.skip));
   }
   Eigen::VectorXd cscale = vand.colwise().norm().cwiseInverse().transpose();
   vand = vand * cscale.asDiagonal();
@@ -253,6 +291,40 @@ PronyFit prony_ss(const Eigen::Ref<const Eigen::MatrixXd>& y, double sample_rate
   const Eigen::MatrixXcd res = vand * (cscale.cwiseInverse().asDiagonal() * fit.residues) - rhs;
   fit.residual_rms = (res.colwise().norm() / std::sqrt(double(k_used))).transpose();
   return fit;
+}
+
+}  // namespace
+
+PronyFit prony_ss(const Eigen::Ref<const Eigen::MatrixXd>& y, double sample_rate_hz,
+                  const PronyOptions& opt) {
+  if (opt.order && *opt.order < 1) fail("order must be >= 1");
+  Decomposition d = decompose(y, sample_rate_hz, opt, opt.order.value_or(0), !opt.order, true);
+  return realize(d, y, sample_rate_hz, opt, opt.order.value_or(0));
+}
+
+std::vector<PronyOrderFit> prony_ss_orders(const Eigen::Ref<const Eigen::MatrixXd>& y,
+                                           double sample_rate_hz, const PronyOptions& opt,
+                                           const std::vector<std::size_t>& orders) {
+  std::size_t highest = 0;
+  bool automatic = false;
+  for (std::size_t p : orders) {
+    highest = std::max(highest, p);
+    automatic = automatic || p == 0;
+  }
+  Decomposition d = decompose(y, sample_rate_hz, opt, highest, automatic, false);
+  std::vector<PronyOrderFit> out;
+  out.reserve(orders.size());
+  for (std::size_t p : orders) {
+    PronyOrderFit f;
+    f.requested = p;
+    try {
+      f.fit = realize(d, y, sample_rate_hz, opt, p);
+    } catch (const std::invalid_argument& e) {
+      f.error = e.what();
+    }
+    out.push_back(std::move(f));
+  }
+  return out;
 }
 
 std::complex<double> laplace(const PronyFit& fit, Eigen::Index signal, std::complex<double> s) {

@@ -13,6 +13,7 @@
 #include <complex>
 #include <cstdint>
 #include <optional>
+#include <string>
 #include <vector>
 
 #include "dsp/impedance_types.hpp"
@@ -77,6 +78,22 @@ struct PronyFit {
 // small for the (manual) order, or too few samples.
 PronyFit prony_ss(const Eigen::Ref<const Eigen::MatrixXd>& y, double sample_rate_hz,
                   const PronyOptions& opt = {});
+
+// Fits of the same data at several orders from ONE Hankel SVD (the
+// stabilization chart's rows): the realization of order p is the leading
+// p × p block of the largest one's, so each extra order costs an eigenvalue
+// problem and a residue fit, not a decomposition. An order of 0 is the
+// automatic one; opt.order is ignored. Errors of the data as a whole (bad
+// rate, constant signal, too few samples) throw std::invalid_argument; an
+// order the data cannot carry is that entry's `error`.
+struct PronyOrderFit {
+  std::size_t requested = 0;
+  std::optional<PronyFit> fit;
+  std::string error;  // when !fit
+};
+std::vector<PronyOrderFit> prony_ss_orders(const Eigen::Ref<const Eigen::MatrixXd>& y,
+                                           double sample_rate_hz, const PronyOptions& opt,
+                                           const std::vector<std::size_t>& orders);
 
 // The decimation D prony_ss uses for `opt` at this rate (opt.decimation, or
 // the automatic choice from band_hz); 10·D + 1 is its low-pass filter's length.

@@ -26,27 +26,26 @@ StabilizationChart stabilization_chart(const DividerRecord& rec, const PronyImpe
   if (!(s.freq_tol > 0) || !(s.damping_tol > 0))
     throw std::invalid_argument("stabilization_chart: tolerances must be positive");
   StabilizationChart chart;
-  {
-    PronyImpedanceOptions a = opt;
-    a.prony.order.reset();
-    try {
-      chart.selected_order = fit_prony_impedance(rec, a).fit.order;
-    } catch (const std::invalid_argument&) {
-      chart.selected_order = 0;
-    }
+  // Every row and the automatic order from one decomposition (the chart's
+  // orders are truncations of the same SVD).
+  std::vector<std::size_t> orders{0};
+  for (std::size_t p = s.min_order; p <= s.max_order; p += s.step) orders.push_back(p);
+  std::vector<std::optional<PronyImpedance>> fits;
+  try {
+    fits = fit_prony_impedance_orders(rec, opt, orders);
+  } catch (const std::invalid_argument&) {
+    return chart;  // the record carries no fit at any order: an empty chart
   }
+  chart.selected_order = fits[0] ? fits[0]->fit.order : 0;
   std::vector<PoleInfo> previous;
   bool have_previous = false;
-  for (std::size_t p = s.min_order; p <= s.max_order; p += s.step) {
-    PronyImpedanceOptions o = opt;
-    o.prony.order = p;
-    std::vector<PoleInfo> poles;
-    try {
-      poles = pole_table(fit_prony_impedance(rec, o).fit);
-    } catch (const std::invalid_argument&) {
+  for (std::size_t row = 1; row < orders.size(); ++row) {
+    const std::size_t p = orders[row];
+    if (!fits[row]) {
       have_previous = false;  // the data cannot carry this order: a gap in the chart
       continue;
     }
+    const std::vector<PoleInfo> poles = pole_table(fits[row]->fit);
     chart.orders.push_back(p);
     for (const auto& q : poles) {
       if (s.fmax_hz > 0 && q.freq_hz > s.fmax_hz) continue;
@@ -66,7 +65,7 @@ StabilizationChart stabilization_chart(const DividerRecord& rec, const PronyImpe
       }
       chart.poles.push_back(sp);
     }
-    previous = std::move(poles);
+    previous = poles;
     have_previous = true;
   }
   return chart;

@@ -216,6 +216,36 @@ TEST(PronyOrder, ManualOverride) {
   EXPECT_EQ(fit.lambda.size(), 3);
 }
 
+// prony_ss_orders: each order from ONE decomposition equals a separate prony_ss
+// at that order (the realization of order p is the leading p × p block of the
+// largest one's). With the full SVD both use the same singular triplets, so
+// the poles agree to rounding; an order above the Hankel rank is that entry's
+// error, not an exception for the others.
+TEST(PronyOrder, SeveralOrdersFromOneDecompositionMatchSeparateFits) {
+  const Synthetic syn;
+  Eigen::MatrixXd y = syn.sample(300);
+  std::mt19937_64 rng(7);
+  std::normal_distribution<double> nd(0.0, 1e-3);
+  for (Eigen::Index i = 0; i < y.size(); ++i) y.data()[i] += nd(rng);
+  dsp::PronyOptions o;
+  o.svd = dsp::SvdMethod::Full;
+  const std::vector<std::size_t> orders{0, 3, 5, 9, 1000};
+  const auto fits = dsp::prony_ss_orders(y, syn.fs, o, orders);
+  ASSERT_EQ(fits.size(), orders.size());
+  for (std::size_t i = 0; i + 1 < orders.size(); ++i) {
+    ASSERT_TRUE(fits[i].fit) << fits[i].error;
+    dsp::PronyOptions one = o;
+    if (orders[i]) one.order = orders[i];
+    const auto ref = dsp::prony_ss(y, syn.fs, one);
+    ASSERT_EQ(fits[i].fit->order, ref.order);
+    EXPECT_EQ(fits[i].fit->order_automatic, orders[i] == 0);
+    std::vector<cd> truth(ref.lambda.data(), ref.lambda.data() + ref.lambda.size());
+    EXPECT_LT(pole_error(truth, fits[i].fit->lambda), 1e-9) << "order " << orders[i];
+  }
+  EXPECT_FALSE(fits.back().fit);
+  EXPECT_NE(fits.back().error.find("too small for order 1000"), std::string::npos) << fits.back().error;
+}
+
 // Refusals: a clear std::invalid_argument naming the function and the problem.
 void expect_refusal(const std::function<void()>& f, const std::string& needle) {
   try {

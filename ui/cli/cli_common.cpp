@@ -2,6 +2,7 @@
 
 #include <unistd.h>
 
+#include <iomanip>
 #include <cstdio>
 #include <iostream>
 
@@ -40,7 +41,8 @@ int run_command(Context& ctx, const std::function<void()>& body) {
   }
 }
 
-void print_json(const nlohmann::json& j) { std::cout << j.dump(2) << std::endl; }
+// Streamed (no serialised copy in memory: a 250 000-bin spectrum is ~100 MB of text).
+void print_json(const nlohmann::json& j) { std::cout << std::setw(2) << j << std::endl; }
 
 void add_json_flag(CLI::App* cmd, Context& ctx) {
   cmd->add_flag("--json", ctx.json, "Machine-readable JSON output on stdout");

@@ -5,6 +5,7 @@
 // Prony, FFT and cross spectra go through acq::assess_impedance: fixture
 // compensation and deskew from the capture's calibration shots, uncertainty
 // band, Kramers-Kronig check, shot validity and the stabilization chart.
+#include <iomanip>
 #include <cstdio>
 #include <fstream>
 #include <iostream>
@@ -323,7 +324,7 @@ void run(const ImpedanceArgs& a, Context& ctx) {
                             {"abs_sigma_ohm", std::vector<double>(band->abs_sigma_ohm.data(), band->abs_sigma_ohm.data() + band->size())}};
     }
     if (ctx.json) {
-      *os << j.dump(2) << std::endl;
+      *os << std::setw(2) << j << std::endl;  // streamed, no serialised copy
     } else {
       print_text(j);
       print_trust(j);
