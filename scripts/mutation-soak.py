@@ -32,11 +32,18 @@ def raw_data_ranges(path):
     try:
         import h5py
     except ImportError:
+        print("soak: no h5py in this python (use /usr/bin/python3, Debian's python3-h5py):"
+              " mutating bytes uniformly, not mostly metadata", file=sys.stderr)
         return []
     ranges = []
     with h5py.File(path, "r") as f:
         def visit(name, obj):
             if isinstance(obj, h5py.Dataset):
+                if obj.chunks is not None:  # chunked (often compressed): each chunk's bytes
+                    for i in range(obj.id.get_num_chunks()):
+                        c = obj.id.get_chunk_info(i)
+                        ranges.append((c.byte_offset, c.byte_offset + c.size))
+                    return
                 off = obj.id.get_offset()
                 if off is not None:
                     ranges.append((off, off + obj.id.get_storage_size()))

@@ -15,6 +15,7 @@
 #include "model/harmonic.hpp"
 #include "model/material_presets.hpp"
 #include "ui/cli/cli_common.hpp"
+#include "ui/cli/cmd_update_capture.hpp"
 #include "update/impedance_file.hpp"
 #include "update/least_squares.hpp"
 #include "update/rayleigh.hpp"
@@ -28,9 +29,9 @@ namespace pm = piezo::model;
 namespace pu = piezo::update;
 
 struct UpdateArgs {
-  std::string file, resonances, antiresonances, low_z, material = "apc850", set, method = "cmcm";
+  std::string file, resonances, antiresonances, low_z, material = "apc850", set, method;
   std::string overlay, damping, capacitance = "fe";
-  bool isotropic = false, cross_modes = false;
+  bool isotropic = false, cross_modes = false, transverse = false;
   int max_iterations = pu::CmcmOptions{}.max_iterations;
   int n_radial = pm::MeshOptions{}.n_radial, n_axial = pm::MeshOptions{}.n_axial;
 };
@@ -83,7 +84,22 @@ std::vector<std::complex<double>> model_impedance(pm::ModalSolver& solver,
   return pm::impedance_from_admittance(pm::admittance_modal(port, f, d));
 }
 
+void run_update_features(Context& ctx, const UpdateArgs& a0, const std::string& method);
+
 void run_update(Context& ctx, const UpdateArgs& a) {
+  if (a.file.size() > 3 && a.file.compare(a.file.size() - 3, 3, ".h5") == 0) {
+    // A capture: the tube's constants from the recorded samples.
+    if (a.isotropic && a.transverse) throw InputError("--isotropic and --transverse exclude each other");
+    run_update_capture(ctx, a.file, a.method.empty() ? "oe" : a.method, a.material, !a.transverse);
+    return;
+  }
+  if (a.transverse) throw InputError("--transverse is for a capture (an impedance file's default class is transversely isotropic)");
+  run_update_features(ctx, a, a.method.empty() ? "cmcm" : a.method);
+}
+
+void run_update_features(Context& ctx, const UpdateArgs& a0, const std::string& method) {
+  UpdateArgs a = a0;
+  a.method = method;
   if (a.method != "cmcm" && a.method != "lm" && a.method != "both")
     throw InputError("--method must be cmcm, lm or both");
   if (a.capacitance != "fe" && a.capacitance != "analytic")
@@ -333,16 +349,22 @@ void run_update(Context& ctx, const UpdateArgs& a) {
 void register_update_command(CLI::App& app, Context& ctx) {
   auto a = std::make_shared<UpdateArgs>();
   auto* cmd =
-      app.add_subcommand("update", "FE model updating from impedance features (extended CMCM, LM)");
-  cmd->add_option("FILE", a->file, "Impedance file: CSV f_hz,re_ohm,im_ohm or Touchstone .s1p");
+      app.add_subcommand("update", "FE model updating: from a capture (output-error fit) or impedance features (extended CMCM, LM)");
+  cmd->add_option("FILE", a->file,
+                  "Impedance file (CSV f_hz,re_ohm,im_ohm or Touchstone .s1p) or a capture (.h5)");
   cmd->add_option("--resonances", a->resonances, "Resonances F1,F2,… [Hz]");
   cmd->add_option("--antiresonances", a->antiresonances, "Anti-resonances F1,F2,… [Hz]");
   cmd->add_option("--low-z", a->low_z, "|Z| at a low frequency, OHM@HZ (e.g. 26804@400)");
   cmd->add_option("--material", a->material, "Material preset of the original model")
       ->capture_default_str();
-  cmd->add_flag("--isotropic", a->isotropic, "Isotropic-simplification class (seed §6.4.3)");
+  cmd->add_flag("--isotropic", a->isotropic,
+                "Isotropic-simplification class (seed §6.4.3; a capture's default)");
   cmd->add_option("--set", a->set, "Original parameters: YE11=…,nu12=…,d31=…,epsT33_rel=…");
-  cmd->add_option("--method", a->method, "cmcm, lm or both")->capture_default_str();
+  cmd->add_option("--method", a->method,
+                  "impedance file: cmcm (default), lm or both; capture: oe (default, output-error fit of "
+                  "the samples), cmcm, lm or all");
+  cmd->add_flag("--transverse", a->transverse,
+                "Capture: transversely isotropic class instead of the isotropic one");
   cmd->add_option("--overlay", a->overlay, "Write |Z| of original, updated and measured to CSV");
   cmd->add_option("--damping", a->damping, "Rayleigh fit from two modes: F1:ZETA1,F2:ZETA2");
   cmd->add_option("--capacitance", a->capacitance,

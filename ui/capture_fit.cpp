@@ -1,0 +1,51 @@
+#include "ui/capture_fit.hpp"
+
+#include <stdexcept>
+
+#include "model/material_presets.hpp"
+#include "model/material_spec.hpp"
+#include "model/modal.hpp"
+#include "model/tube_model.hpp"
+
+namespace piezo::ui {
+
+CaptureFit fit_capture(const acq::Capture& cap, const CaptureFitRequest& req) {
+  // The dut transient shots of the first one's drive.
+  const acq::Shot* first = nullptr;
+  for (const auto& s : cap.shots)
+    if (s.role == acq::Role::Dut && s.excitation != acq::Excitation::Sine) {
+      first = &s;
+      break;
+    }
+  if (!first) throw std::invalid_argument("the capture holds no dut transient shot to fit");
+  CaptureFit out;
+  out.excitation = std::string(acq::to_string(first->excitation));
+  update::OeData data;
+  data.sample_rate_hz = first->sample_rate_hz;
+  data.circuit.r1_ohm = cap.setup.divider_r1_ohm;
+  for (const auto& s : cap.shots) {
+    if (s.role != acq::Role::Dut || s.excitation != first->excitation ||
+        s.sample_rate_hz != first->sample_rate_hz)
+      continue;
+    ++out.shots_available;
+    data.shots.push_back({s.v1, s.v2, static_cast<std::size_t>(std::max<std::int64_t>(0, s.pretrigger_samples))});
+  }
+  if (req.fixture) {
+    const auto& fx = *req.fixture;
+    data.circuit.r1_ohm *= 1.0 + fx.r1_error.value_or(0.0);
+    data.circuit.c_parallel_f = std::max(0.0, fx.fixture_capacitance_f.value_or(0.0));
+    data.circuit.r_lead_ohm = std::max(0.0, fx.lead_resistance_ohm.value_or(0.0));
+    data.v2_delay_s = fx.skew_s.value_or(0.0);
+  }
+  const auto nominal = model::resolve_material({req.material, req.isotropic, ""});
+  model::TubeGeometry g = cap.setup.geometry();
+  if (!cap.setup.density_kg_m3) g.density_kg_m3 = nominal.density_kg_m3;
+  model::TubeModel tube(g);
+  model::ModalSolver solver(tube);
+  const auto cls = req.isotropic ? update::MaterialClass::isotropic()
+                                 : update::MaterialClass::transversely_isotropic(nominal.d);
+  out.result = update::fit_output_error(solver, cls, model::isotropic_params(nominal.d), data, req.options);
+  return out;
+}
+
+}  // namespace piezo::ui

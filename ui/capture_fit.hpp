@@ -1,0 +1,34 @@
+#pragma once
+// The output-error estimator (update/output_error.hpp) on a capture: its dut
+// transient shots of one drive, R1 and geometry from /setup, the nominal
+// material of the model class — what `piezobench update CAP.h5 --method oe`,
+// the pipeline and replay run.
+#include <optional>
+#include <string>
+
+#include "acquisition/capture.hpp"
+#include "dsp/fixture_calibration.hpp"
+#include "update/output_error.hpp"
+
+namespace piezo::ui {
+
+struct CaptureFitRequest {
+  std::string material = "apc850";
+  bool isotropic = true;
+  update::OeOptions options;
+  // A measured fixture (calibration shots): true R1, Cp at node 2, lead R
+  // enter the divider the port is simulated in.
+  std::optional<dsp::FixtureCalibration> fixture;
+};
+
+struct CaptureFit {
+  update::OeResult result;
+  std::string excitation;  // the drive of the shots used
+  int shots_available = 0;
+};
+
+// Throws std::invalid_argument when the capture holds no dut transient shot
+// or the fit cannot use it.
+CaptureFit fit_capture(const acq::Capture& cap, const CaptureFitRequest& req);
+
+}  // namespace piezo::ui

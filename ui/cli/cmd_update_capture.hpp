@@ -1,0 +1,12 @@
+#pragma once
+#include <string>
+
+#include "ui/cli/cli_common.hpp"
+
+namespace piezo::cli {
+
+// `piezobench update CAP.h5 --method oe|cmcm|lm|all` (see cmd_update_capture.cpp).
+void run_update_capture(Context& ctx, const std::string& file, const std::string& method,
+                        const std::string& material, bool isotropic);
+
+}  // namespace piezo::cli

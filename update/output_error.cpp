@@ -1,0 +1,637 @@
+#include "update/output_error.hpp"
+
+#include <Eigen/Dense>
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <complex>
+#include <cstdio>
+#include <optional>
+#include <stdexcept>
+
+#include "dsp/fft.hpp"
+#include "dsp/prony_ss.hpp"
+
+namespace piezo::update {
+
+namespace {
+
+constexpr double kTwoPi = 2.0 * M_PI;
+using cd = std::complex<double>;
+constexpr int kParams = 5;  // ln YE11, nu12 (relative), ln d31, ln εT33, ln β
+
+[[noreturn]] void fail(const std::string& msg) {
+  throw std::invalid_argument("fit_output_error: " + msg);
+}
+
+// Causal low-pass FIR (Blackman-windowed sinc, cutoff fc, unit DC gain), the
+// filter update/port_fit.cpp applies to its output error.
+Eigen::VectorXd lowpass_taps(double fs, double fc) {
+  const auto taps = static_cast<Eigen::Index>(2 * std::ceil(5.5 * fs / fc) + 1);
+  const double f = fc / fs;
+  const double mid = double(taps - 1) / 2.0;
+  Eigen::VectorXd h(taps);
+  for (Eigen::Index k = 0; k < taps; ++k) {
+    const double t = double(k) - mid;
+    const double sinc = t == 0.0 ? 2.0 * f : std::sin(kTwoPi * f * t) / (M_PI * t);
+    const double w = 0.42 - 0.5 * std::cos(kTwoPi * double(k) / double(taps - 1)) +
+                     0.08 * std::cos(2.0 * kTwoPi * double(k) / double(taps - 1));
+    h[k] = sinc * w;
+  }
+  return h / h.sum();
+}
+
+// The parameter vector θ relative to the nominal constants.
+struct Coordinates5 {
+  TubeParams p0;
+  double beta0 = 1e-7;
+  TubeParams params(const Eigen::VectorXd& x) const {
+    TubeParams p = p0;
+    p.y_e11 = p0.y_e11 * std::exp(x[0]);
+    p.nu12 = p0.nu12 * (1.0 + x[1]);
+    p.d31 = p0.d31 * std::exp(x[2]);
+    p.eps_t33 = p0.eps_t33 * std::exp(x[3]);
+    return p;
+  }
+  double beta(const Eigen::VectorXd& x) const { return beta0 * std::exp(x[4]); }
+};
+
+// Shots averaged per (length, pretrigger) group; the largest group is used.
+struct Averaged {
+  std::vector<double> v1, v2;
+  std::size_t pretrigger = 0;
+  std::vector<std::vector<double>> dev1, dev2;  // each shot minus the average (K ≥ 2)
+  int shots = 0;
+};
+
+Averaged average(const OeData& d) {
+  if (d.shots.empty()) fail("no shots");
+  // Group by (length, pretrigger): the largest group.
+  std::size_t best = 0, best_count = 0;
+  for (std::size_t i = 0; i < d.shots.size(); ++i) {
+    std::size_t c = 0;
+    for (const auto& s : d.shots)
+      c += s.v1.size() == d.shots[i].v1.size() && s.pretrigger == d.shots[i].pretrigger;
+    if (c > best_count) best = i, best_count = c;
+  }
+  const OeShot& ref = d.shots[best];
+  const std::size_t n = ref.v1.size();
+  Averaged a;
+  a.v1.assign(n, 0.0);
+  a.v2.assign(n, 0.0);
+  a.pretrigger = ref.pretrigger;
+  std::vector<const OeShot*> used;
+  for (const auto& s : d.shots) {
+    if (s.v1.size() != n || s.pretrigger != ref.pretrigger) continue;
+    if (s.v2.size() != n) fail("a shot's v1 and v2 differ in length");
+    for (std::size_t i = 0; i < n; ++i) {
+      if (!std::isfinite(s.v1[i]) || !std::isfinite(s.v2[i])) fail("a shot holds NaN or Inf samples");
+      a.v1[i] += s.v1[i];
+      a.v2[i] += s.v2[i];
+    }
+    used.push_back(&s);
+  }
+  a.shots = static_cast<int>(used.size());
+  for (auto& v : a.v1) v /= a.shots;
+  for (auto& v : a.v2) v /= a.shots;
+  if (a.shots >= 2)
+    for (const OeShot* s : used) {
+      std::vector<double> d1(n), d2(n);
+      for (std::size_t i = 0; i < n; ++i) {
+        d1[i] = s->v1[i] - a.v1[i];
+        d2[i] = s->v2[i] - a.v2[i];
+      }
+      a.dev1.push_back(std::move(d1));
+      a.dev2.push_back(std::move(d2));
+    }
+  // DAQ offsets: the idle level before the drive (with a pretrigger of its own).
+  if (a.pretrigger >= 16 && a.pretrigger < n) {
+    double m1 = 0, m2 = 0;
+    for (std::size_t i = 0; i < a.pretrigger; ++i) {
+      m1 += a.v1[i];
+      m2 += a.v2[i];
+    }
+    m1 /= double(a.pretrigger);
+    m2 /= double(a.pretrigger);
+    for (std::size_t i = 0; i < n; ++i) {
+      a.v1[i] -= m1;
+      a.v2[i] -= m2;
+    }
+  }
+  return a;
+}
+
+// The filtered, decimated output error of one parameter vector.
+class Problem {
+ public:
+  Problem(model::ModalSolver& solver, const MaterialClass& cls, const Coordinates5& co,
+          const Averaged& rec, const OeData& data, double band_hz, const model::ModalOptions& modal)
+      : solver_(solver), cls_(cls), co_(co), circuit_(data.circuit), modal_(modal),
+        fs_(data.sample_rate_hz), delay_(data.v2_delay_s), n_(rec.v1.size()),
+        nfft_(dsp::good_fft_size(std::max<std::size_t>(4 * n_, 1u << 14))), fft_(nfft_) {
+    const Eigen::VectorXd h = lowpass_taps(fs_, band_hz);
+    if (static_cast<std::size_t>(h.size()) > nfft_ - n_) fail("record too short for the band");
+    kmax_ = std::min<std::size_t>(fft_.bins() - 1,
+                                  static_cast<std::size_t>(std::ceil(2.5 * band_hz * double(nfft_) / fs_)));
+    std::vector<cd> hl(fft_.bins()), v1(fft_.bins()), v2(fft_.bins());
+    fft_.forward(h.data(), static_cast<std::size_t>(h.size()), hl.data());
+    fft_.forward(rec.v1.data(), n_, v1.data());
+    fft_.forward(rec.v2.data(), n_, v2.data());
+    lv1_.resize(kmax_ + 1);
+    ly_.resize(kmax_ + 1);
+    l_.resize(kmax_ + 1);
+    for (std::size_t k = 0; k <= kmax_; ++k) {
+      l_[k] = hl[k];
+      lv1_[k] = hl[k] * v1[k];
+      ly_[k] = hl[k] * v2[k];
+    }
+    decim_ = std::max<std::size_t>(1, static_cast<std::size_t>(fs_ / (2.0 * band_hz)));
+    for (std::size_t i = 0; i < n_; i += decim_) idx_.push_back(i);
+    spec_.assign(fft_.bins(), cd(0.0, 0.0));
+    buf_.resize(n_);
+  }
+
+  std::size_t samples() const { return idx_.size(); }
+  int evaluations() const { return evaluations_; }
+
+  // Perturbations of the measurement chain (for the type-B sensitivities).
+  struct Chain {
+    double r1_rel = 0, cp_f = 0, gain_rel = 0, skew_s = 0;
+  };
+
+  // T(f_k) of the divider for parameters x; empty when the model cannot be built.
+  std::optional<std::vector<cd>> transfer(const Eigen::VectorXd& x) {
+    return transfer(x, Chain{0, 0, 0, 0});
+  }
+  std::optional<std::vector<cd>> transfer(const Eigen::VectorXd& x, const Chain& b) {
+    ++evaluations_;
+    model::ModalPortModel port;
+    try {
+      port = solver_.port_model(cls_.e_form(co_.params(x)), modal_);
+    } catch (const std::exception&) {
+      return std::nullopt;
+    }
+    if (!port.converged) return std::nullopt;
+    const model::RayleighDamping damp{0.0, co_.beta(x)};
+    std::vector<cd> t(kmax_ + 1);
+    const double r1 = circuit_.r1_ohm * (1.0 + b.r1_rel), cp = circuit_.c_parallel_f + b.cp_f;
+    for (std::size_t k = 0; k <= kmax_; ++k) {
+      const double w = kTwoPi * fs_ * double(k) / double(nfft_);
+      const cd yt = cd(0.0, w) * port.charge_per_volt(w, damp);
+      const cd yb = circuit_.r_lead_ohm > 0 ? yt / (1.0 + circuit_.r_lead_ohm * yt) : yt;
+      const cd y2 = yb + cd(0.0, w * cp) + 1.0 / circuit_.r_daq_ohm;
+      t[k] = (1.0 + b.gain_rel) * std::polar(1.0, -w * (delay_ + b.skew_s)) / (1.0 + r1 * y2);
+    }
+    return t;
+  }
+
+  // Filtered output error for a given transfer.
+  Eigen::VectorXd residual_of(const std::vector<cd>& t) {
+    for (std::size_t k = 0; k <= kmax_; ++k) spec_[k] = t[k] * lv1_[k] - ly_[k];
+    return invert();
+  }
+
+  // Filtered output error (volts) at the decimated samples.
+  std::optional<Eigen::VectorXd> residual(const Eigen::VectorXd& x) {
+    const auto t = transfer(x);
+    if (!t) return std::nullopt;
+    return residual_of(*t);
+  }
+
+  // L ∗ (T ∗ d1 − d2) at the decimated samples (a shot's deviation from the mean).
+  Eigen::VectorXd deviation(const std::vector<cd>& t, const std::vector<double>& d1,
+                            const std::vector<double>& d2) {
+    std::vector<cd> a(fft_.bins()), b(fft_.bins());
+    fft_.forward(d1.data(), n_, a.data());
+    fft_.forward(d2.data(), n_, b.data());
+    for (std::size_t k = 0; k <= kmax_; ++k) spec_[k] = l_[k] * (t[k] * a[k] - b[k]);
+    return invert();
+  }
+
+  // σ of the filtered error for white noise σ1 on v1 and σ2 on v2 (Parseval).
+  double propagated_sigma(const std::vector<cd>& t, double s1, double s2) const {
+    double a1 = 0, a2 = 0;
+    for (std::size_t k = 0; k <= kmax_; ++k) {
+      const double w = (k == 0 || 2 * k == nfft_) ? 1.0 : 2.0;
+      a1 += w * std::norm(l_[k] * t[k]);
+      a2 += w * std::norm(l_[k]);
+    }
+    return std::sqrt((s1 * s1 * a1 + s2 * s2 * a2) / double(nfft_));
+  }
+
+ private:
+  Eigen::VectorXd invert() {
+    for (std::size_t k = kmax_ + 1; k < spec_.size(); ++k) spec_[k] = 0.0;
+    fft_.inverse(spec_.data(), buf_.data(), n_);
+    Eigen::VectorXd r(static_cast<Eigen::Index>(idx_.size()));
+    const double scale = 1.0 / double(nfft_);
+    for (std::size_t i = 0; i < idx_.size(); ++i) r[static_cast<Eigen::Index>(i)] = buf_[idx_[i]] * scale;
+    return r;
+  }
+
+  model::ModalSolver& solver_;
+  const MaterialClass& cls_;
+  Coordinates5 co_;
+  model::DividerCircuit circuit_;
+  model::ModalOptions modal_;
+  double fs_, delay_;
+  std::size_t n_, nfft_;
+  dsp::RealFft fft_;
+  std::size_t kmax_ = 0, decim_ = 1;
+  std::vector<cd> l_, lv1_, ly_, spec_;
+  std::vector<double> buf_;
+  std::vector<std::size_t> idx_;
+  int evaluations_ = 0;
+};
+
+// The nominal model's third electrically active short-circuit mode (Hz), or
+// its highest active one when it has fewer.
+double third_active_mode_hz(model::ModalSolver& solver, const MaterialClass& cls,
+                            const TubeParams& p, const model::ModalOptions& modal) {
+  const auto port = solver.port_model(cls.e_form(p), modal);
+  double f = 0;
+  int seen = 0;
+  for (const auto& m : port.modes) {
+    if (m.residual || !m.symmetric) continue;
+    const double coupling = m.participation * m.participation / (m.omega * m.omega * port.c_clamped);
+    if (coupling < modal.active_coupling) continue;
+    f = m.omega / kTwoPi;
+    if (++seen == 3) break;
+  }
+  if (!(f > 0)) throw std::runtime_error("the nominal model has no electrically active mode");
+  return f;
+}
+
+struct LmOutcome {
+  Eigen::VectorXd x;
+  double cost = 0;  // ½‖r/σ‖²
+  bool converged = false;
+  int iterations = 0;
+  std::string message;
+  Eigen::MatrixXd j, jtj;  // at the answer
+};
+
+}  // namespace
+
+OeResult fit_output_error(model::ModalSolver& solver, const MaterialClass& cls,
+                          const TubeParams& nominal, const OeData& data, const OeOptions& opt) {
+  const auto t0 = std::chrono::steady_clock::now();
+  const double fs = data.sample_rate_hz;
+  if (!(fs > 0) || !std::isfinite(fs)) fail("sample rate must be positive");
+  data.circuit.validate();
+  const Averaged rec = average(data);
+  if (rec.v1.size() < 256) fail("too short: " + std::to_string(rec.v1.size()) + " samples (need 256)");
+  {
+    double s = 0;
+    for (double v : rec.v1) s += v * v;
+    if (!(s > 0)) fail("v1 is zero: the capture holds no drive");
+  }
+
+  OeResult out;
+  out.original = nominal;
+  out.shots_used = rec.shots;
+  Coordinates5 co{nominal, opt.beta0_s};
+  try {
+    out.band_hz = opt.band_hz > 0 ? opt.band_hz
+                                  : std::min(1.6 * third_active_mode_hz(solver, cls, nominal, opt.modal),
+                                             fs / 8.0);
+  } catch (const std::exception& e) {
+    out.status = UpdateStatus::solver_failure;
+    out.message = std::string("the nominal model cannot be built: ") + e.what();
+    return out;
+  }
+  if (!(out.band_hz < fs / 4)) fail("band above a quarter of the sample rate");
+  Problem prob(solver, cls, co, rec, data, out.band_hz, opt.modal);
+  out.residual_samples = static_cast<int>(prob.samples());
+  if (prob.samples() < 4 * kParams) fail("too few samples in the band for five parameters");
+
+  // Noise of the filtered error: the shots' scatter, else the pretrigger, else
+  // each channel's high-pass estimate — at the nominal model's T (recomputed
+  // at the answer below).
+  auto noise_sigma = [&](const std::vector<cd>& t) {
+    const std::size_t n = rec.v1.size();
+    if (rec.shots >= 2) {
+      double ss = 0;
+      std::size_t m = 0;
+      Problem& p = prob;
+      for (std::size_t k = 0; k < rec.dev1.size(); ++k) {
+        const Eigen::VectorXd e = p.deviation(t, rec.dev1[k], rec.dev2[k]);
+        ss += e.squaredNorm();
+        m += static_cast<std::size_t>(e.size());
+      }
+      out.noise_source = "shots (" + std::to_string(rec.shots) + ")";
+      out.noise_dof = double(m) * double(rec.shots - 1) / double(rec.shots);
+      // per-shot variance ss/((K−1)·M/K·…): Σ_k ‖e_k‖² = (K−1)/K·K·M·σ², the average's σ²/K
+      const double var_shot = ss / (double(m) * double(rec.shots - 1) / double(rec.shots));
+      return std::sqrt(var_shot / double(rec.shots));
+    }
+    double s1 = 0, s2 = 0;
+    if (rec.pretrigger >= 64 && rec.pretrigger < n) {
+      for (std::size_t i = 0; i < rec.pretrigger; ++i) {
+        s1 += rec.v1[i] * rec.v1[i];
+        s2 += rec.v2[i] * rec.v2[i];
+      }
+      s1 = std::sqrt(s1 / double(rec.pretrigger - 1));
+      s2 = std::sqrt(s2 / double(rec.pretrigger - 1));
+      out.noise_source = "pretrigger (" + std::to_string(rec.pretrigger) + " samples)";
+      out.noise_dof = double(rec.pretrigger - 1);
+    } else {
+      const Eigen::Map<const Eigen::VectorXd> a(rec.v1.data(), static_cast<Eigen::Index>(n)),
+          b(rec.v2.data(), static_cast<Eigen::Index>(n));
+      s1 = dsp::estimate_noise_std(a);
+      s2 = dsp::estimate_noise_std(b);
+      out.noise_source = "high-pass estimate of each channel";
+      // The median of |6th differences| of overlapping windows: about a fifth
+      // of the samples' worth of independent information.
+      out.noise_dof = 0.2 * double(n);
+    }
+    return prob.propagated_sigma(t, s1, s2);
+  };
+  const Eigen::VectorXd x_nominal = Eigen::VectorXd::Zero(kParams);
+  const auto t_nominal = prob.transfer(x_nominal);
+  if (!t_nominal) {
+    out.status = UpdateStatus::solver_failure;
+    out.message = "the nominal model cannot be simulated";
+    return out;
+  }
+  double sigma = noise_sigma(*t_nominal);
+  if (!(sigma > 0) || !std::isfinite(sigma)) {
+    // Noise-free (synthetic) data: weigh by a tiny fraction of the signal.
+    sigma = 1e-9 * std::sqrt(std::max(1e-300, [&] {
+              double s = 0;
+              for (double v : rec.v2) s += v * v;
+              return s / double(rec.v2.size());
+            }()));
+    out.noise_source = "none measurable (noise-free data)";
+  }
+
+  auto weighted = [&](const Eigen::VectorXd& x) -> std::optional<Eigen::VectorXd> {
+    auto r = prob.residual(x);
+    if (!r) return std::nullopt;
+    *r /= sigma;
+    if (!r->allFinite()) return std::nullopt;
+    return r;
+  };
+  auto jacobian = [&](const Eigen::VectorXd& x, const Eigen::VectorXd& r0, Eigen::MatrixXd& j) {
+    j.resize(r0.size(), kParams);
+    for (int c = 0; c < kParams; ++c) {
+      const double h = c == 4 ? 1e-4 : 1e-6;
+      Eigen::VectorXd xp = x;
+      xp[c] += h;
+      auto rp = weighted(xp);
+      if (!rp) {
+        xp[c] = x[c] - h;  // the other side
+        rp = weighted(xp);
+        if (!rp) return false;
+        j.col(c) = (r0 - *rp) / h;
+      } else {
+        j.col(c) = (*rp - r0) / h;
+      }
+    }
+    return true;
+  };
+  auto levenberg_marquardt = [&](Eigen::VectorXd x) {
+    LmOutcome o;
+    auto r = weighted(x);
+    if (!r) {
+      o.message = "the start cannot be simulated";
+      o.cost = INFINITY;
+      o.x = x;
+      return o;
+    }
+    double cost = 0.5 * r->squaredNorm();
+    double mu = 1e-3;
+    Eigen::MatrixXd j;
+    for (int it = 1; it <= opt.max_iterations; ++it) {
+      o.iterations = it;
+      if (!jacobian(x, *r, j)) {
+        o.message = "the model could not be simulated near the estimate";
+        break;
+      }
+      const Eigen::MatrixXd jtj = j.transpose() * j;
+      const Eigen::VectorXd g = j.transpose() * *r;
+      bool accepted = false, done = false;
+      for (int tries = 0; tries < 14 && !accepted; ++tries) {
+        Eigen::MatrixXd a = jtj;
+        for (int p = 0; p < kParams; ++p) a(p, p) += mu * std::max(jtj(p, p), 1e-300);
+        Eigen::VectorXd step = a.ldlt().solve(-g);
+        // Trust region: no constant moves by more than 30 % in one step.
+        const double big = step.cwiseAbs().maxCoeff();
+        if (big > 0.3) step *= 0.3 / big;
+        const Eigen::VectorXd trial = x + step;
+        const auto rt = weighted(trial);
+        const double ct = rt ? 0.5 * rt->squaredNorm() : INFINITY;
+        if (ct < cost) {
+          x = trial;
+          r = rt;
+          const double drop = cost - ct;
+          cost = ct;
+          mu = std::max(mu / 3.0, 1e-12);
+          accepted = true;
+          // The cost is ½χ²: a decrease of 1e-3 moves no estimate by a
+          // measurable fraction of its sigma.
+          done = step.cwiseAbs().maxCoeff() < opt.step_tolerance || drop < opt.cost_tolerance;
+        } else {
+          mu *= 4.0;
+          if (step.cwiseAbs().maxCoeff() < opt.step_tolerance) accepted = done = true;
+        }
+      }
+      if (!accepted) {
+        double cosine = 0;
+        for (int p = 0; p < kParams; ++p)
+          cosine = std::max(cosine, std::abs(g[p]) / std::sqrt(jtj(p, p) * 2.0 * cost + 1e-300));
+        done = cosine < 1e-4;
+        if (!done) o.message = "no decrease of the output error (gradient cosine " + std::to_string(cosine) + ")";
+      }
+      if (done) {
+        o.converged = true;
+        break;
+      }
+      if (!accepted) break;
+    }
+    if (!o.converged && o.message.empty())
+      o.message = "did not converge in " + std::to_string(opt.max_iterations) + " iterations";
+    o.x = x;
+    o.cost = cost;
+    if (jacobian(x, *r, j)) {
+      o.j = j;
+      o.jtj = j.transpose() * j;
+    }
+    return o;
+  };
+
+  // Coarse stage: the 3 × 3 grid over YE11 and nu12.
+  struct Start {
+    Eigen::VectorXd x;
+    double cost;
+  };
+  std::vector<Start> grid;
+  for (int a = -1; a <= 1; ++a)
+    for (int b = -1; b <= 1; ++b) {
+      Eigen::VectorXd x = Eigen::VectorXd::Zero(kParams);
+      x[0] = std::log1p(a * opt.grid_span_ye11);
+      x[1] = b * opt.grid_span_nu12;
+      const auto r = weighted(x);
+      grid.push_back({x, r ? 0.5 * r->squaredNorm() : INFINITY});
+    }
+  std::sort(grid.begin(), grid.end(), [](const Start& a, const Start& b) { return a.cost < b.cost; });
+  out.starts = static_cast<int>(grid.size());
+  std::vector<LmOutcome> runs;
+  for (int i = 0; i < std::min<int>(opt.refine, static_cast<int>(grid.size())); ++i) {
+    if (!std::isfinite(grid[static_cast<std::size_t>(i)].cost)) break;
+    runs.push_back(levenberg_marquardt(grid[static_cast<std::size_t>(i)].x));
+    out.iterations += runs.back().iterations;
+  }
+  std::sort(runs.begin(), runs.end(), [](const LmOutcome& a, const LmOutcome& b) { return a.cost < b.cost; });
+  out.evaluations = prob.evaluations();
+  if (runs.empty() || !std::isfinite(runs.front().cost)) {
+    out.status = UpdateStatus::solver_failure;
+    out.message = "no start of the output-error fit could be simulated";
+    return out;
+  }
+  const LmOutcome& best = runs.front();
+  for (const auto& r : runs) {
+    out.optima.push_back(co.params(r.x));
+    out.optima_cost.push_back(r.cost);
+  }
+  out.updated = co.params(best.x);
+  out.damping = {0.0, co.beta(best.x)};
+
+  // Noise at the answer, χ², covariance.
+  const auto t_best = prob.transfer(best.x);
+  if (t_best) {
+    const double s = noise_sigma(*t_best);
+    if (s > 0 && std::isfinite(s) && out.noise_source.rfind("none", 0) != 0) {
+      // Re-weigh the cost and Jacobian to the noise at the answer.
+      const double f = sigma / s;
+      sigma = s;
+      for (auto& r : runs) {
+        r.cost *= f * f;
+        r.jtj *= f * f;
+        r.j *= f;
+      }
+    }
+  }
+  const int m = out.residual_samples;
+  const double dof = std::max(1, m - kParams);
+  out.noise_rms_v = sigma;
+  out.chi2_per_dof = 2.0 * best.cost / dof;
+  out.residual_rms_v = sigma * std::sqrt(2.0 * best.cost / m);
+  const double s2 = std::max(1.0, out.chi2_per_dof);
+  Eigen::MatrixXd cov = Eigen::MatrixXd::Constant(kParams, kParams, NAN);
+  if (best.jtj.rows() == kParams) {
+    Eigen::FullPivLU<Eigen::MatrixXd> lu(best.jtj);
+    if (lu.isInvertible()) cov = s2 * lu.inverse();
+  }
+  const Eigen::VectorXd sx_stat = cov.diagonal().cwiseMax(0.0).cwiseSqrt();
+  // Type-B part: the constants' shift per unit error of each chain quantity.
+  if (t_best && best.jtj.rows() == kParams && cov.allFinite()) {
+    const Eigen::MatrixXd& jb = best.j;  // weighted J at the answer
+    const bool have_j = jb.rows() == out.residual_samples && jb.cols() == kParams;
+    const Eigen::VectorXd r0 = prob.residual_of(*t_best);
+    using Chain = Problem::Chain;
+    const std::pair<Chain, double> chain[] = {
+        {Chain{1e-4, 0, 0, 0}, opt.r1_rel_sigma / 1e-4},
+        {Chain{0, 1e-12, 0, 0}, opt.cp_sigma_f / 1e-12},
+        {Chain{0, 0, 1e-4, 0}, opt.gain_rel_sigma / 1e-4},
+        {Chain{0, 0, 0, 1e-9}, opt.skew_sigma_s / 1e-9},
+    };
+    if (have_j) {
+      const Eigen::MatrixXd jtj = jb.transpose() * jb;
+      const auto ldlt = jtj.ldlt();
+      for (const auto& [b, scale] : chain) {
+        if (!(scale > 0)) continue;
+        const auto tb = prob.transfer(best.x, b);
+        if (!tb) continue;
+        const Eigen::VectorXd drb = (prob.residual_of(*tb) - r0) / sigma;  // ∂r/∂b·δb, weighted
+        const Eigen::VectorXd dx = -ldlt.solve(jb.transpose() * drb) * scale;  // shift per 1 sigma of b
+        if (dx.allFinite()) cov += dx * dx.transpose();
+      }
+    }
+  }
+  Eigen::VectorXd sx = cov.diagonal().cwiseMax(0.0).cwiseSqrt();
+  // Lack of fit: χ²/ν beyond what the noise estimate's own scatter allows.
+  out.chi2_limit = 1.0 + opt.lack_of_fit_z *
+                             std::sqrt(2.0 / dof + (out.noise_dof > 0 ? 2.0 / out.noise_dof : 0.0));
+  out.lack_of_fit = out.chi2_per_dof > out.chi2_limit;
+  out.correlation = Eigen::MatrixXd::Identity(kParams, kParams);
+  for (int a = 0; a < kParams; ++a)
+    for (int b = 0; b < kParams; ++b)
+      if (a != b) out.correlation(a, b) = cov(a, b) / (sx[a] * sx[b]);
+  out.corr_nu12_d31 = out.correlation(1, 2);
+
+  const TubeParams& u = out.updated;
+  const double beta = out.damping.beta;
+  struct Row {
+    const char* name;
+    const char* unit;
+    double value, sigma, nominal;
+    double limit;
+  };
+  const Row rows[kParams] = {
+      {"YE11", "Pa", u.y_e11, u.y_e11 * sx[0], nominal.y_e11, opt.identifiable_rel_sigma},
+      {"nu12", "-", u.nu12, nominal.nu12 * sx[1], nominal.nu12, opt.identifiable_rel_sigma},
+      {"d31", "C/N", u.d31, std::abs(u.d31) * sx[2], nominal.d31, opt.identifiable_rel_sigma},
+      {"epsT33_rel", "-", u.eps_t33 / model::kEps0, u.eps_t33 / model::kEps0 * sx[3],
+       nominal.eps_t33 / model::kEps0, opt.identifiable_rel_sigma},
+      {"beta", "s", beta, beta * sx[4], opt.beta0_s, 0.5},
+  };
+  for (int i = 0; i < kParams; ++i) {
+    OeParameter p;
+    p.name = rows[i].name;
+    p.unit = rows[i].unit;
+    p.value = rows[i].value;
+    p.sigma = rows[i].sigma;
+    p.sigma_statistical = rows[i].sigma * sx_stat[i] / sx[i];
+    p.nominal = rows[i].nominal;
+    p.status = "ok";
+    char buf[400];
+    const double rel = std::abs(p.sigma / p.value);
+    if (!std::isfinite(p.sigma)) {
+      p.status = "not identifiable";
+      p.reason = "singular";
+      p.note = "the data do not constrain it (singular normal equations): a longer record, a chirp or "
+               "more shots";
+    } else if (out.lack_of_fit) {
+      p.status = "not identifiable";
+      p.reason = "lack of fit";
+      std::snprintf(buf, sizeof buf,
+                    "the model class does not explain this capture (chi2/dof %.3g, the noise alone "
+                    "allows up to %.3g): an effect outside the model biases every constant; find it "
+                    "(gap diagnosis) or measure the fixture (calibration shots)",
+                    out.chi2_per_dof, out.chi2_limit);
+      p.note = buf;
+    } else if (rel > rows[i].limit) {
+      p.status = "not identifiable";
+      p.reason = "sigma";
+      std::snprintf(buf, sizeof buf,
+                    "relative sigma %.3g %% exceeds the %.3g %% limit: more shots (sigma falls as "
+                    "1/sqrt(shots)), less noise or a drive with more energy in the band would pin it",
+                    100 * rel, 100 * rows[i].limit);
+      p.note = buf;
+    }
+    // Another optimum the data cannot tell from the best (Δχ² < 4·s²) that puts
+    // this constant more than 3 sigma away.
+    for (std::size_t k = 1; k < runs.size() && p.status == "ok"; ++k) {
+      if (2.0 * (runs[k].cost - best.cost) > 4.0 * s2) continue;
+      const double dx = std::abs(runs[k].x[i] - best.x[i]);
+      if (dx > 3.0 * sx_stat[i]) {
+        p.status = "not identifiable";
+        p.reason = "starts";
+        std::snprintf(buf, sizeof buf,
+                      "two starts reach equally good fits %.3g sigma apart: a chirp or a longer record "
+                      "would separate them",
+                      dx / sx_stat[i]);
+        p.note = buf;
+      }
+    }
+    out.parameters.push_back(p);
+  }
+  out.status = best.converged ? UpdateStatus::converged : UpdateStatus::max_iterations;
+  out.message = best.converged ? "" : best.message;
+  out.evaluations = prob.evaluations();
+  out.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  return out;
+}
+
+}  // namespace piezo::update

@@ -1,0 +1,139 @@
+#pragma once
+// Output-error estimation of the tube's constants from a divider capture
+// (issue 17): the material constants of the model class and the Rayleigh
+// damping β are fitted DIRECTLY to the recorded samples — v2 predicted from the
+// recorded v1 through R1 and the FE port model (model/port_model.hpp, seed
+// eqs 87-92) — instead of going through Prony's features and CMCM's pairing.
+//
+//   prediction  v̂2 = IDFT[ T_θ(f_k) · DFT[v1] ],  T = 1/(1 + R1·Y_θ(jω))
+//               per DFT bin on a zero-padded record (4× the record: the modes'
+//               ring-down does not wrap around), i.e. the tube at rest and v1 = 0
+//               before the first recorded sample. With a pretrigger that is the
+//               truth (the AWG idles); a record that starts AT the step assumes
+//               the step happened at its first sample (the drive's onset is v1[0]).
+//   residual    r = L ∗ (v̂2 − v2) at every d-th sample, L a causal low-pass
+//               FIR (Blackman-windowed sinc at band_hz, unit DC gain),
+//               d = fs/(2·band): the modes far above the band (which the step
+//               excites and the FE mesh places less well) are left out, and the
+//               filtered error is sampled at about its own bandwidth, so its
+//               samples are nearly independent (for the covariance);
+//   weight      1/σ_r, σ_r the noise the capture itself shows: the scatter of
+//               repeated shots, else the pretrigger samples, else the robust
+//               high-pass noise estimate of each channel (dsp::estimate_noise_std),
+//               propagated through L (and T for v1's noise);
+//   fit         θ = (ln YE11, nu12, ln(d31/d31₀), ln εT33, ln β); a coarse
+//               stage evaluates a 3×3 grid over YE11 and nu12 (the constants
+//               that set the resonance pattern; the others enter the pattern
+//               weakly), Levenberg–Marquardt from the best starts on the
+//               re-linearised FE port model; the best optimum wins and the
+//               spread of the distinct optima is reported.
+//   uncertainty cov = s²·(JᵀJ)⁻¹ of the weighted residual, s² = max(1, χ²/ν):
+//               a fit worse than the noise (an effect the model class lacks)
+//               widens every sigma by the Birge ratio instead of hiding it.
+//   honesty     a constant whose relative sigma exceeds `identifiable_rel_sigma`,
+//               or whose value differs between the starts' optima by more than
+//               3 sigma, is "not identifiable" (with its numbers and what would
+//               pin it).
+#include <Eigen/Core>
+#include <span>
+#include <string>
+#include <vector>
+
+#include "model/modal.hpp"
+#include "model/transient.hpp"
+#include "update/cmcm.hpp"
+#include "update/parametrization.hpp"
+
+namespace piezo::update {
+
+// One recorded divider shot: samples from the record's start (pretrigger
+// included), volts.
+struct OeShot {
+  std::span<const double> v1, v2;
+  std::size_t pretrigger = 0;  // samples before the drive starts (0: the record starts at it)
+};
+
+struct OeData {
+  std::vector<OeShot> shots;  // same rate; shots of equal length and pretrigger are averaged
+  double sample_rate_hz = 0;
+  model::DividerCircuit circuit;  // R1 (and a measured fixture: Cp, lead R)
+  double v2_delay_s = 0;          // channel 2 recorded late by this (a measured skew)
+};
+
+struct OeOptions {
+  double band_hz = 0;  // 0: 1.6 × the nominal model's third electrically active mode
+  model::ModalOptions modal = [] {
+    model::ModalOptions m;
+    m.n_modes = 16;
+    return m;
+  }();
+  double beta0_s = 1e-7;  // Rayleigh β to start from (the seed's value)
+  // Coarse stage: the grid (1 ± span) over YE11 and nu12; LM from the best `refine` points.
+  double grid_span_ye11 = 0.08, grid_span_nu12 = 0.10;
+  int refine = 3;
+  int max_iterations = 40;
+  double step_tolerance = 1e-6;  // converged when max |Δθ| < this …
+  double cost_tolerance = 1e-3;  // … or ½χ² dropped by less than this in the last step
+  double identifiable_rel_sigma = 0.05;
+  // Systematic (type B) uncertainties of the measurement chain that the
+  // samples cannot separate from the constants — R1 and a capacitance across
+  // the transducer are exact aliases of the admittance's scale and of C0, a
+  // channel gain and skew near ones. Each is propagated to the constants
+  // through the fit's sensitivity dθ/db = −(JᵀJ)⁻¹Jᵀ ∂r/∂b and added to their
+  // covariance. Defaults: an R1 known to its 1 % tolerance, 30 pF of unmeasured
+  // cable/input capacitance, 0.5 % channel-gain mismatch, no skew (simultaneous
+  // sampling). A measured fixture (calibration shots) replaces them by its sigmas.
+  double r1_rel_sigma = 0.01;
+  double cp_sigma_f = 30e-12;
+  double gain_rel_sigma = 0.005;
+  double skew_sigma_s = 0.0;
+  // Lack of fit: χ²/ν above 1 + lack_of_fit_z·sqrt(2/ν + 2/ν_noise) (ν_noise:
+  // the degrees of freedom of the noise estimate) means the model class does
+  // not explain the capture: every constant is then "not identifiable" (reason
+  // "lack of fit"), its sigma widened by the Birge ratio sqrt(χ²/ν).
+  double lack_of_fit_z = 4.0;
+};
+
+struct OeParameter {
+  std::string name, unit;
+  double value = 0, sigma = 0;
+  double nominal = 0;
+  double sigma_statistical = 0;  // from the noise alone (Birge-widened), without the type-B part
+  std::string status;  // "ok" | "not identifiable"
+  std::string reason;  // when not identifiable: "sigma" | "starts" | "lack of fit" | "singular"
+  std::string note;    // why not identifiable, and what would pin it
+};
+
+struct OeResult {
+  UpdateStatus status = UpdateStatus::bad_input;
+  std::string message;
+  TubeParams original, updated;
+  model::RayleighDamping damping;           // fitted β (α = 0)
+  std::vector<OeParameter> parameters;      // YE11, nu12, d31, epsT33_rel, beta
+  Eigen::MatrixXd correlation;              // same order as parameters
+  double corr_nu12_d31 = 0;
+  double band_hz = 0;
+  int shots_used = 0;
+  std::string noise_source;                 // "shots" | "pretrigger" | "high-pass estimate"
+  double noise_rms_v = 0;                   // σ_r of the filtered residual samples
+  double residual_rms_v = 0;                // of the filtered residual at the optimum
+  double chi2_per_dof = 0;                  // (residual/noise)² per degree of freedom
+  double chi2_limit = 0;                    // the lack-of-fit threshold for chi2_per_dof
+  double noise_dof = 0;                     // degrees of freedom of the noise estimate
+  bool lack_of_fit = false;
+  int residual_samples = 0;
+  int starts = 0, iterations = 0, evaluations = 0;
+  std::vector<TubeParams> optima;            // every refined start's optimum (best first)
+  std::vector<double> optima_cost;
+  double seconds = 0;
+  bool ok() const { return status == UpdateStatus::converged; }
+};
+
+// Throws std::invalid_argument for unusable data (no shots, lengths that do
+// not match, non-finite samples, a band above Nyquist); a fit that does not
+// converge is a status with a message.
+OeResult fit_output_error(model::ModalSolver& solver, const MaterialClass& cls,
+                          const TubeParams& nominal, const OeData& data,
+                          const OeOptions& options = {});
+
+}  // namespace piezo::update
