@@ -19,6 +19,8 @@ CaptureFit fit_capture(const acq::Capture& cap, const CaptureFitRequest& req) {
     }
   if (!first) throw std::invalid_argument("the capture holds no dut transient shot to fit");
   CaptureFit out;
+  update::OeOptions opts_value = req.options;
+  const update::OeOptions& opts = opts_value;
   out.excitation = std::string(acq::to_string(first->excitation));
   update::OeData data;
   data.sample_rate_hz = first->sample_rate_hz;
@@ -36,6 +38,11 @@ CaptureFit fit_capture(const acq::Capture& cap, const CaptureFitRequest& req) {
     data.circuit.c_parallel_f = std::max(0.0, fx.fixture_capacitance_f.value_or(0.0));
     data.circuit.r_lead_ohm = std::max(0.0, fx.lead_resistance_ohm.value_or(0.0));
     data.v2_delay_s = fx.skew_s.value_or(0.0);
+    // Measured: their sigmas replace the stated tolerances.
+    auto& o = const_cast<update::OeOptions&>(opts);
+    if (fx.r1_error) o.r1_rel_sigma = fx.r1_error_sigma.value_or(o.r1_rel_sigma);
+    if (fx.fixture_capacitance_f) o.cp_sigma_f = fx.fixture_capacitance_sigma_f.value_or(o.cp_sigma_f);
+    if (fx.skew_s) o.skew_sigma_s = fx.skew_sigma_s.value_or(o.skew_sigma_s);
   }
   const auto nominal = model::resolve_material({req.material, req.isotropic, ""});
   model::TubeGeometry g = cap.setup.geometry();
@@ -44,7 +51,7 @@ CaptureFit fit_capture(const acq::Capture& cap, const CaptureFitRequest& req) {
   model::ModalSolver solver(tube);
   const auto cls = req.isotropic ? update::MaterialClass::isotropic()
                                  : update::MaterialClass::transversely_isotropic(nominal.d);
-  out.result = update::fit_output_error(solver, cls, model::isotropic_params(nominal.d), data, req.options);
+  out.result = update::fit_output_error(solver, cls, model::isotropic_params(nominal.d), data, opts);
   return out;
 }
 

@@ -23,6 +23,7 @@
 #include "model/tube_model.hpp"
 #include "update/least_squares.hpp"
 #include "update/port_fit.hpp"
+#include "ui/capture_fit.hpp"
 #include "update/rayleigh.hpp"
 #include "update/updater.hpp"
 
@@ -385,7 +386,7 @@ UpdateOutcome update_stage(const PipelineRequest& req, const acq::Capture& cap, 
   if (sim)
     for (const auto& [k, v] : sim->physics().truth()) truth[k] = v;
   auto row = [&](const char* name, const char* unit, double a, double b, double scale) {
-    ParamRow p{name, unit, a * scale, b * scale, std::nullopt};
+    ParamRow p{name, unit, a * scale, b * scale, std::nullopt, std::nullopt, std::nullopt, {}};
     if (truth.count(name)) p.truth = truth[name] * (std::string(name) == "epsT33_rel" ? 1.0 : scale);
     out.params.push_back(p);
   };
@@ -393,7 +394,8 @@ UpdateOutcome update_stage(const PipelineRequest& req, const acq::Capture& cap, 
   row("nu12", "-", p0.nu12, updated.nu12, 1.0);
   row("d31", "C/N", p0.d31, updated.d31, 1.0);
   out.params.push_back({"epsT33_rel", "-", p0.eps_t33 / model::kEps0, updated.eps_t33 / model::kEps0,
-                        truth.count("epsT33_rel") ? std::optional(truth["epsT33_rel"]) : std::nullopt});
+                        truth.count("epsT33_rel") ? std::optional(truth["epsT33_rel"]) : std::nullopt,
+                        std::nullopt, std::nullopt, {}});
 
   // Model curves on the measurement's grid: original and updated.
   const auto& grid = out.curves.front().f_hz;
@@ -406,6 +408,52 @@ UpdateOutcome update_stage(const PipelineRequest& req, const acq::Capture& cap, 
   u.damping = damping;
   if (!feat.resonances_hz.empty()) u.first_resonance_hz = feat.resonances_hz.front();
   return u;
+}
+
+// The output-error fit of the constants to the capture's samples, beside the
+// seed's chain (its numbers go into the parameter rows; the diagnosis still
+// starts from the seed's update).
+void output_error_stage(const PipelineRequest& req, const acq::Capture& cap, PipelineResult& out) {
+  CaptureFitRequest cr;
+  cr.material = req.material;
+  cr.isotropic = req.isotropic;
+  if (req.use_calibration) cr.fixture = out.fixture;
+  try {
+    const CaptureFit f = fit_capture(cap, cr);
+    const auto& r = f.result;
+    out.output_error = r;
+    int ok = 0;
+    for (const auto& p : r.parameters) ok += p.status == "ok";
+    char note[320];
+    std::snprintf(note, sizeof note,
+                  "output-error fit of %d shot(s) %s: chi2/dof %.3g (limit %.3g), %d of %zu constants ok, "
+                  "%d FE port models, %.2f s%s%s",
+                  r.shots_used, r.ok() ? "converged" : "did NOT converge", r.chi2_per_dof, r.chi2_limit, ok,
+                  r.parameters.size(), r.evaluations, r.seconds, r.message.empty() ? "" : ": ",
+                  r.message.c_str());
+    out.stages.push_back({"update (output-error)", r.ok(), note});
+    for (auto& row : out.params)
+      for (const auto& p : r.parameters)
+        if (p.name == row.name) {
+          row.oe = p.value;
+          row.oe_sigma = p.sigma;
+          row.oe_status = p.status;
+        }
+    if (out.params.empty())  // the seed's chain failed: the rows come from the fit alone
+      for (const auto& p : r.parameters)
+        if (p.name != "beta") {
+          ParamRow row{p.name, p.unit, p.nominal, NAN, std::nullopt, std::nullopt, std::nullopt, {}};
+          row.oe = p.value;
+          row.oe_sigma = p.sigma;
+          row.oe_status = p.status;
+          out.params.push_back(row);
+        }
+    if (r.lack_of_fit)
+      out.warnings.push_back("the output-error fit does not explain the capture (chi2/dof " +
+                             std::to_string(r.chi2_per_dof) + "): its constants are marked not identifiable");
+  } catch (const std::exception& e) {
+    out.stages.push_back({"update (output-error)", false, e.what()});
+  }
 }
 
 // Transient dut shots of one excitation kind (the fit's, or any other).
@@ -533,6 +581,9 @@ PipelineResult run_pipeline(const PipelineRequest& req, const std::function<void
   if (cancel) return out;
   progress(0.6, "update: extended CMCM");
   const UpdateOutcome u = update_stage(req, cap, z, sim.get(), out);
+  if (cancel) return out;
+  progress(0.65, "update: output-error fit");
+  output_error_stage(req, cap, out);
   if (cancel) return out;
   if (!req.diagnose) {
     out.stages.push_back({"diagnose", false, "not requested"});

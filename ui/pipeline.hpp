@@ -15,6 +15,7 @@
 #include "acquisition/sim_setup.hpp"
 #include "dsp/fixture_calibration.hpp"
 #include "update/gap_diagnosis.hpp"
+#include "update/output_error.hpp"
 
 namespace piezo::ui {
 
@@ -63,6 +64,10 @@ struct ParamRow {
   std::string name, unit;
   double original = 0, updated = 0;
   std::optional<double> truth;  // only when the bench is simulated (shown for the demo)
+  // The output-error fit of the same capture (update/output_error.hpp), beside
+  // the seed's chain: value, sigma and status.
+  std::optional<double> oe, oe_sigma;
+  std::string oe_status;
 };
 
 struct StageReport {
@@ -89,6 +94,7 @@ struct PipelineResult {
   std::vector<ParamRow> params;
   std::string verdict;
   std::optional<update::GapDiagnosis> diagnosis;
+  std::optional<update::OeResult> output_error;  // the output-error fit (issue 17), when it ran
   std::string heldout_path;  // the held-out capture, when there is one
   std::vector<StageReport> stages;
   std::vector<std::string> warnings;

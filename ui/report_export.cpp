@@ -55,6 +55,7 @@ nlohmann::json report_json(const PipelineResult& r) {
   for (const auto& p : r.params) {
     nlohmann::json row = {{"name", p.name}, {"unit", p.unit}, {"original", p.original}, {"updated", p.updated}};
     if (p.truth) row["true"] = *p.truth;
+    if (p.oe) row["output_error"] = {{"value", *p.oe}, {"sigma", p.oe_sigma.value_or(NAN)}, {"status", p.oe_status}};
     j["parameters"].push_back(row);
   }
   j["stages"] = nlohmann::json::array();

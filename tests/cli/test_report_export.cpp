@@ -15,7 +15,7 @@ TEST(ReportExport, CsvTouchstoneAndJson) {
   ui::PipelineResult r;
   r.capture_path = "x.h5";
   r.curves.push_back({"measured (Prony-SS)", {1000.0, 2000.0}, {{10.0, -20.0}, {5.0, -8.0}}});
-  r.params.push_back({"YE11", "Pa", 6.3e10, 6.66e10, 6.66e10});
+  r.params.push_back({"YE11", "Pa", 6.3e10, 6.66e10, 6.66e10, std::nullopt, std::nullopt, {}});
   r.stages.push_back({"update", true, "converged"});
   const auto dir = std::filesystem::temp_directory_path() / ("piezobench-export-" + std::to_string(::getpid()));
   std::filesystem::create_directories(dir);

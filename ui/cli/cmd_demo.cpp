@@ -81,15 +81,21 @@ void register_demo_command(CLI::App& app, Context& ctx) {
       for (const auto& s : res.stages)
         std::cout << "  " << (s.ran ? "[ran]     " : "[skipped] ") << s.name << ": " << s.note << "\n";
       if (!res.params.empty()) {
-        std::printf("\n  %-12s %14s %14s %14s %10s\n", "parameter", "original", "updated", "true (sim)",
-                    "error %");
+        std::printf("\n  %-12s %12s %12s %12s %8s %12s %8s %8s %s\n", "parameter", "original", "true (sim)",
+                    "cmcm", "error %", "oe", "sigma %", "error %", "oe status");
         for (const auto& p : res.params) {
-          char t[32] = "-", e[32] = "-";
+          char t[32] = "-", e[32] = "-", oe[32] = "-", os[32] = "-", oee[32] = "-";
           if (p.truth) {
             std::snprintf(t, sizeof t, "%.6g", *p.truth);
             std::snprintf(e, sizeof e, "%+.3f", 100.0 * (p.updated - *p.truth) / *p.truth);
           }
-          std::printf("  %-12s %14.6g %14.6g %14s %10s\n", p.name.c_str(), p.original, p.updated, t, e);
+          if (p.oe) {
+            std::snprintf(oe, sizeof oe, "%.6g", *p.oe);
+            std::snprintf(os, sizeof os, "%.3f", 100.0 * p.oe_sigma.value_or(NAN) / std::abs(*p.oe));
+            if (p.truth) std::snprintf(oee, sizeof oee, "%+.3f", 100.0 * (*p.oe - *p.truth) / *p.truth);
+          }
+          std::printf("  %-12s %12.6g %12s %12.6g %8s %12s %8s %8s %s\n", p.name.c_str(), p.original, t, p.updated,
+                      e, oe, os, oee, p.oe_status.c_str());
         }
       }
       if (res.diagnosis) print_diagnosis(std::cout, *res.diagnosis);
