@@ -65,4 +65,20 @@ std::optional<WindowKind> parse_window(std::string_view s) {
   return std::nullopt;
 }
 
+Eigen::VectorXd blackman_lowpass(double fs, double fc) {
+  constexpr double kTwoPi = 2.0 * M_PI;
+  const auto taps = static_cast<Eigen::Index>(2 * std::ceil(5.5 * fs / fc) + 1);
+  const double f = fc / fs;
+  const double mid = double(taps - 1) / 2.0;
+  Eigen::VectorXd h(taps);
+  for (Eigen::Index k = 0; k < taps; ++k) {
+    const double t = double(k) - mid;
+    const double sinc = t == 0.0 ? 2.0 * f : std::sin(kTwoPi * f * t) / (M_PI * t);
+    const double w = 0.42 - 0.5 * std::cos(kTwoPi * double(k) / double(taps - 1)) +
+                     0.08 * std::cos(2.0 * kTwoPi * double(k) / double(taps - 1));
+    h[k] = sinc * w;
+  }
+  return h / h.sum();
+}
+
 }  // namespace piezo::dsp

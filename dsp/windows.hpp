@@ -19,6 +19,10 @@ struct Window {
 // Symmetric-in-DFT-sense ("periodic") window of length n.
 Eigen::VectorXd make_window(const Window& w, Eigen::Index n);
 
+// Causal low-pass FIR: Blackman-windowed sinc at cutoff fc (Hz) for rate fs,
+// 2·ceil(5.5·fs/fc) + 1 taps, unit DC gain (the output-error fits' filter).
+Eigen::VectorXd blackman_lowpass(double fs, double fc);
+
 std::string_view to_string(WindowKind k);
 std::optional<WindowKind> parse_window(std::string_view s);
 

@@ -9,6 +9,19 @@
 
 namespace piezo::ui {
 
+CaptureModel capture_model(const acq::Capture& cap, const std::string& material, bool isotropic) {
+  CaptureModel m;
+  m.nominal = model::resolve_material({material, isotropic, ""});
+  model::TubeGeometry g = cap.setup.geometry();
+  if (!cap.setup.density_kg_m3) g.density_kg_m3 = m.nominal.density_kg_m3;
+  m.tube = std::make_unique<model::TubeModel>(g);
+  m.solver = std::make_unique<model::ModalSolver>(*m.tube);
+  m.cls = isotropic ? update::MaterialClass::isotropic()
+                    : update::MaterialClass::transversely_isotropic(m.nominal.d);
+  m.p0 = model::isotropic_params(m.nominal.d);
+  return m;
+}
+
 CaptureFit fit_capture(const acq::Capture& cap, const CaptureFitRequest& req) {
   // The dut transient shots of the first one's drive.
   const acq::Shot* first = nullptr;
@@ -19,8 +32,7 @@ CaptureFit fit_capture(const acq::Capture& cap, const CaptureFitRequest& req) {
     }
   if (!first) throw std::invalid_argument("the capture holds no dut transient shot to fit");
   CaptureFit out;
-  update::OeOptions opts_value = req.options;
-  const update::OeOptions& opts = opts_value;
+  update::OeOptions opts = req.options;
   out.excitation = std::string(acq::to_string(first->excitation));
   update::OeData data;
   data.sample_rate_hz = first->sample_rate_hz;
@@ -39,19 +51,13 @@ CaptureFit fit_capture(const acq::Capture& cap, const CaptureFitRequest& req) {
     data.circuit.r_lead_ohm = std::max(0.0, fx.lead_resistance_ohm.value_or(0.0));
     data.v2_delay_s = fx.skew_s.value_or(0.0);
     // Measured: their sigmas replace the stated tolerances.
-    auto& o = const_cast<update::OeOptions&>(opts);
+    auto& o = opts;
     if (fx.r1_error) o.r1_rel_sigma = fx.r1_error_sigma.value_or(o.r1_rel_sigma);
     if (fx.fixture_capacitance_f) o.cp_sigma_f = fx.fixture_capacitance_sigma_f.value_or(o.cp_sigma_f);
     if (fx.skew_s) o.skew_sigma_s = fx.skew_sigma_s.value_or(o.skew_sigma_s);
   }
-  const auto nominal = model::resolve_material({req.material, req.isotropic, ""});
-  model::TubeGeometry g = cap.setup.geometry();
-  if (!cap.setup.density_kg_m3) g.density_kg_m3 = nominal.density_kg_m3;
-  model::TubeModel tube(g);
-  model::ModalSolver solver(tube);
-  const auto cls = req.isotropic ? update::MaterialClass::isotropic()
-                                 : update::MaterialClass::transversely_isotropic(nominal.d);
-  out.result = update::fit_output_error(solver, cls, model::isotropic_params(nominal.d), data, opts);
+  const CaptureModel m = capture_model(cap, req.material, req.isotropic);
+  out.result = update::fit_output_error(*m.solver, m.cls, m.p0, data, opts);
   return out;
 }
 

@@ -3,14 +3,29 @@
 // transient shots of one drive, R1 and geometry from /setup, the nominal
 // material of the model class — what `piezobench update CAP.h5 --method oe`,
 // the pipeline and replay run.
+#include <memory>
 #include <optional>
 #include <string>
 
 #include "acquisition/capture.hpp"
 #include "dsp/fixture_calibration.hpp"
+#include "model/material_spec.hpp"
+#include "model/modal.hpp"
+#include "model/tube_model.hpp"
 #include "update/output_error.hpp"
 
 namespace piezo::ui {
+
+// The tube model of a capture: /setup's geometry (the material's density when
+// the capture states none), the nominal material and the model class.
+struct CaptureModel {
+  model::ResolvedMaterial nominal;
+  std::unique_ptr<model::TubeModel> tube;
+  std::unique_ptr<model::ModalSolver> solver;  // of *tube
+  update::MaterialClass cls;
+  update::TubeParams p0;  // the nominal material's four constants
+};
+CaptureModel capture_model(const acq::Capture& cap, const std::string& material, bool isotropic);
 
 struct CaptureFitRequest {
   std::string material = "apc850";

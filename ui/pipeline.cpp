@@ -339,14 +339,11 @@ UpdateOutcome update_stage(const PipelineRequest& req, const acq::Capture& cap, 
   feat.low_z_ohm = 1.0 / (2 * M_PI * feat.low_z_hz * z.features.capacitance_f);
   feat.validate();
 
-  auto nominal = model::resolve_material({req.material, req.isotropic, ""});
-  model::TubeGeometry g = cap.setup.geometry();
-  if (!cap.setup.density_kg_m3) g.density_kg_m3 = nominal.density_kg_m3;
-  model::TubeModel tube(g);
-  model::ModalSolver solver(tube);
-  const auto cls = req.isotropic ? update::MaterialClass::isotropic()
-                                 : update::MaterialClass::transversely_isotropic(nominal.d);
-  const update::TubeParams p0 = model::isotropic_params(nominal.d);
+  const CaptureModel cm = capture_model(cap, req.material, req.isotropic);
+  const model::TubeModel& tube = *cm.tube;
+  model::ModalSolver& solver = *cm.solver;
+  const auto& cls = cm.cls;
+  const update::TubeParams& p0 = cm.p0;
   update::UpdateOptions uo;
   // Measured features are not exactly reachable by the model (noise, three
   // resonances for two stiffnesses), so the outer sweeps settle to a
@@ -535,18 +532,14 @@ void diagnose_stage(const PipelineRequest& req, const acq::Capture& cap, const a
   if (ho_shots.size() >= 3) ho = gap_data(*ho_cap, ho_shots, req.gap_floor, ho_what);
   else out.warnings.push_back("gap diagnosis without held-out data (fewer than 3 other shots)");
 
-  auto nominal = model::resolve_material({req.material, req.isotropic, ""});
-  model::TubeGeometry g = cap.setup.geometry();
-  if (!cap.setup.density_kg_m3) g.density_kg_m3 = nominal.density_kg_m3;
-  model::TubeModel tube(g);
-  model::ModalSolver solver(tube);
-  const auto cls = req.isotropic ? update::MaterialClass::isotropic()
-                                 : update::MaterialClass::transversely_isotropic(nominal.d);
+  const CaptureModel cm = capture_model(cap, req.material, req.isotropic);
+  model::ModalSolver& solver = *cm.solver;
+  const auto& cls = cm.cls;
   update::GapOptions go;
   go.candidates = req.gap_candidates;
   if (out.fixture) go.measured = measured_effects(*out.fixture, out.fixture_model);
   go.damping_ref_hz = u.first_resonance_hz;
-  go.other_starts = {model::isotropic_params(nominal.d)};  // where the update started
+  go.other_starts = {cm.p0};  // where the update started
   auto d = update::diagnose_gap(
       solver, cls, u.updated, u.damping, cap.setup.divider_r1_ohm, fit, ho ? &*ho : nullptr, go,
       [&](double f, const std::string& s) { progress(0.7 + 0.29 * f, s); }, &cancel);

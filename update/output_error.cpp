@@ -11,6 +11,7 @@
 
 #include "dsp/fft.hpp"
 #include "dsp/prony_ss.hpp"
+#include "dsp/windows.hpp"
 
 namespace piezo::update {
 
@@ -22,23 +23,6 @@ constexpr int kParams = 5;  // ln YE11, nu12 (relative), ln d31, ln εT33, ln β
 
 [[noreturn]] void fail(const std::string& msg) {
   throw std::invalid_argument("fit_output_error: " + msg);
-}
-
-// Causal low-pass FIR (Blackman-windowed sinc, cutoff fc, unit DC gain), the
-// filter update/port_fit.cpp applies to its output error.
-Eigen::VectorXd lowpass_taps(double fs, double fc) {
-  const auto taps = static_cast<Eigen::Index>(2 * std::ceil(5.5 * fs / fc) + 1);
-  const double f = fc / fs;
-  const double mid = double(taps - 1) / 2.0;
-  Eigen::VectorXd h(taps);
-  for (Eigen::Index k = 0; k < taps; ++k) {
-    const double t = double(k) - mid;
-    const double sinc = t == 0.0 ? 2.0 * f : std::sin(kTwoPi * f * t) / (M_PI * t);
-    const double w = 0.42 - 0.5 * std::cos(kTwoPi * double(k) / double(taps - 1)) +
-                     0.08 * std::cos(2.0 * kTwoPi * double(k) / double(taps - 1));
-    h[k] = sinc * w;
-  }
-  return h / h.sum();
 }
 
 // The parameter vector θ relative to the nominal constants.
@@ -129,7 +113,7 @@ class Problem {
       : solver_(solver), cls_(cls), co_(co), circuit_(data.circuit), modal_(modal),
         fs_(data.sample_rate_hz), delay_(data.v2_delay_s), n_(rec.v1.size()),
         nfft_(dsp::good_fft_size(std::max<std::size_t>(4 * n_, 1u << 14))), fft_(nfft_) {
-    const Eigen::VectorXd h = lowpass_taps(fs_, band_hz);
+    const Eigen::VectorXd h = dsp::blackman_lowpass(fs_, band_hz);
     if (static_cast<std::size_t>(h.size()) > nfft_ - n_) fail("record too short for the band");
     kmax_ = std::min<std::size_t>(fft_.bins() - 1,
                                   static_cast<std::size_t>(std::ceil(2.5 * band_hz * double(nfft_) / fs_)));

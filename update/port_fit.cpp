@@ -7,6 +7,7 @@
 #include <optional>
 #include <stdexcept>
 
+#include "dsp/windows.hpp"
 #include "model/transient.hpp"
 
 namespace piezo::update {
@@ -68,19 +69,7 @@ std::optional<Eigen::VectorXd> ratios_from_antiresonances(const std::vector<doub
 // evaluated at every d-th sample of x (x = 0 before its first sample).
 class LowpassDecimator {
  public:
-  LowpassDecimator(double fs, double fc) {
-    const auto taps = static_cast<Eigen::Index>(2 * std::ceil(5.5 * fs / fc) + 1);
-    const double f = fc / fs;
-    const double mid = double(taps - 1) / 2.0;
-    h_.resize(taps);
-    for (Eigen::Index k = 0; k < taps; ++k) {
-      const double t = double(k) - mid;
-      const double sinc = t == 0.0 ? 2.0 * f : std::sin(kTwoPi * f * t) / (M_PI * t);
-      const double w = 0.42 - 0.5 * std::cos(kTwoPi * double(k) / double(taps - 1)) +
-                       0.08 * std::cos(2.0 * kTwoPi * double(k) / double(taps - 1));
-      h_[k] = sinc * w;
-    }
-    h_ /= h_.sum();
+  LowpassDecimator(double fs, double fc) : h_(dsp::blackman_lowpass(fs, fc)) {
     // Output every d-th sample, d = fs/(2 fc): the filtered error is then
     // sampled at about its own bandwidth, nearly white (for the covariance).
     d_ = std::max<Eigen::Index>(1, static_cast<Eigen::Index>(fs / (2.0 * fc)));

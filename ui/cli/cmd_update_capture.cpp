@@ -111,14 +111,11 @@ nlohmann::json feature_methods(const acq::Capture& cap, const std::string& mater
                                 {"antiresonances_hz", mf.antiresonances_hz},
                                 {"low_z_ohm", mf.low_z_ohm},
                                 {"low_z_hz", mf.low_z_hz}};
-  const auto nominal = pm::resolve_material({material, isotropic, ""});
-  pm::TubeGeometry g = cap.setup.geometry();
-  if (!cap.setup.density_kg_m3) g.density_kg_m3 = nominal.density_kg_m3;
-  pm::TubeModel tube(g);
-  pm::ModalSolver solver(tube);
-  const auto cls = isotropic ? pu::MaterialClass::isotropic()
-                             : pu::MaterialClass::transversely_isotropic(nominal.d);
-  const auto p0 = pm::isotropic_params(nominal.d);
+  const ui::CaptureModel m = ui::capture_model(cap, material, isotropic);
+  const pm::TubeModel& tube = *m.tube;
+  pm::ModalSolver& solver = *m.solver;
+  const auto& cls = m.cls;
+  const auto& p0 = m.p0;
   if (cmcm) {
     pu::UpdateOptions uo;
     uo.max_sweeps = 40;
@@ -149,13 +146,12 @@ void run_update_capture(Context& ctx, const std::string& file, const std::string
   ui::CaptureFitRequest req;
   req.material = material;
   req.isotropic = isotropic;
-  (void)pm::resolve_material({material, isotropic, ""});  // an unknown material: exit 2
-
   nlohmann::json out;
   out["capture"] = file;
   out["method"] = method;
   out["model_class"] = isotropic ? "isotropic" : "transversely_isotropic";
   out["material"] = material;
+  // (an unknown material throws here: exit 2)
   out["original"] = params_of(pm::isotropic_params(pm::resolve_material({material, isotropic, ""}).d));
   nlohmann::json methods;
   if (method == "oe" || method == "all") {
