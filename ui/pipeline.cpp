@@ -321,96 +321,88 @@ std::vector<std::complex<double>> model_z(model::ModalSolver& solver, const mode
 
 struct UpdateOutcome {
   bool ok = false;
+  std::string method;  // "output-error" | "cmcm" | "lm"
   update::TubeParams updated;
   model::RayleighDamping damping;
   double first_resonance_hz = 50e3;
 };
 
-UpdateOutcome update_stage(const PipelineRequest& req, const acq::Capture& cap, const dsp::ImpedanceResult& z,
-                  const drivers::sim::SimBench* sim, PipelineResult& out) {
-  update::MeasuredFeatures feat;
-  feat.resonances_hz = out.resonances_hz;
-  feat.antiresonances_hz = out.antiresonances_hz;
-  if (feat.resonances_hz.size() > 3) feat.resonances_hz.resize(3);
-  if (feat.antiresonances_hz.size() > 3) feat.antiresonances_hz.resize(3);
-  if (!(z.features.capacitance_f > 0))
-    throw std::runtime_error("update: the estimate has no low-frequency capacitance");
-  feat.low_z_hz = 400.0;  // the seed's low-frequency point (Table 4/5)
-  feat.low_z_ohm = 1.0 / (2 * M_PI * feat.low_z_hz * z.features.capacitance_f);
-  feat.validate();
+// The seed's chain (chapter 6-7): extended CMCM on the estimate's features,
+// least squares (LM) on the same features where CMCM does not converge (or
+// beside it, `req.compare_lm`). Never throws: its failure is a stage note.
+struct SeedUpdate {
+  UpdateOutcome chosen;                     // CMCM's, else LM's
+  std::optional<update::TubeParams> cmcm, lm;
+};
 
-  const CaptureModel cm = capture_model(cap, req.material, req.isotropic);
-  const model::TubeModel& tube = *cm.tube;
-  model::ModalSolver& solver = *cm.solver;
-  const auto& cls = cm.cls;
-  const update::TubeParams& p0 = cm.p0;
-  update::UpdateOptions uo;
-  // Measured features are not exactly reachable by the model (noise, three
-  // resonances for two stiffnesses), so the outer sweeps settle to a
-  // least-squares point more slowly than on exact data: allow more sweeps and
-  // stop at 1e-6 relative change (far below the features' uncertainty).
-  uo.max_sweeps = 40;
-  uo.sweep_tolerance = 1e-6;
-  auto r = update::update_cmcm(tube, solver, cls, p0, feat, uo);
-  char note[480];
-  std::snprintf(note, sizeof note, "extended CMCM %s: %d elastic + %d piezo iterations in %d sweeps, %.2f s%s",
-                r.ok() ? "converged" : "did NOT converge", r.iterations_elastic, r.iterations_piezo, r.sweeps,
-                r.seconds, r.ok() ? "" : (": " + r.message).c_str());
-  update::TubeParams updated = r.updated;
-  bool ok = r.ok();
-  if (!ok) {
-    // Second, independent updater on the same features (update/least_squares.hpp):
-    // no mode-shape pairing, so a start far from the answer (mode veering, an
-    // ambiguous MAC) does not stop it. Its answer is checked like CMCM's.
-    const auto lm = update::update_lm(tube, solver, cls, p0, feat);
-    char lm_note[240];
-    std::snprintf(lm_note, sizeof lm_note, "; least squares (LM) %s in %d iterations, %.2f s%s",
-                  lm.ok() ? "converged" : "did NOT converge", lm.iterations, lm.seconds,
-                  lm.ok() ? " - its result is used" : (": " + lm.message).c_str());
-    std::strncat(note, lm_note, sizeof note - std::strlen(note) - 1);
-    if (lm.ok()) {
-      updated = lm.updated;
-      ok = true;
-      out.warnings.push_back("CMCM did not converge (" + r.message + "); the least-squares update was used");
+SeedUpdate seed_update_stage(const PipelineRequest& req, const acq::Capture& cap, const dsp::ImpedanceResult& z,
+                             PipelineResult& out) {
+  SeedUpdate s;
+  try {
+    update::MeasuredFeatures feat;
+    feat.resonances_hz = out.resonances_hz;
+    feat.antiresonances_hz = out.antiresonances_hz;
+    if (feat.resonances_hz.size() > 3) feat.resonances_hz.resize(3);
+    if (feat.antiresonances_hz.size() > 3) feat.antiresonances_hz.resize(3);
+    if (!(z.features.capacitance_f > 0))
+      throw std::runtime_error("the estimate has no low-frequency capacitance");
+    feat.low_z_hz = 400.0;  // the seed's low-frequency point (Table 4/5)
+    feat.low_z_ohm = 1.0 / (2 * M_PI * feat.low_z_hz * z.features.capacitance_f);
+    feat.validate();
+
+    const CaptureModel cm = capture_model(cap, req.material, req.isotropic);
+    update::UpdateOptions uo;
+    // Measured features are not exactly reachable by the model (noise, three
+    // resonances for two stiffnesses), so the outer sweeps settle to a
+    // least-squares point more slowly than on exact data: allow more sweeps and
+    // stop at 1e-6 relative change (far below the features' uncertainty).
+    uo.max_sweeps = 40;
+    uo.sweep_tolerance = 1e-6;
+    const auto r = update::update_cmcm(*cm.tube, *cm.solver, cm.cls, cm.p0, feat, uo);
+    std::string note;
+    {
+      char buf[200];
+      std::snprintf(buf, sizeof buf, "extended CMCM %s: %d elastic + %d piezo iterations in %d sweeps, %.2f s",
+                    r.ok() ? "converged" : "did NOT converge", r.iterations_elastic, r.iterations_piezo,
+                    r.sweeps, r.seconds);
+      note = buf;
+      if (!r.ok()) note += ": " + r.message;
     }
+    if (r.ok()) {
+      s.cmcm = r.updated;
+      s.chosen = {true, "cmcm", r.updated, {}, 50e3};
+    }
+    if (!r.ok() || req.compare_lm) {
+      // Second, independent updater on the same features (update/least_squares.hpp):
+      // no mode-shape pairing, so a start far from the answer (mode veering, an
+      // ambiguous MAC) does not stop it.
+      try {
+        const auto lm = update::update_lm(*cm.tube, *cm.solver, cm.cls, cm.p0, feat);
+        char buf[200];
+        std::snprintf(buf, sizeof buf, "; least squares (LM) on the same features %s in %d iterations, %.2f s",
+                      lm.ok() ? "converged" : "did NOT converge", lm.iterations, lm.seconds);
+        note += buf;
+        if (!lm.ok()) note += ": " + lm.message;
+        if (lm.ok()) {
+          s.lm = lm.updated;
+          if (!s.chosen.ok) s.chosen = {true, "lm", lm.updated, {}, 50e3};
+        }
+      } catch (const std::exception& e) {
+        note += std::string("; least squares (LM) refused: ") + e.what();
+      }
+    }
+    if (!feat.resonances_hz.empty()) s.chosen.first_resonance_hz = feat.resonances_hz.front();
+    out.stages.push_back({"update (CMCM)", s.chosen.ok, note});
+  } catch (const std::exception& e) {
+    out.stages.push_back({"update (CMCM)", false, std::string("the seed's chain could not run: ") + e.what()});
   }
-  out.stages.push_back({"update", ok, note});
-  if (!ok) {
-    out.warnings.push_back("model update did not converge: " + r.message);
-    return {};
-  }
-  std::map<std::string, double> truth;
-  if (sim)
-    for (const auto& [k, v] : sim->physics().truth()) truth[k] = v;
-  auto row = [&](const char* name, const char* unit, double a, double b, double scale) {
-    ParamRow p{name, unit, a * scale, b * scale, std::nullopt, std::nullopt, std::nullopt, {}};
-    if (truth.count(name)) p.truth = truth[name] * (std::string(name) == "epsT33_rel" ? 1.0 : scale);
-    out.params.push_back(p);
-  };
-  row("YE11", "Pa", p0.y_e11, updated.y_e11, 1.0);
-  row("nu12", "-", p0.nu12, updated.nu12, 1.0);
-  row("d31", "C/N", p0.d31, updated.d31, 1.0);
-  out.params.push_back({"epsT33_rel", "-", p0.eps_t33 / model::kEps0, updated.eps_t33 / model::kEps0,
-                        truth.count("epsT33_rel") ? std::optional(truth["epsT33_rel"]) : std::nullopt,
-                        std::nullopt, std::nullopt, {}});
-
-  // Model curves on the measurement's grid: original and updated.
-  const auto& grid = out.curves.front().f_hz;
-  const auto damping = damping_from_features(z, out);
-  out.curves.push_back({"original model", grid, model_z(solver, cls.e_form(p0), grid, damping)});
-  out.curves.push_back({"updated model", grid, model_z(solver, cls.e_form(updated), grid, damping)});
-  UpdateOutcome u;
-  u.ok = true;
-  u.updated = updated;
-  u.damping = damping;
-  if (!feat.resonances_hz.empty()) u.first_resonance_hz = feat.resonances_hz.front();
-  return u;
+  return s;
 }
 
-// The output-error fit of the constants to the capture's samples, beside the
-// seed's chain (its numbers go into the parameter rows; the diagnosis still
-// starts from the seed's update).
-void output_error_stage(const PipelineRequest& req, const acq::Capture& cap, PipelineResult& out) {
+// The output-error fit of the constants and Rayleigh β to the capture's
+// samples (update/output_error.hpp): the pipeline's update. Never throws.
+std::optional<update::OeResult> output_error_stage(const PipelineRequest& req, const acq::Capture& cap,
+                                                   PipelineResult& out) {
   CaptureFitRequest cr;
   cr.material = req.material;
   cr.isotropic = req.isotropic;
@@ -418,7 +410,6 @@ void output_error_stage(const PipelineRequest& req, const acq::Capture& cap, Pip
   try {
     const CaptureFit f = fit_capture(cap, cr);
     const auto& r = f.result;
-    out.output_error = r;
     int ok = 0;
     for (const auto& p : r.parameters) ok += p.status == "ok";
     char note[320];
@@ -429,27 +420,72 @@ void output_error_stage(const PipelineRequest& req, const acq::Capture& cap, Pip
                   r.parameters.size(), r.evaluations, r.seconds, r.message.empty() ? "" : ": ",
                   r.message.c_str());
     out.stages.push_back({"update (output-error)", r.ok(), note});
-    for (auto& row : out.params)
-      for (const auto& p : r.parameters)
-        if (p.name == row.name) {
-          row.oe = p.value;
-          row.oe_sigma = p.sigma;
-          row.oe_status = p.status;
-        }
-    if (out.params.empty())  // the seed's chain failed: the rows come from the fit alone
-      for (const auto& p : r.parameters)
-        if (p.name != "beta") {
-          ParamRow row{p.name, p.unit, p.nominal, NAN, std::nullopt, std::nullopt, std::nullopt, {}};
-          row.oe = p.value;
-          row.oe_sigma = p.sigma;
-          row.oe_status = p.status;
-          out.params.push_back(row);
-        }
-    if (r.lack_of_fit)
+    if (r.ok() && r.lack_of_fit)
       out.warnings.push_back("the output-error fit does not explain the capture (chi2/dof " +
-                             std::to_string(r.chi2_per_dof) + "): its constants are marked not identifiable");
+                             std::to_string(r.chi2_per_dof) +
+                             "): its constants are marked not identifiable; the gap diagnosis looks for the cause");
+    out.output_error = r;
+    out.output_error_excitation = f.excitation;
+    return r;
   } catch (const std::exception& e) {
     out.stages.push_back({"update (output-error)", false, e.what()});
+    return std::nullopt;
+  }
+}
+
+// The first electrically active short-circuit mode of the model (the
+// diagnosis' damping reference when the estimate found no resonance).
+double first_active_mode_hz(model::ModalSolver& solver, const model::PiezoMaterialE& m) {
+  model::ModalOptions mo;
+  mo.n_modes = 12;
+  const auto port = solver.port_model(m, mo);
+  double wmax = 0;
+  for (const auto& md : port.modes)
+    if (!md.residual && md.omega > 0) wmax = std::max(wmax, md.participation * md.participation / (md.omega * md.omega));
+  for (const auto& md : port.modes)
+    if (!md.residual && md.omega > 0 && md.participation * md.participation / (md.omega * md.omega) >= 0.05 * wmax)
+      return md.omega / (2 * M_PI);
+  return 50e3;
+}
+
+// The parameter rows: the pipeline's update beside the seed's chain and the
+// output-error fit; the simulated bench's truth for the demo only.
+void parameter_rows(const update::TubeParams& p0, const UpdateOutcome& u, const SeedUpdate& seed,
+                    const std::optional<update::OeResult>& oe, const drivers::sim::SimBench* sim,
+                    PipelineResult& out) {
+  std::map<std::string, double> truth;
+  if (sim)
+    for (const auto& [k, v] : sim->physics().truth()) truth[k] = v;
+  auto value = [](const update::TubeParams& t, const std::string& n) {
+    if (n == "YE11") return t.y_e11;
+    if (n == "nu12") return t.nu12;
+    if (n == "d31") return t.d31;
+    return t.eps_t33 / model::kEps0;
+  };
+  for (const std::string n : {"YE11", "nu12", "d31", "epsT33_rel"}) {
+    ParamRow row;
+    row.name = n;
+    row.unit = n == "YE11" ? "Pa" : n == "d31" ? "C/N" : "-";
+    row.original = value(p0, n);
+    row.updated = u.ok ? value(u.updated, n) : NAN;
+    if (truth.count(n)) row.truth = truth[n];
+    if (seed.cmcm) row.cmcm = value(*seed.cmcm, n);
+    else if (seed.chosen.ok) row.cmcm = value(seed.chosen.updated, n);  // the seed's chain ended in LM
+    if (seed.lm) row.lm = value(*seed.lm, n);
+    if (oe)
+      for (const auto& p : oe->parameters)
+        if (p.name == n) {
+          row.oe = p.value;
+          row.oe_sigma = p.sigma;
+          row.oe_status = p.status;
+        }
+    if (u.method == "output-error") {
+      row.sigma = row.oe_sigma;
+      row.status = row.oe_status;
+    } else if (u.ok) {
+      row.status = "ok (seed's chain, no sigma)";
+    }
+    out.params.push_back(row);
   }
 }
 
@@ -563,25 +599,76 @@ PipelineResult run_pipeline(const PipelineRequest& req, const std::function<void
   if (cancel) return out;
   if (req.use_calibration) calibrate_stage(cap, out);
   progress(0.45, "estimate: Prony-SS");
-  auto z = estimate(cap, out);
-  {
+  // The estimate (Prony-SS features, FFT and cross-spectra overlays) feeds the
+  // seed's chain and the plots; the output-error fit does not need it, so its
+  // failure on a capture stops neither.
+  std::optional<dsp::ImpedanceResult> z;
+  try {
+    z = estimate(cap, out);
     char note[160];
     std::snprintf(note, sizeof note, "Prony-SS order %d on %zu samples (%d shot(s) averaged): %zu resonances, %zu anti-resonances, C = %.4g F",
-                  out.order, z.samples_used, out.shots_averaged, out.resonances_hz.size(), out.antiresonances_hz.size(),
-                  z.features.capacitance_f);
+                  out.order, z->samples_used, out.shots_averaged, out.resonances_hz.size(), out.antiresonances_hz.size(),
+                  z->features.capacitance_f);
     out.stages.push_back({"estimate", true, note});
+  } catch (const std::exception& e) {
+    out.stages.push_back({"estimate", false, std::string("failed: ") + e.what()});
+    out.warnings.push_back(std::string("the impedance estimate failed (") + e.what() +
+                           "); the output-error fit runs on the samples alone");
   }
   if (cancel) return out;
-  progress(0.6, "update: extended CMCM");
-  const UpdateOutcome u = update_stage(req, cap, z, sim.get(), out);
+  progress(0.55, "update: extended CMCM (the seed's chain)");
+  SeedUpdate seed;
+  if (z) seed = seed_update_stage(req, cap, *z, out);
+  else out.stages.push_back({"update (CMCM)", false, "needs the impedance estimate"});
   if (cancel) return out;
-  progress(0.65, "update: output-error fit");
-  output_error_stage(req, cap, out);
+  progress(0.62, "update: output-error fit");
+  const auto oe = output_error_stage(req, cap, out);
   if (cancel) return out;
+
+  // The pipeline's update: the output-error fit where it converged (its
+  // constants carry sigma and status), else the seed's chain.
+  UpdateOutcome u;
+  const CaptureModel cm = capture_model(cap, req.material, req.isotropic);
+  if (oe && oe->ok()) {
+    u = {true, "output-error", oe->updated, oe->damping, 50e3};
+    if (!out.resonances_hz.empty()) u.first_resonance_hz = out.resonances_hz.front();
+    else u.first_resonance_hz = first_active_mode_hz(*cm.solver, cm.cls.e_form(oe->updated));
+  } else if (seed.chosen.ok) {
+    u = seed.chosen;
+    u.damping = damping_from_features(*z, out);
+    out.warnings.push_back(std::string("the output-error fit did not converge: the seed's chain (") +
+                           (u.method == "cmcm" ? "extended CMCM" : "least squares on features") +
+                           ") is used, without sigma");
+  }
+  out.update_method = u.ok ? u.method : "";
+  {
+    std::string note;
+    if (u.ok) {
+      note = u.method == "output-error" ? "the output-error fit's constants and beta (with sigma)"
+                                        : u.method == "cmcm" ? "the seed's extended CMCM (no sigma)"
+                                                             : "least squares (LM) on the seed's features (no sigma)";
+      if (u.method == "output-error" && oe->lack_of_fit) note += "; the model class does not explain the capture";
+    } else {
+      note = "neither the output-error fit nor the seed's chain converged";
+    }
+    out.stages.push_back({"update", u.ok, note});
+  }
+  parameter_rows(cm.p0, u, seed, oe, sim.get(), out);
+  if (!u.ok) {
+    out.warnings.push_back("no model update: see the update stages");
+    throw std::runtime_error("update: neither the output-error fit nor the seed's chain converged (" +
+                             (out.stages.end()[-2].note) + "; " + out.stages.end()[-3].note + ")");
+  }
+  {  // Model curves on the measurement's grid (or a plain one): original and updated.
+    std::vector<double> grid;
+    if (!out.curves.empty()) grid = out.curves.front().f_hz;
+    else
+      for (double f = 100.0; f <= 120e3; f += 100.0) grid.push_back(f);
+    out.curves.push_back({"original model", grid, model_z(*cm.solver, cm.cls.e_form(cm.p0), grid, u.damping)});
+    out.curves.push_back({"updated model", grid, model_z(*cm.solver, cm.cls.e_form(u.updated), grid, u.damping)});
+  }
   if (!req.diagnose) {
     out.stages.push_back({"diagnose", false, "not requested"});
-  } else if (!u.ok) {
-    out.stages.push_back({"diagnose", false, "needs a converged update"});
   } else {
     std::optional<acq::Capture> heldout;
     if (!req.heldout_capture.empty()) {

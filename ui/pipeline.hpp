@@ -52,6 +52,9 @@ struct PipelineRequest {
   acq::TechnicianPrompt prompt;
   // Use the capture's calibration shots (fixture measured, see PipelineResult::fixture).
   bool use_calibration = true;
+  // Also run least squares (LM) on the seed's features beside extended CMCM
+  // (the demo's comparison table); otherwise LM runs only where CMCM fails.
+  bool compare_lm = false;
 };
 
 struct Curve {
@@ -62,10 +65,17 @@ struct Curve {
 
 struct ParamRow {
   std::string name, unit;
+  // `updated` is the pipeline's update (PipelineResult::update_method: the
+  // output-error fit, or the seed's chain where that did not converge), with
+  // its sigma and status when it has them.
   double original = 0, updated = 0;
+  std::optional<double> sigma;
+  std::string status;           // "ok" | "not identifiable" (output-error); "ok (no sigma)" for the seed's chain
   std::optional<double> truth;  // only when the bench is simulated (shown for the demo)
-  // The output-error fit of the same capture (update/output_error.hpp), beside
-  // the seed's chain: value, sigma and status.
+  // Side by side: the seed's extended CMCM (or its LM fallback) on the
+  // features, least squares (LM) on the same features when asked for, and the
+  // output-error fit of the capture (update/output_error.hpp) with sigma and status.
+  std::optional<double> cmcm, lm;
   std::optional<double> oe, oe_sigma;
   std::string oe_status;
 };
@@ -92,9 +102,11 @@ struct PipelineResult {
   std::vector<double> singular_values;  // normalised, for the order plot
   int order = 0;
   std::vector<ParamRow> params;
+  std::string update_method;  // "output-error" | "cmcm" | "lm": whose constants `updated` holds
   std::string verdict;
   std::optional<update::GapDiagnosis> diagnosis;
   std::optional<update::OeResult> output_error;  // the output-error fit (issue 17), when it ran
+  std::string output_error_excitation;          // the drive of the shots it fitted
   std::string heldout_path;  // the held-out capture, when there is one
   std::vector<StageReport> stages;
   std::vector<std::string> warnings;

@@ -1,4 +1,5 @@
 #include "ui/report_export.hpp"
+#include "ui/output_error_json.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -51,10 +52,15 @@ nlohmann::json report_json(const PipelineResult& r) {
   j["resonances_hz"] = r.resonances_hz;
   j["antiresonances_hz"] = r.antiresonances_hz;
   j["order"] = r.order;
+  j["update_method"] = r.update_method;
   j["parameters"] = nlohmann::json::array();
   for (const auto& p : r.params) {
     nlohmann::json row = {{"name", p.name}, {"unit", p.unit}, {"original", p.original}, {"updated", p.updated}};
+    if (p.sigma) row["sigma"] = *p.sigma;
+    if (!p.status.empty()) row["status"] = p.status;
     if (p.truth) row["true"] = *p.truth;
+    if (p.cmcm) row["cmcm"] = *p.cmcm;
+    if (p.lm) row["lm"] = *p.lm;
     if (p.oe) row["output_error"] = {{"value", *p.oe}, {"sigma", p.oe_sigma.value_or(NAN)}, {"status", p.oe_status}};
     j["parameters"].push_back(row);
   }
@@ -70,6 +76,7 @@ nlohmann::json report_json(const PipelineResult& r) {
                     {"r1_error", o(f.r1_error)},
                     {"skew_s", o(f.skew_s)}};
   }
+  if (r.output_error) j["output_error"] = output_error_json(*r.output_error, r.output_error_excitation);
   if (r.diagnosis) j["diagnosis"] = diagnosis_json(*r.diagnosis);
   j["warnings"] = r.warnings;
   return j;

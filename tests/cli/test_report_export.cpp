@@ -15,7 +15,17 @@ TEST(ReportExport, CsvTouchstoneAndJson) {
   ui::PipelineResult r;
   r.capture_path = "x.h5";
   r.curves.push_back({"measured (Prony-SS)", {1000.0, 2000.0}, {{10.0, -20.0}, {5.0, -8.0}}});
-  r.params.push_back({"YE11", "Pa", 6.3e10, 6.66e10, 6.66e10, std::nullopt, std::nullopt, {}});
+  ui::ParamRow p;
+  p.name = "YE11";
+  p.unit = "Pa";
+  p.original = 6.3e10;
+  p.updated = 6.66e10;
+  p.sigma = 0.02e10;
+  p.status = "ok";
+  p.truth = 6.66e10;
+  p.cmcm = 6.7e10;
+  r.params.push_back(p);
+  r.update_method = "output-error";
   r.stages.push_back({"update", true, "converged"});
   const auto dir = std::filesystem::temp_directory_path() / ("piezobench-export-" + std::to_string(::getpid()));
   std::filesystem::create_directories(dir);
@@ -36,6 +46,10 @@ TEST(ReportExport, CsvTouchstoneAndJson) {
   auto j = nlohmann::json::parse(js);
   EXPECT_EQ(j["parameters"][0]["name"], "YE11");
   EXPECT_EQ(j["parameters"][0]["updated"], 6.66e10);
+  EXPECT_EQ(j["parameters"][0]["sigma"], 0.02e10);  // issue 17: sigma beside every constant
+  EXPECT_EQ(j["parameters"][0]["status"], "ok");
+  EXPECT_EQ(j["parameters"][0]["cmcm"], 6.7e10);  // the seed's chain side by side
+  EXPECT_EQ(j["update_method"], "output-error");
   EXPECT_EQ(j["stages"][0]["ran"], true);
   EXPECT_THROW(ui::export_csv(r, (dir / "no/such/dir/a.csv").string()), std::runtime_error);
   ui::PipelineResult empty;

@@ -53,7 +53,8 @@ inline void make_truncated_capture(const fs::path& file) {
 }
 
 // What a record says, without what legitimately differs from run to run:
-// wall-clock fields (elapsed_s, replayed_utc, stage notes with timings).
+// wall-clock fields (elapsed_s, replayed_utc, stage notes with timings, the
+// output-error fit's seconds).
 struct Content {
   std::string path, sha256, status;
   nlohmann::json json;
@@ -63,6 +64,7 @@ struct Content {
 inline nlohmann::json without_timing(nlohmann::json j) {
   if (j.contains("result") && j["result"].contains("stages"))
     for (auto& s : j["result"]["stages"]) s.erase("note");
+  if (j.contains("result") && j["result"].contains("output_error")) j["result"]["output_error"].erase("seconds");
   return j;
 }
 

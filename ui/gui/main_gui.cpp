@@ -107,7 +107,9 @@ nlohmann::json frame_stats(const AppState& s, const TestScript& script) {
                 {"sv", rect(s.sv_view)}};
   if (s.result) {
     for (const auto& p : s.result->params)
-      j["params"].push_back({{"name", p.name}, {"original", p.original}, {"updated", p.updated}});
+      j["params"].push_back({{"name", p.name}, {"original", p.original}, {"updated", p.updated},
+                             {"sigma", p.sigma ? nlohmann::json(*p.sigma) : nlohmann::json(nullptr)},
+                             {"status", p.status}});
     if (const auto& d = s.result->diagnosis) {
       j["diagnosis"] = {{"verdict", d->verdict},
                         {"effects", d->effects.size()},

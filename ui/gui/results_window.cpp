@@ -10,12 +10,22 @@ namespace {
 void parameter_table(const ui::PipelineResult& r) {
   const bool sim = std::any_of(r.params.begin(), r.params.end(),
                                [](const auto& p) { return p.truth.has_value(); });
-  if (!ImGui::BeginTable("params", sim ? 5 : 4, ImGuiTableFlags_Borders | ImGuiTableFlags_RowBg))
+  const bool seed = std::any_of(r.params.begin(), r.params.end(), [](const auto& p) { return p.cmcm.has_value(); });
+  // Which method `updated` holds, and the fit's summary: a tooltip on the
+  // values (the table keeps its height, the exports stay in view).
+  const char* method = r.update_method == "output-error" ? "output-error fit of the samples (with sigma)"
+                       : r.update_method == "cmcm"       ? "the seed's extended CMCM (no sigma)"
+                                                         : "least squares on the seed's features (no sigma)";
+  const int cols = 6 + (seed ? 1 : 0) + (sim ? 1 : 0);
+  if (!ImGui::BeginTable("params", cols, ImGuiTableFlags_Borders | ImGuiTableFlags_RowBg))
     return;
   ImGui::TableSetupColumn("parameter");
   ImGui::TableSetupColumn("original");
   ImGui::TableSetupColumn("updated");
+  ImGui::TableSetupColumn("sigma");
   ImGui::TableSetupColumn("change %");
+  ImGui::TableSetupColumn("status");
+  if (seed) ImGui::TableSetupColumn("CMCM (seed)");
   if (sim) ImGui::TableSetupColumn("true (sim)");
   ImGui::TableHeadersRow();
   for (const auto& p : r.params) {
@@ -26,8 +36,37 @@ void parameter_table(const ui::PipelineResult& r) {
     ImGui::Text("%.5g", p.original);
     ImGui::TableNextColumn();
     ImGui::Text("%.5g", p.updated);
+    if (ImGui::IsItemHovered()) {
+      if (r.output_error && r.output_error->ok())
+        ImGui::SetTooltip("%s\ncorr(nu12, d31) %+.2f, chi2/dof %.3g (limit %.3g), Rayleigh beta %.3g s", method,
+                          r.output_error->corr_nu12_d31, r.output_error->chi2_per_dof, r.output_error->chi2_limit,
+                          r.output_error->damping.beta);
+      else
+        ImGui::SetTooltip("%s", method);
+    }
+    ImGui::TableNextColumn();
+    if (p.sigma)
+      ImGui::Text("%.2g (%.2f %%)", *p.sigma, 100.0 * *p.sigma / std::abs(p.updated));
+    else
+      ImGui::TextDisabled("-");
     ImGui::TableNextColumn();
     ImGui::Text("%+.2f", p.original != 0 ? 100.0 * (p.updated - p.original) / p.original : 0.0);
+    ImGui::TableNextColumn();
+    if (p.status == "ok") {
+      ImGui::TextUnformatted("ok");
+    } else {
+      ImGui::TextColored(ImVec4(1.0f, 0.6f, 0.2f, 1.0f), "%s", p.status.c_str());
+      if (ImGui::IsItemHovered() && r.output_error)  // why, and what would pin it
+        for (const auto& q : r.output_error->parameters)
+          if (q.name == p.name && !q.note.empty()) ImGui::SetTooltip("%s", q.note.c_str());
+    }
+    if (seed) {
+      ImGui::TableNextColumn();
+      if (p.cmcm)
+        ImGui::Text("%.5g", *p.cmcm);
+      else
+        ImGui::TextDisabled("-");
+    }
     if (!sim) continue;
     ImGui::TableNextColumn();
     if (p.truth)

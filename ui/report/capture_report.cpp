@@ -45,13 +45,18 @@ std::string capture_summary_markdown(const ui::PipelineResult& r, const CaptureI
   for (const auto& s : r.stages)
     o << "| " << s.name << " | " << (s.ran ? "yes" : "no") << " | " << cell(s.note) << " |\n";
   if (!r.params.empty()) {
-    o << "\n## Parameters\n\n| parameter | unit | original | updated | change |\n| --- | --- | --- "
-         "| --- | --- |\n";
+    o << "\n## Parameters\n\nUpdate: " << r.update_method
+      << "\n\n| parameter | unit | original | updated | sigma | change | status | CMCM (seed) |\n"
+         "| --- | --- | --- | --- | --- | --- | --- | --- |\n";
     for (const auto& p : r.params)
       o << "| " << p.name << " | " << p.unit << " | " << fmt("%.6g", p.original) << " | "
-        << fmt("%.6g", p.updated) << " | "
+        << fmt("%.6g", p.updated) << " | " << (p.sigma ? fmt("%.3g", *p.sigma) : "-") << " | "
         << (p.original != 0 ? fmt("%+.2f %%", 100.0 * (p.updated - p.original) / p.original) : "-")
-        << " |\n";
+        << " | " << cell(p.status) << " | " << (p.cmcm ? fmt("%.6g", *p.cmcm) : "-") << " |\n";
+    if (r.output_error && r.output_error->ok())
+      o << "\ncorr(nu12, d31) " << fmt("%+.3f", r.output_error->corr_nu12_d31) << ", chi2/dof "
+        << fmt("%.3g", r.output_error->chi2_per_dof) << " (limit " << fmt("%.3g", r.output_error->chi2_limit)
+        << "), Rayleigh beta " << fmt("%.3g s", r.output_error->damping.beta) << "\n";
   }
   o << "\n## Features (Prony-SS)\n\n";
   auto list = [&](const char* what, const std::vector<double>& v) {

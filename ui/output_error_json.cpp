@@ -1,0 +1,63 @@
+#include "ui/output_error_json.hpp"
+
+#include <cmath>
+
+#include "model/material.hpp"
+
+namespace piezo::ui {
+
+nlohmann::json tube_params_json(const update::TubeParams& p) {
+  return {{"YE11", p.y_e11}, {"nu12", p.nu12}, {"d31", p.d31}, {"epsT33_rel", p.eps_t33 / model::kEps0}};
+}
+
+nlohmann::json output_error_json(const update::OeResult& r, const std::string& excitation) {
+  nlohmann::json params = nlohmann::json::array();
+  std::vector<std::string> names;
+  for (const auto& p : r.parameters) {
+    params.push_back({{"name", p.name}, {"unit", p.unit}, {"value", p.value}, {"sigma", p.sigma},
+                      {"relative_sigma", std::abs(p.sigma / p.value)}, {"nominal", p.nominal},
+                      {"sigma_statistical", p.sigma_statistical}, {"status", p.status},
+                      {"reason", p.reason}, {"note", p.note}});
+    names.push_back(p.name);
+  }
+  nlohmann::json corr = nlohmann::json::array();
+  for (Eigen::Index i = 0; i < r.correlation.rows(); ++i) {
+    std::vector<double> row;
+    for (Eigen::Index j = 0; j < r.correlation.cols(); ++j) row.push_back(r.correlation(i, j));
+    corr.push_back(row);
+  }
+  nlohmann::json optima = nlohmann::json::array();
+  for (std::size_t k = 0; k < r.optima.size(); ++k) {
+    auto o = tube_params_json(r.optima[k]);
+    o["chi2"] = 2.0 * r.optima_cost[k];
+    optima.push_back(o);
+  }
+  return {{"method", "oe"},
+          {"converged", r.ok()},
+          {"status", update::to_string(r.status)},
+          {"message", r.message},
+          {"updated", tube_params_json(r.updated)},
+          {"parameters", params},
+          {"correlation", {{"names", names}, {"matrix", corr}}},
+          {"corr_nu12_d31", r.corr_nu12_d31},
+          {"damping", {{"rayleigh_alpha", r.damping.alpha}, {"rayleigh_beta", r.damping.beta}}},
+          {"fit",
+           {{"excitation", excitation},
+            {"shots", r.shots_used},
+            {"band_hz", r.band_hz},
+            {"residual_samples", r.residual_samples},
+            {"noise_source", r.noise_source},
+            {"noise_rms_v", r.noise_rms_v},
+            {"residual_rms_v", r.residual_rms_v},
+            {"chi2_per_dof", r.chi2_per_dof},
+            {"chi2_limit", r.chi2_limit},
+            {"lack_of_fit", r.lack_of_fit},
+            {"noise_dof", r.noise_dof},
+            {"starts", r.starts},
+            {"iterations", r.iterations},
+            {"evaluations", r.evaluations},
+            {"optima", optima}}},
+          {"seconds", r.seconds}};
+}
+
+}  // namespace piezo::ui
