@@ -137,7 +137,7 @@ void calibrate_stage(const acq::Capture& cap, PipelineResult& out) {
   }
 }
 
-dsp::ImpedanceResult estimate(const acq::Capture& cap, PipelineResult& out) {
+dsp::ImpedanceResult estimate(const acq::Capture& cap, bool refine_features, PipelineResult& out) {
   const std::optional<dsp::FixtureCalibration>& fx = out.fixture;
   bool fixture_in_fit = false;  // the port fit ran with the measured fixture in its circuit
   std::vector<const acq::Shot*> shots;
@@ -187,7 +187,7 @@ dsp::ImpedanceResult estimate(const acq::Capture& cap, PipelineResult& out) {
   // samples (update/port_fit.hpp): Prony's zeros of Z(s) carry a truncation
   // bias where the noise sets its order (+0.2 … 0.3 % on the third resonance,
   // +1 % on nu12 after the update). Prony's values stay when the fit fails.
-  {
+  if (refine_features) {
     auto& fr = prony.features.resonances;
     auto& fa = prony.features.antiresonances;
     const std::size_t n = std::min<std::size_t>({3, fr.size(), fa.size()});
@@ -604,7 +604,7 @@ PipelineResult run_pipeline(const PipelineRequest& req, const std::function<void
   // failure on a capture stops neither.
   std::optional<dsp::ImpedanceResult> z;
   try {
-    z = estimate(cap, out);
+    z = estimate(cap, req.seed_chain, out);
     char note[160];
     std::snprintf(note, sizeof note, "Prony-SS order %d on %zu samples (%d shot(s) averaged): %zu resonances, %zu anti-resonances, C = %.4g F",
                   out.order, z->samples_used, out.shots_averaged, out.resonances_hz.size(), out.antiresonances_hz.size(),
@@ -618,7 +618,8 @@ PipelineResult run_pipeline(const PipelineRequest& req, const std::function<void
   if (cancel) return out;
   progress(0.55, "update: extended CMCM (the seed's chain)");
   SeedUpdate seed;
-  if (z) seed = seed_update_stage(req, cap, *z, out);
+  if (!req.seed_chain) out.stages.push_back({"update (CMCM)", false, "not requested (the seed's chain is off)"});
+  else if (z) seed = seed_update_stage(req, cap, *z, out);
   else out.stages.push_back({"update (CMCM)", false, "needs the impedance estimate"});
   if (cancel) return out;
   progress(0.62, "update: output-error fit");

@@ -52,6 +52,11 @@ struct PipelineRequest {
   acq::TechnicianPrompt prompt;
   // Use the capture's calibration shots (fixture measured, see PipelineResult::fixture).
   bool use_calibration = true;
+  // The seed's chain beside the output-error fit: the port-model refinement
+  // of Prony's features and extended CMCM on them (LM where CMCM fails).
+  // Off, the pipeline runs Prony-SS (plots, features) and the output-error
+  // fit only: replay's default, for throughput (`replay --seed-chain` turns it on).
+  bool seed_chain = true;
   // Also run least squares (LM) on the seed's features beside extended CMCM
   // (the demo's comparison table); otherwise LM runs only where CMCM fails.
   bool compare_lm = false;

@@ -73,7 +73,7 @@ struct OeOptions {
   int refine = 3;
   int max_iterations = 40;
   double step_tolerance = 1e-6;  // converged when max |Δθ| < this …
-  double cost_tolerance = 1e-3;  // … or ½χ² dropped by less than this in the last step
+  double cost_tolerance = 1e-2;  // … or ½χ² dropped by less than this (the answer within ~0.15 sigma)
   double identifiable_rel_sigma = 0.05;
   // Systematic (type B) uncertainties of the measurement chain that the
   // samples cannot separate from the constants — R1 and a capacitance across

@@ -63,6 +63,7 @@ void register_replay_commands(CLI::App& app, Context& ctx) {
     std::size_t jobs = 1;
     double timeout_s = 600.0;
     bool transverse = false;
+    bool seed_chain = false;
   };
   auto a = std::make_shared<Args>();
   r->add_option("PATH", a->inputs, "Capture files and folders (searched recursively for *.h5)")
@@ -87,6 +88,9 @@ void register_replay_commands(CLI::App& app, Context& ctx) {
                 "Nominal material (default: the capture's /setup/material, else apc850)");
   r->add_flag("--transverse", a->transverse,
               "Transversely isotropic class instead of the isotropic one");
+  r->add_flag("--seed-chain", a->seed_chain,
+              "Also run the seed's chain (Prony features -> extended CMCM, LM where it fails) beside the "
+              "output-error fit; its constants go into parameters[].cmcm");
   add_json_flag(r, ctx);
   r->callback([&ctx, a] {
     ctx.exit_code = run_command(ctx, [&] {
@@ -100,6 +104,7 @@ void register_replay_commands(CLI::App& app, Context& ctx) {
       if (!a->jsonl.empty()) opt.jsonl = a->jsonl;
       opt.material = a->material;
       opt.isotropic = !a->transverse;
+      opt.seed_chain = a->seed_chain;
       opt.software = std::string("piezobench ") + kVersion + " replay";
       g_stop = false;
       std::signal(SIGINT, on_signal);

@@ -194,6 +194,7 @@ Outcome replay_capture(const fs::path& file, const ReplayOptions& opt, const Sin
     req.replay_contained = false;  // this worker process is the containment
     req.material = material;
     req.isotropic = opt.isotropic;
+    req.seed_chain = opt.seed_chain;
     result = ui::run_pipeline(req, nullptr, cancel);
   } catch (const acq::CaptureError& e) {
     return fail(sha, "bad capture", e.what());

@@ -42,6 +42,7 @@ struct ReplayOptions {
       jsonl;             // one line per capture of this run (truncated at start)
   std::string material;  // nominal model; empty: the capture's /setup/material, else apc850
   bool isotropic = true;
+  bool seed_chain = false;  // also run the seed's CMCM/LM chain (ui::PipelineRequest::seed_chain)
   std::string software = "piezobench replay";
   // A capture whose worker has not answered after this long is a hang: the
   // worker is killed and the capture recorded as failed ("hung").
