@@ -7,6 +7,7 @@
 //    the `validate` program runs all twenty and checks the aggregate).
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -31,16 +32,20 @@ struct Synthetic {
   std::vector<double> v1, v2;
   update::TubeParams truth;
   double beta = 6e-8;
+  std::size_t pretrigger = 200;
 };
 
 // The seed's lab drive (1 V exp_decay at 3000 1/s, 200 idle samples first),
 // 20000 samples at 10 MS/s, through R1 = 3140 Ω into the FE tube.
 Synthetic simulate(model::ModalSolver& solver, const update::MaterialClass& cls,
-                   const update::TubeParams& truth, double noise_rel, std::uint64_t seed) {
+                   const update::TubeParams& truth, double noise_rel, std::uint64_t seed,
+                   std::size_t pre = 200, double beta = 6e-8) {
   Synthetic s;
   s.truth = truth;
+  s.beta = beta;
+  s.pretrigger = pre;
   const double fs = 10e6;
-  const std::size_t n = 20000, pre = 200;
+  const std::size_t n = 20000;
   s.v1.assign(n, 0.0);
   for (std::size_t i = pre; i < n; ++i) s.v1[i] = std::exp(-3000.0 * double(i - pre) / fs);
   model::ModalOptions mo;
@@ -68,7 +73,7 @@ update::OeData data_of(const Synthetic& s) {
   update::OeData d;
   d.sample_rate_hz = 10e6;
   d.circuit.r1_ohm = 3140.0;
-  d.shots.push_back({s.v1, s.v2, 200});
+  d.shots.push_back({s.v1, s.v2, s.pretrigger});
   return d;
 }
 
@@ -95,6 +100,7 @@ class OutputErrorSimulated : public ::testing::Test {
   }
 };
 
+#ifndef PIEZO_OE_VALIDATE  // the make-test program; the validate one runs the study below
 // Noise-free: what is left is the two simulators' difference (first-order
 // hold vs band-limited input, ≤ 1e-3 of the response in the band) and the
 // estimator's 16-mode truncation against 40 modes: a few 1e-3 at most.
@@ -142,6 +148,76 @@ TEST_F(OutputErrorSimulated, BadInputIsRefusedWithAMessage) {
   d.shots[0] = {nan, z, 0};
   EXPECT_THROW(update::fit_output_error(solver, cls, nominal, d), std::invalid_argument);
 }
+#endif  // PIEZO_OE_VALIDATE
+
+#ifdef PIEZO_OE_VALIDATE
+// Issue 17's own study: twenty tubes drawn within ±15 % of the nominal
+// constants (and β within 4e-8 … 1.2e-7 s), ONE shot each of the seed's lab
+// drive at a noise level drawn in 1 … 5 % per channel, half with 200 idle
+// samples before the step, half starting at it. The truth is the simulator's
+// (40 modes, first-order hold); the estimator starts from the nominal
+// material. Acceptance: in >= 19 of 20 tubes YE11 and εT33 within 1 %, nu12
+// and d31 within 3 %; across all, >= 95 % of the ok constants within 3 sigma
+// and none beyond 5 sigma.
+// Measured (2026-11-25): 14/20 within the bounds — NOT met. The honesty part
+// holds (68 ok constants, all within 3 sigma, none beyond 5). Two causes:
+// at 3-5 % noise one shot gives nu12 and d31 a sigma of 2-4 % (the misses
+// are at 0.5-2.4 sigma), and in 5 of the 10 records with a 200-sample
+// pretrigger chi2/dof is 1.3-2.7 on the model's own data: the pretrigger
+// means remove the DAQ offsets only to sigma/sqrt(200), a constant that does
+// not average down, so the fit is flagged "lack of fit" (not identifiable).
+// Projecting the residual's mean out (tried) brings every chi2/dof to ~1 and
+// 80/80 ok constants within 3 sigma here, but then corpus case 02 (2.4 % end
+// mass, one shot) passes the chi2 test and reports YE11 ok at -8.4 sigma:
+// the chi2 test alone cannot see that end mass in one shot.
+TEST_F(OutputErrorSimulated, TwentyTubesOneShotOneToFivePercentNoise) {
+  std::mt19937_64 rng(20261125);
+  std::uniform_real_distribution<double> spread(0.85, 1.15), noise(0.01, 0.05), lbeta(std::log(4e-8), std::log(1.2e-7));
+  int within_bounds = 0, ok = 0, within3 = 0, beyond5 = 0;
+  double seconds = 0;
+  std::vector<double> secs;
+  for (int k = 0; k < 20; ++k) {
+    update::TubeParams t = nominal;
+    t.y_e11 *= spread(rng);
+    t.nu12 *= spread(rng);
+    t.d31 *= spread(rng);
+    t.eps_t33 *= spread(rng);
+    const double nr = noise(rng), beta = std::exp(lbeta(rng));
+    const std::size_t pre = k % 2 ? 0 : 200;
+    const auto s = simulate(solver, cls, t, nr, 1000 + static_cast<std::uint64_t>(k), pre, beta);
+    const auto r = update::fit_output_error(solver, cls, nominal, data_of(s));
+    EXPECT_TRUE(r.ok()) << "tube " << k << ": " << r.message;
+    seconds += r.seconds;
+    secs.push_back(r.seconds);
+    bool in = r.ok();
+    std::printf("tube %2d noise %.1f %% pre %3zu chi2/dof %.2f %3d models %.2f s:", k, 100 * nr, pre,
+                r.chi2_per_dof, r.evaluations, r.seconds);
+    for (int i = 0; i < 4 && i < static_cast<int>(r.parameters.size()); ++i) {
+      const auto& p = r.parameters[static_cast<std::size_t>(i)];
+      const double tv = truth_of(t, p.name), rel = p.value / tv - 1.0, z = (p.value - tv) / p.sigma;
+      const double bound = (i == 0 || i == 3) ? 0.01 : 0.03;
+      in = in && std::abs(rel) <= bound;
+      if (p.status == "ok") {
+        ++ok;
+        within3 += std::abs(z) <= 3.0;
+        beyond5 += std::abs(z) > 5.0;
+        EXPECT_LE(std::abs(z), 5.0) << "tube " << k << " " << p.name << " ok at " << z << " sigma";
+      }
+      std::printf(" %s %+.2f%% (%+.1fs %s)", p.name.c_str(), 100 * rel, z, p.status == "ok" ? "ok" : "n.i.");
+    }
+    std::printf("%s\n", in ? "" : "  OUT OF BOUNDS");
+    within_bounds += in;
+  }
+  std::sort(secs.begin(), secs.end());
+  std::printf("within bounds %d/20; ok constants %d: within 3 sigma %d, beyond 5 sigma %d; fit median %.2f s, mean %.2f s\n",
+              within_bounds, ok, within3, beyond5, 0.5 * (secs[9] + secs[10]), seconds / 20);
+  EXPECT_GE(within_bounds, 19);
+  EXPECT_EQ(beyond5, 0);
+  if (ok > 0) {
+    EXPECT_GE(double(within3), 0.95 * double(ok));
+  }
+}
+#endif  // PIEZO_OE_VALIDATE
 
 // ---- the corpus written by another tool ----------------------------------
 const std::filesystem::path kCorpus = std::filesystem::path(PIEZO_SOURCE_DIR) / "../shared/corpus/refsim-v1";
@@ -197,7 +273,12 @@ std::vector<std::string> corpus_cases() {
   return v;
 }
 
-TEST(OutputErrorCorpus, EveryCaseGivesAnEstimateAndNoConfidentWrongAnswer) {
+#ifdef PIEZO_OE_VALIDATE
+#define PIEZO_OE_CORPUS_TEST AllTwentyCasesGiveAnEstimateAndNoConfidentWrongAnswer
+#else
+#define PIEZO_OE_CORPUS_TEST ThreeCasesGiveAnEstimateAndNoConfidentWrongAnswer
+#endif
+TEST(OutputErrorCorpus, PIEZO_OE_CORPUS_TEST) {
   if (!std::filesystem::exists(kCorpus / "01" / "fit.h5")) GTEST_SKIP() << "no corpus at " << kCorpus;
   int ok = 0, within3 = 0, beyond5 = 0;
   for (const auto& c : corpus_cases()) {
