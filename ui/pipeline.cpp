@@ -335,7 +335,7 @@ struct SeedUpdate {
   std::optional<update::TubeParams> cmcm, lm;
 };
 
-SeedUpdate seed_update_stage(const PipelineRequest& req, const acq::Capture& cap, const dsp::ImpedanceResult& z,
+SeedUpdate seed_update_stage(const PipelineRequest& req, const CaptureModel& cm, const dsp::ImpedanceResult& z,
                              PipelineResult& out) {
   SeedUpdate s;
   try {
@@ -350,7 +350,6 @@ SeedUpdate seed_update_stage(const PipelineRequest& req, const acq::Capture& cap
     feat.low_z_ohm = 1.0 / (2 * M_PI * feat.low_z_hz * z.features.capacitance_f);
     feat.validate();
 
-    const CaptureModel cm = capture_model(cap, req.material, req.isotropic);
     update::UpdateOptions uo;
     // Measured features are not exactly reachable by the model (noise, three
     // resonances for two stiffnesses), so the outer sweeps settle to a
@@ -537,9 +536,9 @@ std::vector<update::MeasuredEffect> measured_effects(const dsp::FixtureCalibrati
   return v;
 }
 
-void diagnose_stage(const PipelineRequest& req, const acq::Capture& cap, const acq::Capture* heldout_cap,
-                    const UpdateOutcome& u, PipelineResult& out, const Stages& progress,
-                    const std::atomic<bool>& cancel) {
+void diagnose_stage(const PipelineRequest& req, const acq::Capture& cap, const CaptureModel& cm,
+                    const acq::Capture* heldout_cap, const UpdateOutcome& u, PipelineResult& out,
+                    const Stages& progress, const std::atomic<bool>& cancel) {
   auto fit_shots = dut_shots(cap, std::nullopt, false);
   if (fit_shots.empty()) throw std::invalid_argument("gap diagnosis: the capture holds no transient dut shot");
   const acq::Excitation kind = fit_shots.front()->excitation;
@@ -568,7 +567,6 @@ void diagnose_stage(const PipelineRequest& req, const acq::Capture& cap, const a
   if (ho_shots.size() >= 3) ho = gap_data(*ho_cap, ho_shots, req.gap_floor, ho_what);
   else out.warnings.push_back("gap diagnosis without held-out data (fewer than 3 other shots)");
 
-  const CaptureModel cm = capture_model(cap, req.material, req.isotropic);
   model::ModalSolver& solver = *cm.solver;
   const auto& cls = cm.cls;
   update::GapOptions go;
@@ -616,20 +614,24 @@ PipelineResult run_pipeline(const PipelineRequest& req, const std::function<void
                            "); the output-error fit runs on the samples alone");
   }
   if (cancel) return out;
+  // One tube model for the seed's chain, the model curves and the diagnosis
+  // (the output-error fit builds its own through ui::fit_capture).
+  const CaptureModel cm = capture_model(cap, req.material, req.isotropic);
   progress(0.55, "update: extended CMCM (the seed's chain)");
   SeedUpdate seed;
   if (!req.seed_chain) out.stages.push_back({"update (CMCM)", false, "not requested (the seed's chain is off)"});
-  else if (z) seed = seed_update_stage(req, cap, *z, out);
+  else if (z) seed = seed_update_stage(req, cm, *z, out);
   else out.stages.push_back({"update (CMCM)", false, "needs the impedance estimate"});
+  const std::string seed_note = out.stages.back().note;
   if (cancel) return out;
   progress(0.62, "update: output-error fit");
   const auto oe = output_error_stage(req, cap, out);
+  const std::string oe_note = out.stages.back().note;
   if (cancel) return out;
 
   // The pipeline's update: the output-error fit where it converged (its
   // constants carry sigma and status), else the seed's chain.
   UpdateOutcome u;
-  const CaptureModel cm = capture_model(cap, req.material, req.isotropic);
   if (oe && oe->ok()) {
     u = {true, "output-error", oe->updated, oe->damping, 50e3};
     if (!out.resonances_hz.empty()) u.first_resonance_hz = out.resonances_hz.front();
@@ -657,8 +659,8 @@ PipelineResult run_pipeline(const PipelineRequest& req, const std::function<void
   parameter_rows(cm.p0, u, seed, oe, sim.get(), out);
   if (!u.ok) {
     out.warnings.push_back("no model update: see the update stages");
-    throw std::runtime_error("update: neither the output-error fit nor the seed's chain converged (" +
-                             (out.stages.end()[-2].note) + "; " + out.stages.end()[-3].note + ")");
+    throw std::runtime_error("update: neither the output-error fit nor the seed's chain converged (" + oe_note +
+                             "; " + seed_note + ")");
   }
   {  // Model curves on the measurement's grid (or a plain one): original and updated.
     std::vector<double> grid;
@@ -683,7 +685,7 @@ PipelineResult run_pipeline(const PipelineRequest& req, const std::function<void
     if (cancel) return out;
     progress(0.7, "diagnose: gap");
     try {
-      diagnose_stage(req, cap, heldout ? &*heldout : nullptr, u, out, progress, cancel);
+      diagnose_stage(req, cap, cm, heldout ? &*heldout : nullptr, u, out, progress, cancel);
     } catch (const std::exception& e) {
       // The capture and the update stand; the diagnosis failing must not lose them.
       out.stages.push_back({"diagnose", false, std::string("failed: ") + e.what()});
