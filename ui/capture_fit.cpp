@@ -23,6 +23,10 @@ CaptureModel capture_model(const acq::Capture& cap, const std::string& material,
 }
 
 CaptureFit fit_capture(const acq::Capture& cap, const CaptureFitRequest& req) {
+  return fit_capture(cap, req, capture_model(cap, req.material, req.isotropic));
+}
+
+CaptureFit fit_capture(const acq::Capture& cap, const CaptureFitRequest& req, const CaptureModel& m) {
   // The dut transient shots of the first one's drive.
   const acq::Shot* first = nullptr;
   for (const auto& s : cap.shots)
@@ -56,7 +60,6 @@ CaptureFit fit_capture(const acq::Capture& cap, const CaptureFitRequest& req) {
     if (fx.fixture_capacitance_f) o.cp_sigma_f = fx.fixture_capacitance_sigma_f.value_or(o.cp_sigma_f);
     if (fx.skew_s) o.skew_sigma_s = fx.skew_sigma_s.value_or(o.skew_sigma_s);
   }
-  const CaptureModel m = capture_model(cap, req.material, req.isotropic);
   out.result = update::fit_output_error(*m.solver, m.cls, m.p0, data, opts);
   return out;
 }

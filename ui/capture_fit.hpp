@@ -45,5 +45,8 @@ struct CaptureFit {
 // Throws std::invalid_argument when the capture holds no dut transient shot
 // or the fit cannot use it.
 CaptureFit fit_capture(const acq::Capture& cap, const CaptureFitRequest& req);
+// The same on a tube model the caller already holds (capture_model of the
+// same capture, material and class: the pipeline's).
+CaptureFit fit_capture(const acq::Capture& cap, const CaptureFitRequest& req, const CaptureModel& model);
 
 }  // namespace piezo::ui

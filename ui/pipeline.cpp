@@ -401,13 +401,13 @@ SeedUpdate seed_update_stage(const PipelineRequest& req, const CaptureModel& cm,
 // The output-error fit of the constants and Rayleigh β to the capture's
 // samples (update/output_error.hpp): the pipeline's update. Never throws.
 std::optional<update::OeResult> output_error_stage(const PipelineRequest& req, const acq::Capture& cap,
-                                                   PipelineResult& out) {
+                                                   const CaptureModel& cm, PipelineResult& out) {
   CaptureFitRequest cr;
   cr.material = req.material;
   cr.isotropic = req.isotropic;
   if (req.use_calibration) cr.fixture = out.fixture;
   try {
-    const CaptureFit f = fit_capture(cap, cr);
+    const CaptureFit f = fit_capture(cap, cr, cm);
     const auto& r = f.result;
     int ok = 0;
     for (const auto& p : r.parameters) ok += p.status == "ok";
@@ -614,8 +614,8 @@ PipelineResult run_pipeline(const PipelineRequest& req, const std::function<void
                            "); the output-error fit runs on the samples alone");
   }
   if (cancel) return out;
-  // One tube model for the seed's chain, the model curves and the diagnosis
-  // (the output-error fit builds its own through ui::fit_capture).
+  // One tube model for the seed's chain, the output-error fit, the model
+  // curves and the diagnosis.
   const CaptureModel cm = capture_model(cap, req.material, req.isotropic);
   progress(0.55, "update: extended CMCM (the seed's chain)");
   SeedUpdate seed;
@@ -625,7 +625,7 @@ PipelineResult run_pipeline(const PipelineRequest& req, const std::function<void
   const std::string seed_note = out.stages.back().note;
   if (cancel) return out;
   progress(0.62, "update: output-error fit");
-  const auto oe = output_error_stage(req, cap, out);
+  const auto oe = output_error_stage(req, cap, cm, out);
   const std::string oe_note = out.stages.back().note;
   if (cancel) return out;
 
