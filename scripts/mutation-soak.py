@@ -15,7 +15,9 @@ then
 Prints a summary and exits non-zero on any violation.
 
   /usr/bin/python3 scripts/mutation-soak.py --cli build/ui/piezobench \
-      --capture CAP.h5 --count 10000 --batch 100 --jobs 2 --work /tmp/soak
+      --capture CAP.h5 --count 10000 --batch 100 --jobs 2 --work /tmp/soak [--resume]
+Each batch is checked whole (replay, resume, capture info) and marked
+batchNNNN.done; --resume goes on from the first batch not marked.
 """
 import argparse
 import json
@@ -51,6 +53,56 @@ def raw_data_ranges(path):
     return sorted(ranges)
 
 
+def replay_batch(a, d, files):
+    """Replay one batch twice (the run, then the resume); returns (counts, violations)."""
+    counts = {"ok": 0, "failed": 0, "crashed": 0, "hung": 0}
+    bad = []
+    out, jl = d + "-results.h5", d + ".jsonl"
+    for f in (out, jl):
+        if os.path.exists(f):
+            os.remove(f)
+    cmd = [a.cli, "replay", d, "--out", out, "--jsonl", jl, "--jobs", str(a.jobs),
+           "--timeout", str(a.timeout), "--json"]
+    p = subprocess.run(cmd, capture_output=True, text=True)
+    if p.returncode not in (0, 2):
+        return counts, ["replay %s: exit %d: %s" % (d, p.returncode, p.stderr[-400:])]
+    lines = [json.loads(x) for x in open(jl)]
+    seen = {os.path.basename(x["path"]) for x in lines}
+    missing = [f for f in files if f not in seen]
+    if missing:
+        bad.append("replay %s: no record for %s" % (d, missing[:5]))
+    for x in lines:
+        if x["status"] == "ok":
+            counts["ok"] += 1
+        else:
+            counts["failed"] += 1
+            kind = x.get("error", {}).get("kind", "")
+            if kind in counts:
+                counts[kind] += 1
+            if not x.get("error", {}).get("message"):
+                bad.append("replay %s: failed record without a message" % x["path"])
+    p2 = subprocess.run(cmd, capture_output=True, text=True)  # the resume
+    if p2.returncode not in (0, 2):
+        bad.append("resume %s: exit %d: %s" % (d, p2.returncode, p2.stderr[-400:]))
+    else:
+        j = json.loads(p2.stdout)
+        if j["total"] != len(files) or j["done_before"] + j["replayed"] + j["failed"] != len(files):
+            bad.append("resume %s: %s" % (d, p2.stdout.strip()))
+    return counts, bad
+
+
+def info_batch(a, d, files):
+    """`capture info` on every file of one batch; returns (exit-code counts, violations)."""
+    codes, bad = {}, []
+    for f in files:
+        p = subprocess.run([a.cli, "capture", "info", os.path.join(d, f)],
+                           capture_output=True, text=True)
+        codes[str(p.returncode)] = codes.get(str(p.returncode), 0) + 1
+        if p.returncode not in (0, 2):
+            bad.append("capture info %s/%s: exit %d %s" % (d, f, p.returncode, p.stderr[-300:]))
+    return codes, bad
+
+
 def main():
     ap = argparse.ArgumentParser()
     ap.add_argument("--cli", required=True)
@@ -59,89 +111,80 @@ def main():
     ap.add_argument("--batch", type=int, default=100)
     ap.add_argument("--jobs", type=int, default=2)
     ap.add_argument("--seed", type=int, default=16)
+    ap.add_argument("--timeout", type=float, default=120,
+                    help="replay --timeout: seconds before a hung worker is killed (the mutants are small)")
     ap.add_argument("--work", required=True)
     ap.add_argument("--metadata-share", type=float, default=0.9)
     ap.add_argument("--skip-replay", action="store_true")
     ap.add_argument("--skip-info", action="store_true")
+    ap.add_argument("--resume", action="store_true",
+                    help="keep WORK and the batches already checked (batchNNNN.done); "
+                         "the mutants are the same for the same --seed, --count and --batch")
     a = ap.parse_args()
 
     data = open(a.capture, "rb").read()
     raw = raw_data_ranges(a.capture)
     meta = [i for i in range(len(data)) if not any(lo <= i < hi for lo, hi in raw)] if raw else []
     rng = random.Random(a.seed)
-    if os.path.exists(a.work):
+    if os.path.exists(a.work) and not a.resume:
         shutil.rmtree(a.work)
-    os.makedirs(a.work)
+    os.makedirs(a.work, exist_ok=True)
     batches = []
     for b in range(0, a.count, a.batch):
         d = os.path.join(a.work, "batch%04d" % (b // a.batch))
-        os.makedirs(d)
+        os.makedirs(d, exist_ok=True)
         for k in range(b, min(a.count, b + a.batch)):
             m = bytearray(data)
             for _ in range(rng.randint(1, 8)):
                 pos = rng.choice(meta) if meta and rng.random() < a.metadata_share else rng.randrange(len(m))
                 m[pos] = rng.randrange(256)
-            open(os.path.join(d, "m%05d.h5" % k), "wb").write(m)
+            f = os.path.join(d, "m%05d.h5" % k)
+            if not os.path.exists(f):
+                open(f, "wb").write(m)
         batches.append(d)
     print("soak: %d mutants of %s (%d bytes, %d of metadata) in %d batches"
           % (a.count, a.capture, len(data), len(meta), len(batches)), flush=True)
 
     bad = []
-    if not a.skip_replay:
-        t0 = time.time()
-        counts = {"ok": 0, "failed": 0, "crashed": 0, "hung": 0}
-        for d in batches:
-            files = sorted(f for f in os.listdir(d) if f.endswith(".h5"))
-            out, jl = d + "-results.h5", d + ".jsonl"
-            cmd = [a.cli, "replay", d, "--out", out, "--jsonl", jl, "--jobs", str(a.jobs), "--json"]
-            p = subprocess.run(cmd, capture_output=True, text=True)
-            if p.returncode not in (0, 2):
-                bad.append("replay %s: exit %d: %s" % (d, p.returncode, p.stderr[-400:]))
-                continue
-            lines = [json.loads(x) for x in open(jl)]
-            seen = {os.path.basename(x["path"]) for x in lines}
-            missing = [f for f in files if f not in seen]
-            if missing:
-                bad.append("replay %s: no record for %s" % (d, missing[:5]))
-            for x in lines:
-                if x["status"] == "ok":
-                    counts["ok"] += 1
-                else:
-                    counts["failed"] += 1
-                    kind = x.get("error", {}).get("kind", "")
-                    if kind in counts:
-                        counts[kind] += 1
-                    if not x.get("error", {}).get("message"):
-                        bad.append("replay %s: failed record without a message" % x["path"])
-            p2 = subprocess.run(cmd, capture_output=True, text=True)  # the resume
-            if p2.returncode not in (0, 2):
-                bad.append("resume %s: exit %d: %s" % (d, p2.returncode, p2.stderr[-400:]))
-            else:
-                j = json.loads(p2.stdout)
-                if j["total"] != len(files) or j["done_before"] + j["replayed"] + j["failed"] != len(files):
-                    bad.append("resume %s: %s" % (d, p2.stdout.strip()))
-        print("replay: %d files in %.0f s: ok %d, failed %d (of which crashed %d, hung %d); batch deaths %d"
-              % (a.count, time.time() - t0, counts["ok"], counts["failed"], counts["crashed"],
-                 counts["hung"], sum(1 for x in bad if x.startswith("replay") and "exit" in x)), flush=True)
-
-    if not a.skip_info:
-        t0 = time.time()
-        codes = {}
-        for d in batches:
-            for f in sorted(os.listdir(d)):
-                if not f.endswith(".h5"):
-                    continue
-                p = subprocess.run([a.cli, "capture", "info", os.path.join(d, f)],
-                                   capture_output=True, text=True)
-                codes[p.returncode] = codes.get(p.returncode, 0) + 1
-                if p.returncode not in (0, 2):
-                    bad.append("capture info %s/%s: exit %d %s" % (d, f, p.returncode, p.stderr[-300:]))
-        print("capture info: %d files in %.0f s, exit codes %s"
-              % (sum(codes.values()), time.time() - t0, dict(sorted(codes.items()))), flush=True)
+    counts = {"ok": 0, "failed": 0, "crashed": 0, "hung": 0}
+    codes = {}
+    deaths = 0
+    t0 = time.time()
+    for i, d in enumerate(batches):
+        files = sorted(f for f in os.listdir(d) if f.endswith(".h5"))
+        done = d + ".done"
+        if a.resume and os.path.exists(done):
+            r = json.load(open(done))
+        else:
+            r = {"counts": {}, "codes": {}, "violations": []}
+            if not a.skip_replay:
+                c, v = replay_batch(a, d, files)
+                r["counts"] = c
+                r["violations"] += v
+            if not a.skip_info:
+                c, v = info_batch(a, d, files)
+                r["codes"] = c
+                r["violations"] += v
+            json.dump(r, open(done, "w"))
+        for k, n in r["counts"].items():
+            counts[k] += n
+        for k, n in r["codes"].items():
+            codes[k] = codes.get(k, 0) + n
+        bad += r["violations"]
+        deaths += sum(1 for x in r["violations"] if x.startswith("replay") and "exit" in x)
+        print("batch %d/%d (%.0f s): replay ok %d, failed %d (crashed %d, hung %d), batch deaths %d;"
+              " capture info exit codes %s; violations %d"
+              % (i + 1, len(batches), time.time() - t0, counts["ok"], counts["failed"],
+                 counts["crashed"], counts["hung"], deaths, dict(sorted(codes.items())), len(bad)),
+              flush=True)
 
     for x in bad[:20]:
         print("VIOLATION:", x)
-    print("soak: %d violation(s)" % len(bad))
+    print("soak: %d files, replay ok %d / failed %d (crashed %d, hung %d), batch deaths %d; "
+          "capture info exit codes %s; %d violation(s)"
+          % (sum(len([f for f in os.listdir(d) if f.endswith(".h5")]) for d in batches),
+             counts["ok"], counts["failed"], counts["crashed"], counts["hung"], deaths,
+             dict(sorted(codes.items())), len(bad)))
     return 1 if bad else 0
 
 
