@@ -2,6 +2,7 @@
 // Schema: ../shared/capture-format.md. Every violation is a CaptureError
 // naming the file, the path inside it and the problem.
 #include "acquisition/capture_file.hpp"
+#include "acquisition/utf8.hpp"
 
 #include <fcntl.h>
 #include <unistd.h>
@@ -77,7 +78,7 @@ class Reader {
       out = buf.substr(0, buf.find('\0'));
       while (!out.empty() && out.back() == ' ') out.pop_back();  // space-padded strings
     }
-    return out;
+    return utf8_or_replaced(out);
   }
 
   // A float64 attribute; integer-typed values are accepted (exactly representable numbers).

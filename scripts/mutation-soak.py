@@ -63,7 +63,7 @@ def replay_batch(a, d, files):
             os.remove(f)
     cmd = [a.cli, "replay", d, "--out", out, "--jsonl", jl, "--jobs", str(a.jobs),
            "--timeout", str(a.timeout), "--json"]
-    p = subprocess.run(cmd, capture_output=True, text=True)
+    p = subprocess.run(cmd, capture_output=True, text=True, errors="replace")
     if p.returncode not in (0, 2):
         return counts, ["replay %s: exit %d: %s" % (d, p.returncode, p.stderr[-400:])]
     lines = [json.loads(x) for x in open(jl)]
@@ -81,7 +81,7 @@ def replay_batch(a, d, files):
                 counts[kind] += 1
             if not x.get("error", {}).get("message"):
                 bad.append("replay %s: failed record without a message" % x["path"])
-    p2 = subprocess.run(cmd, capture_output=True, text=True)  # the resume
+    p2 = subprocess.run(cmd, capture_output=True, text=True, errors="replace")  # the resume
     if p2.returncode not in (0, 2):
         bad.append("resume %s: exit %d: %s" % (d, p2.returncode, p2.stderr[-400:]))
     else:
@@ -96,7 +96,7 @@ def info_batch(a, d, files):
     codes, bad = {}, []
     for f in files:
         p = subprocess.run([a.cli, "capture", "info", os.path.join(d, f)],
-                           capture_output=True, text=True)
+                           capture_output=True, text=True, errors="replace")
         codes[str(p.returncode)] = codes.get(str(p.returncode), 0) + 1
         if p.returncode not in (0, 2):
             bad.append("capture info %s/%s: exit %d %s" % (d, f, p.returncode, p.stderr[-300:]))

@@ -419,10 +419,18 @@ std::optional<update::OeResult> output_error_stage(const PipelineRequest& req, c
                   r.parameters.size(), r.evaluations, r.seconds, r.message.empty() ? "" : ": ",
                   r.message.c_str());
     out.stages.push_back({"update (output-error)", r.ok(), note});
-    if (r.ok() && r.lack_of_fit)
-      out.warnings.push_back("the output-error fit does not explain the capture (chi2/dof " +
-                             std::to_string(r.chi2_per_dof) +
-                             "): its constants are marked not identifiable; the gap diagnosis looks for the cause");
+    if (r.ok() && r.lack_of_fit) {
+      char w[320];
+      if (r.chi2_per_dof > r.chi2_limit)
+        std::snprintf(w, sizeof w, "the output-error fit does not explain the capture (chi2/dof %.3g)", r.chi2_per_dof);
+      else
+        std::snprintf(w, sizeof w,
+                      "the output-error fit does not explain the capture in %.3g-%.3g kHz (residual %.3g times "
+                      "the noise there, chance 1e%.1f)",
+                      r.band_lo_hz / 1e3, r.band_hi_hz / 1e3, r.band_excess, r.band_log10_p);
+      out.warnings.push_back(std::string(w) +
+                             ": its constants are marked not identifiable; the gap diagnosis looks for the cause");
+    }
     out.output_error = r;
     out.output_error_excitation = f.excitation;
     return r;

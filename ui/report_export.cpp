@@ -1,4 +1,5 @@
 #include "ui/report_export.hpp"
+#include "ui/json_text.hpp"
 #include "ui/output_error_json.hpp"
 
 #include <algorithm>
@@ -84,7 +85,7 @@ nlohmann::json report_json(const PipelineResult& r) {
 
 void export_json(const PipelineResult& r, const std::string& path) {
   auto f = open_out(path);
-  f << report_json(r).dump(2) << "\n";
+  f << json_text(report_json(r), 2) << "\n";
 }
 
 nlohmann::json diagnosis_json(const update::GapDiagnosis& d) {

@@ -219,6 +219,30 @@ class Problem {
     return invert();
   }
 
+  // Expected |DFT|² shape of the decimated residual (bins j = 0..M/2 of its
+  // M-point DFT) for white noise σ1 on v1 and σ2 on v2: |L|²(σ1²|T|² + σ2²),
+  // folded over the aliases of the decimation.
+  Eigen::VectorXd residual_psd(const std::vector<cd>& t, double s1, double s2) const {
+    const std::size_t m = idx_.size();
+    const double fs_dec = fs_ / double(decim_);
+    Eigen::VectorXd p = Eigen::VectorXd::Zero(static_cast<Eigen::Index>(m / 2 + 1));
+    auto at = [&](double f) {
+      const auto k = static_cast<std::size_t>(std::lround(f * double(nfft_) / fs_));
+      return k <= kmax_ ? std::norm(l_[k]) * (s1 * s1 * std::norm(t[k]) + s2 * s2) : 0.0;
+    };
+    for (std::size_t j = 0; j <= m / 2; ++j) {
+      const double f = double(j) * fs_dec / double(m);
+      double v = 0;
+      for (int a = 0; a < 8; ++a) {
+        v += at(f + a * fs_dec);
+        if (a > 0) v += at(a * fs_dec - f);
+      }
+      p[static_cast<Eigen::Index>(j)] = v;
+    }
+    return p;
+  }
+  double residual_bin_hz() const { return fs_ / double(decim_) / double(idx_.size()); }
+
   // σ of the filtered error for white noise σ1 on v1 and σ2 on v2 (Parseval).
   double propagated_sigma(const std::vector<cd>& t, double s1, double s2) const {
     double a1 = 0, a2 = 0;
@@ -281,6 +305,72 @@ double third_active_mode_hz(model::ModalSolver& solver, const MaterialClass& cls
   return f;
 }
 
+// log Q(w, x): the upper regularised incomplete gamma function for integer w,
+// the chance that a sum of w unit exponentials exceeds x.
+double log_gamma_q(int w, double x) {
+  // e^{-x} Σ_{k<w} x^k/k!, in logs
+  double best = -INFINITY;
+  std::vector<double> t(static_cast<std::size_t>(w));
+  for (int k = 0; k < w; ++k) {
+    t[static_cast<std::size_t>(k)] = (k == 0 ? 0.0 : k * std::log(std::max(x, 1e-300))) - std::lgamma(k + 1.0);
+    best = std::max(best, t[static_cast<std::size_t>(k)]);
+  }
+  double sum = 0;
+  for (double v : t) sum += std::exp(v - best);
+  return -x + best + std::log(sum);
+}
+
+struct SpectralTest {
+  double log10_p = 0;  // Bonferroni-corrected, of the most significant window
+  double f_lo = 0, f_hi = 0, excess = 1;
+  int windows = 0;
+};
+
+// Lack of fit concentrated in frequency: the residual's periodogram over its
+// expected noise shape, scaled by its own median (robust to the noise level's
+// error), summed over windows of 1..64 bins; the window least likely under
+// noise alone, its chance multiplied by the number of windows tried.
+SpectralTest spectral_lack_of_fit(const Eigen::VectorXd& r, const Eigen::VectorXd& shape, double bin_hz) {
+  SpectralTest out;
+  const std::size_t m = static_cast<std::size_t>(r.size());
+  if (m < 32) return out;
+  dsp::RealFft fft(m);
+  std::vector<cd> x(fft.bins());
+  fft.forward(r.data(), m, x.data());
+  const double top = shape.maxCoeff();
+  std::vector<double> z;
+  std::vector<std::size_t> bin;
+  for (std::size_t j = 1; j + 1 < fft.bins() && j < static_cast<std::size_t>(shape.size()); ++j) {
+    const double e = shape[static_cast<Eigen::Index>(j)];
+    if (!(e > 1e-4 * top)) continue;  // outside the band
+    z.push_back(std::norm(x[j]) / e);
+    bin.push_back(j);
+  }
+  if (z.size() < 16) return out;
+  std::vector<double> sorted = z;
+  std::nth_element(sorted.begin(), sorted.begin() + static_cast<long>(sorted.size() / 2), sorted.end());
+  const double scale = std::log(2.0) / sorted[sorted.size() / 2];
+  for (auto& v : z) v *= scale;
+  double best = 0;
+  for (int w = 1; w <= 64 && static_cast<std::size_t>(w) <= z.size(); w *= 2) {
+    const std::size_t step = std::max(1, w / 2);
+    for (std::size_t s0 = 0; s0 + static_cast<std::size_t>(w) <= z.size(); s0 += step) {
+      double sum = 0;
+      for (int i = 0; i < w; ++i) sum += z[s0 + static_cast<std::size_t>(i)];
+      ++out.windows;
+      const double lq = log_gamma_q(w, sum);
+      if (lq < best) {
+        best = lq;
+        out.f_lo = double(bin[s0]) * bin_hz;
+        out.f_hi = double(bin[s0 + static_cast<std::size_t>(w) - 1]) * bin_hz;
+        out.excess = sum / w;
+      }
+    }
+  }
+  out.log10_p = std::min(0.0, (best + std::log(double(out.windows))) / std::log(10.0));
+  return out;
+}
+
 struct LmOutcome {
   Eigen::VectorXd x;
   double cost = 0;  // ½‖r/σ‖²
@@ -328,6 +418,7 @@ OeResult fit_output_error(model::ModalSolver& solver, const MaterialClass& cls,
   // Noise of the filtered error: the shots' scatter, else the pretrigger, else
   // each channel's high-pass estimate — at the nominal model's T (recomputed
   // at the answer below).
+  double ch1 = 0, ch2 = 0;  // per-channel white noise of the (averaged) record, volts
   auto noise_sigma = [&](const std::vector<cd>& t) {
     const std::size_t n = rec.v1.size();
     if (rec.shots >= 2) {
@@ -343,6 +434,14 @@ OeResult fit_output_error(model::ModalSolver& solver, const MaterialClass& cls,
       out.noise_dof = double(m) * double(rec.shots - 1) / double(rec.shots);
       // per-shot variance ss/((K−1)·M/K·…): Σ_k ‖e_k‖² = (K−1)/K·K·M·σ², the average's σ²/K
       const double var_shot = ss / (double(m) * double(rec.shots - 1) / double(rec.shots));
+      double q1 = 0, q2 = 0;
+      for (std::size_t k = 0; k < rec.dev1.size(); ++k)
+        for (std::size_t i = 0; i < n; ++i) {
+          q1 += rec.dev1[k][i] * rec.dev1[k][i];
+          q2 += rec.dev2[k][i] * rec.dev2[k][i];
+        }
+      ch1 = std::sqrt(q1 / (double(n) * double(rec.shots - 1)) / double(rec.shots));
+      ch2 = std::sqrt(q2 / (double(n) * double(rec.shots - 1)) / double(rec.shots));
       return std::sqrt(var_shot / double(rec.shots));
     }
     double s1 = 0, s2 = 0;
@@ -365,6 +464,8 @@ OeResult fit_output_error(model::ModalSolver& solver, const MaterialClass& cls,
       // of the samples' worth of independent information.
       out.noise_dof = 0.2 * double(n);
     }
+    ch1 = s1;
+    ch2 = s2;
     return prob.propagated_sigma(t, s1, s2);
   };
   const Eigen::VectorXd x_nominal = Eigen::VectorXd::Zero(kParams);
@@ -385,10 +486,43 @@ OeResult fit_output_error(model::ModalSolver& solver, const MaterialClass& cls,
     out.noise_source = "none measurable (noise-free data)";
   }
 
+  // The DAQ offsets. Removed with the pretrigger's mean, each channel keeps an
+  // error of σ_raw/√P, constant over the record: in the filtered error a
+  // component along u = L ∗ 1 (v1's offset reaches v2 through T, which is 1
+  // at low frequency) of variance τ² = (σ1² + σ2²)/P — correlated noise that
+  // white weighting would count as lack of fit. It is marginalised: the
+  // residual is whitened with the covariance σ²I + τ²uuᵀ (its component along
+  // u shrunk by 1/√(1 + τ²uᵀu/σ²)). Without a pretrigger the offsets are
+  // unknown (τ = ∞): the component is projected out, one degree of freedom less.
+  const Eigen::VectorXd u_offset = [&] {
+    const std::vector<double> zero(rec.v1.size(), 0.0), one(rec.v1.size(), 1.0);
+    return Eigen::VectorXd(-prob.deviation(*t_nominal, zero, one));
+  }();
+  double offset_shrink = 1.0;  // 1 − 1/√(1 + τ²uᵀu/σ²): the share of the u component removed
+  int offset_dof = 1;
+  if (rec.pretrigger >= 16 && rec.pretrigger < rec.v1.size()) {
+    double s1 = 0, s2 = 0;  // the (averaged) record's idle noise: its mean was removed
+    for (std::size_t i = 0; i < rec.pretrigger; ++i) {
+      s1 += rec.v1[i] * rec.v1[i];
+      s2 += rec.v2[i] * rec.v2[i];
+    }
+    const double p = double(rec.pretrigger);
+    const double tau2 = (s1 + s2) / (p - 1.0) / p;
+    offset_shrink = 1.0 - 1.0 / std::sqrt(1.0 + tau2 * u_offset.squaredNorm() / (sigma * sigma));
+    offset_dof = 0;
+    out.offset_model = "pretrigger mean removed, its error marginalised";
+  } else {
+    out.offset_model = "unknown (no pretrigger): projected out";
+  }
+  const double uu = u_offset.squaredNorm();
+  auto whiten = [&](Eigen::VectorXd r) {
+    if (uu > 0 && offset_shrink > 0) r -= (offset_shrink * u_offset.dot(r) / uu) * u_offset;
+    return r;
+  };
   auto weighted = [&](const Eigen::VectorXd& x) -> std::optional<Eigen::VectorXd> {
     auto r = prob.residual(x);
     if (!r) return std::nullopt;
-    *r /= sigma;
+    *r = whiten(std::move(*r)) / sigma;
     if (!r->allFinite()) return std::nullopt;
     return r;
   };
@@ -417,7 +551,7 @@ OeResult fit_output_error(model::ModalSolver& solver, const MaterialClass& cls,
   // stalls far above it (its cost gap to the lead above max(50, 10·s²) and
   // shrinking by less than a tenth per iteration: a local optimum the data
   // reject, which the honesty check below ignores anyway).
-  const double dof_fit = std::max(1.0, double(prob.samples()) - kParams);
+  const double dof_fit = std::max(1.0, double(prob.samples()) - kParams - offset_dof);
   auto levenberg_marquardt = [&](Eigen::VectorXd x, const LmOutcome* lead) {
     LmOutcome o;
     auto r = weighted(x);
@@ -589,7 +723,7 @@ OeResult fit_output_error(model::ModalSolver& solver, const MaterialClass& cls,
     }
   }
   const int m = out.residual_samples;
-  const double dof = std::max(1, m - kParams);
+  const double dof = std::max(1, m - kParams - offset_dof);
   out.noise_rms_v = sigma;
   out.chi2_per_dof = 2.0 * best.cost / dof;
   out.residual_rms_v = sigma * std::sqrt(2.0 * best.cost / m);
@@ -619,7 +753,7 @@ OeResult fit_output_error(model::ModalSolver& solver, const MaterialClass& cls,
         if (!(scale > 0)) continue;
         const auto tb = prob.transfer(best.x, b);
         if (!tb) continue;
-        const Eigen::VectorXd drb = (prob.residual_of(*tb) - r0) / sigma;  // ∂r/∂b·δb, weighted
+        const Eigen::VectorXd drb = whiten(prob.residual_of(*tb) - r0) / sigma;  // ∂r/∂b·δb, weighted
         const Eigen::VectorXd dx = -ldlt.solve(jb.transpose() * drb) * scale;  // shift per 1 sigma of b
         if (dx.allFinite()) cov += dx * dx.transpose();
       }
@@ -630,7 +764,17 @@ OeResult fit_output_error(model::ModalSolver& solver, const MaterialClass& cls,
   out.chi2_limit = 1.0 + opt.lack_of_fit_z *
                              std::sqrt(2.0 / dof + (out.noise_dof > 0 ? 2.0 / out.noise_dof : 0.0));
   out.lack_of_fit = out.chi2_per_dof > out.chi2_limit;
-  out.correlation = Eigen::MatrixXd::Identity(kParams, kParams);
+  // … or concentrated in frequency, where the global χ² dilutes it among
+  // thousands of noise samples (an end mass shifting a few modes).
+  if (t_best && best.r.size() > 0) {
+    const auto st = spectral_lack_of_fit(best.r, prob.residual_psd(*t_best, ch1, ch2), prob.residual_bin_hz());
+    out.band_log10_p = st.log10_p;
+    out.band_excess = st.excess;
+    out.band_lo_hz = st.f_lo;
+    out.band_hi_hz = st.f_hi;
+    out.band_windows = st.windows;
+    out.lack_of_fit = out.lack_of_fit || st.log10_p < std::log10(opt.lack_of_fit_p);
+  }  out.correlation = Eigen::MatrixXd::Identity(kParams, kParams);
   for (int a = 0; a < kParams; ++a)
     for (int b = 0; b < kParams; ++b)
       if (a != b) out.correlation(a, b) = cov(a, b) / (sx[a] * sx[b]);
@@ -671,11 +815,20 @@ OeResult fit_output_error(model::ModalSolver& solver, const MaterialClass& cls,
     } else if (out.lack_of_fit) {
       p.status = "not identifiable";
       p.reason = "lack of fit";
-      std::snprintf(buf, sizeof buf,
-                    "the model class does not explain this capture (chi2/dof %.3g, the noise alone "
-                    "allows up to %.3g): an effect outside the model biases every constant; find it "
-                    "(gap diagnosis) or measure the fixture (calibration shots)",
-                    out.chi2_per_dof, out.chi2_limit);
+      if (out.chi2_per_dof > out.chi2_limit)
+        std::snprintf(buf, sizeof buf,
+                      "the model class does not explain this capture (chi2/dof %.3g, the noise alone "
+                      "allows up to %.3g): an effect outside the model biases every constant; find it "
+                      "(gap diagnosis) or measure the fixture (calibration shots)",
+                      out.chi2_per_dof, out.chi2_limit);
+      else
+        std::snprintf(buf, sizeof buf,
+                      "the model class does not explain this capture in %.3g-%.3g kHz (residual power "
+                      "%.3g times the noise's there, a chance of 1e%.1f under noise alone; chi2/dof "
+                      "%.3g overall): an effect outside the model (an end mass, a skew) biases every "
+                      "constant; find it (gap diagnosis) or measure the fixture (calibration shots)",
+                      out.band_lo_hz / 1e3, out.band_hi_hz / 1e3, out.band_excess, out.band_log10_p,
+                      out.chi2_per_dof);
       p.note = buf;
     } else if (rel > rows[i].limit) {
       p.status = "not identifiable";

@@ -5,6 +5,7 @@
 #include <filesystem>
 
 #include "acquisition/capture_file.hpp"
+#include "acquisition/utf8.hpp"
 #include "tests/support/capture_mutations.hpp"
 
 namespace fs = std::filesystem;
@@ -200,4 +201,32 @@ TEST(CaptureWriter, RefusesInvalidSetup) {
   EXPECT_THROW(acq::CaptureWriter(dir / "w.h5", s), acq::CaptureError);
   EXPECT_FALSE(fs::exists(dir / "w.h5"));
   fs::remove_all(dir);
+}
+
+// Strings written by other tools (Latin-1, damaged bytes, terminal escapes)
+// are read, each offending byte replaced by U+FFFD, so that JSON output and
+// terminals get valid text (found by the mutation soak: `capture info --json`
+// died on a software attribute holding byte 0x87).
+TEST(CaptureFile, StringsThatAreNotUtf8AreReadWithReplacementCharacters) {
+  auto dir = tmp_dir();
+  acq::Capture cap = test::small_valid_capture(100);
+  cap.setup.notes = std::string("line one\nline two\t\xC2\xB5V \xCE\xA9 \xF0\x9F\x94\x8A ok");  // valid UTF-8
+  cap.setup.transducer_id = std::string("tube \xB5-7 \x1b[31mred");  // Latin-1 µ, an escape
+  acq::write_capture(dir / "s.h5", cap);
+  const auto back = acq::read_capture(dir / "s.h5");
+  EXPECT_EQ(back.setup.notes, cap.setup.notes);  // valid text is kept byte for byte
+  EXPECT_EQ(back.setup.transducer_id, std::string("tube \xEF\xBF\xBD-7 \xEF\xBF\xBD[31mred"));
+  fs::remove_all(dir);
+}
+
+TEST(Utf8, MalformedSequencesAreReplacedBytePerByte) {
+  const std::string r = "\xEF\xBF\xBD";
+  EXPECT_EQ(acq::utf8_or_replaced("plain"), "plain");
+  EXPECT_EQ(acq::utf8_or_replaced("\xC0\x80"), r + r);              // overlong NUL
+  EXPECT_EQ(acq::utf8_or_replaced("\xED\xA0\x80"), r + r + r);      // a UTF-16 surrogate
+  EXPECT_EQ(acq::utf8_or_replaced("a\xE2\x82"), "a" + r + r);      // cut short
+  EXPECT_EQ(acq::utf8_or_replaced("\xF4\x90\x80\x80"), r + r + r + r);  // above U+10FFFF
+  EXPECT_EQ(acq::utf8_or_replaced("\xE2\x82\xAC"), "\xE2\x82\xAC");  // the euro sign
+  EXPECT_EQ(acq::utf8_or_replaced(std::string("a\0b", 3)), "a" + r + "b");
+  EXPECT_EQ(acq::utf8_or_replaced("\x7F"), r);
 }

@@ -101,3 +101,25 @@ TEST(Cli, DemoRuns) {
   auto j = nlohmann::json::parse(r.out);
   EXPECT_TRUE(fs::exists(j["capture"].get<std::string>()));
 }
+
+// A file name that is not UTF-8 (Linux names are bytes) and a capture whose
+// strings are not: the JSON output replaces the bytes with U+FFFD instead of
+// ending in an internal error after the work is done (found by the mutation
+// soak, scripts/mutation-soak.py).
+TEST(Cli, CaptureInfoJsonOnANameAndStringsThatAreNotUtf8) {
+  const fs::path dir = tmp_dir() / "utf8";
+  fs::create_directories(dir);
+  acq::Capture cap = test::small_valid_capture(100);
+  cap.setup.transducer_id = std::string("tube \xB5-7");  // Latin-1 µ
+  const fs::path file = dir / std::string("latin1-\xFF.h5");
+  acq::write_capture(file, cap);
+  for (const char* cmd : {"capture info --json ", "impedance --json "}) {
+    auto r = test::run_cli(cmd + std::string("'") + file.string() + "'");
+    ASSERT_EQ(r.exit_code, 0) << cmd << r.err;
+    nlohmann::json j;
+    ASSERT_NO_THROW(j = nlohmann::json::parse(r.out)) << cmd;
+    const std::string name = j.contains("file") ? j["file"].get<std::string>() : j.dump();
+    EXPECT_NE(name.find("latin1-\xEF\xBF\xBD.h5"), std::string::npos) << cmd;
+  }
+  fs::remove_all(dir);
+}

@@ -1,4 +1,5 @@
 #include "ui/cli/cli_common.hpp"
+#include "ui/json_text.hpp"
 
 #include <unistd.h>
 
@@ -42,7 +43,10 @@ int run_command(Context& ctx, const std::function<void()>& body) {
 }
 
 // Streamed (no serialised copy in memory: a 250 000-bin spectrum is ~100 MB of text).
-void print_json(const nlohmann::json& j) { std::cout << std::setw(2) << j << std::endl; }
+void print_json(const nlohmann::json& j) {
+  ui::write_json(std::cout, j);
+  std::cout << std::endl;
+}
 
 void add_json_flag(CLI::App* cmd, Context& ctx) {
   cmd->add_flag("--json", ctx.json, "Machine-readable JSON output on stdout");

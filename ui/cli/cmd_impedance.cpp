@@ -12,6 +12,7 @@
 #include <memory>
 
 #include "acquisition/capture_file.hpp"
+#include "ui/json_text.hpp"
 #include "acquisition/contained_read.hpp"
 #include "acquisition/divider_record.hpp"
 #include "acquisition/impedance_assessment.hpp"
@@ -324,7 +325,8 @@ void run(const ImpedanceArgs& a, Context& ctx) {
                             {"abs_sigma_ohm", std::vector<double>(band->abs_sigma_ohm.data(), band->abs_sigma_ohm.data() + band->size())}};
     }
     if (ctx.json) {
-      *os << std::setw(2) << j << std::endl;  // streamed, no serialised copy
+      ui::write_json(*os, j);  // streamed, no serialised copy
+      *os << std::endl;
     } else {
       print_text(j);
       print_trust(j);

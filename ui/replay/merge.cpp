@@ -1,4 +1,5 @@
 #include "ui/replay/merge.hpp"
+#include "ui/json_text.hpp"
 
 #include <fstream>
 #include <map>
@@ -88,7 +89,7 @@ MergeSummary merge_results(const MergeOptions& opt) {
     std::ofstream f(*opt.jsonl, std::ios::trunc);
     if (!f) throw std::invalid_argument("--jsonl: cannot write " + opt.jsonl->string());
     acq::for_each_result(opt.out,
-                         [&](const acq::ResultRecord& r) { f << record_json(r).dump() << "\n"; });
+                         [&](const acq::ResultRecord& r) { f << ui::json_text(record_json(r)) << "\n"; });
     if (!f.flush()) throw std::runtime_error("--jsonl: cannot write " + opt.jsonl->string());
   }
   if (opt.report_dir) write_batch_summary(opt.out, *opt.report_dir);

@@ -1,4 +1,5 @@
 #include "ui/replay/replay_batch.hpp"
+#include "ui/json_text.hpp"
 
 #include <chrono>
 #include <fstream>
@@ -108,7 +109,7 @@ class Sink {
  private:
   void line(const acq::ResultRecord& rec) {
     if (!jsonl_.is_open()) return;
-    jsonl_ << record_json(rec).dump() << "\n";
+    jsonl_ << ui::json_text(record_json(rec)) << "\n";
     jsonl_.flush();
   }
 

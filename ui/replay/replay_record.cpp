@@ -1,4 +1,5 @@
 #include "ui/replay/replay_record.hpp"
+#include "ui/json_text.hpp"
 
 #include "ui/replay/sha256.hpp"
 #include "ui/report_export.hpp"
@@ -20,7 +21,7 @@ acq::ResultRecord ok_record(const std::string& path, const std::string& sha256,
   rec.elapsed_s = elapsed_s;
   nlohmann::json j = {{"path", path}, {"sha256", sha256}, {"status", "ok"}, {"material", material}};
   j["result"] = ui::report_json(r);
-  rec.result_json = j.dump();
+  rec.result_json = ui::json_text(j);
   for (const auto& c : r.curves) rec.curves.push_back({c.label, c.f_hz, c.z_ohm});
   return rec;
 }
@@ -36,7 +37,7 @@ acq::ResultRecord failed_record(const std::string& path, const std::string& sha2
   rec.elapsed_s = elapsed_s;
   nlohmann::json j = {{"path", path}, {"sha256", sha256}, {"status", "failed"}};
   j["error"] = {{"kind", kind}, {"message", message}};
-  rec.result_json = j.dump();
+  rec.result_json = ui::json_text(j);
   return rec;
 }
 
