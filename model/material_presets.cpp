@@ -86,4 +86,12 @@ const MaterialPreset& find_preset(std::string_view name) {
                               "' (known: " + known + ")");
 }
 
+std::vector<std::string> presets_named_in(std::string_view text) {
+  const std::string t = key(text);
+  std::vector<std::string> out;
+  for (const auto& p : material_presets())
+    if (t.find(p.name) != std::string::npos) out.push_back(p.name);
+  return out;
+}
+
 }  // namespace piezo::model

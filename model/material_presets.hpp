@@ -22,5 +22,9 @@ const std::vector<MaterialPreset>& material_presets();
 // Case-insensitive; '-' and '_' ignored ("PZT-5H" == "pzt5h"). Throws
 // std::invalid_argument listing the known names when not found.
 const MaterialPreset& find_preset(std::string_view name);
+// The presets whose name appears inside a free text ("PZT-5A class (APC850)
+// radially poled tube" names pzt5a and apc850), matched as find_preset does
+// (case, '-', '_' and blanks ignored), in the order of material_presets().
+std::vector<std::string> presets_named_in(std::string_view text);
 
 }  // namespace piezo::model

@@ -1,6 +1,6 @@
 #include "ui/report_export.hpp"
-#include "ui/json_text.hpp"
 #include "ui/output_error_json.hpp"
+#include "ui/json_text.hpp"
 
 #include <algorithm>
 #include <cmath>

@@ -1,5 +1,4 @@
 #include "ui/cli/cli_common.hpp"
-#include "ui/json_text.hpp"
 
 #include <unistd.h>
 
@@ -8,6 +7,7 @@
 #include <iostream>
 
 #include "acquisition/capture.hpp"
+#include "ui/json_text.hpp"
 
 namespace piezo::cli {
 

@@ -17,6 +17,7 @@
 #include "acquisition/capture_file.hpp"
 #include "acquisition/contained_read.hpp"
 #include "model/material_presets.hpp"
+#include "ui/nominal_material.hpp"
 #include "ui/cli/cli_common.hpp"
 #include "ui/cli/diagnosis_text.hpp"
 #include "ui/pipeline.hpp"
@@ -74,18 +75,15 @@ void require_repeated_shots(const acq::Capture& cap, const std::string& path) {
         "(it measures the noise from them): record more with `piezobench measure --shots N`");
 }
 
-// The nominal material: --material, else the one the capture names.
-std::string nominal_material(const DiagnoseArgs& a, const acq::Capture& fit) {
-  std::string m = a.material;
-  if (m.empty()) {
-    m = fit.setup.material.value_or("");
-    if (m.empty())
-      throw InputError(
-          a.fit +
-          ": the capture names no material (/setup/material); give --material, e.g. apc850");
+// The nominal material: --material, else the one the capture names (a
+// description naming a preset, or none, is a warning: ui/nominal_material.hpp).
+std::string nominal_material(const DiagnoseArgs& a, const acq::Capture& fit, std::vector<std::string>& warnings) {
+  const auto nm = ui::nominal_material(a.material, fit.setup.material);
+  if (nm.warning) {
+    std::fprintf(stderr, "piezobench: diagnose: %s: %s\n", a.fit.c_str(), nm.warning->c_str());
+    warnings.push_back(*nm.warning);
   }
-  (void)model::find_preset(m);  // unknown: std::invalid_argument listing the presets (exit 2)
-  return m;
+  return nm.name;
 }
 
 void check_candidates(const std::vector<std::string>& c) {
@@ -155,7 +153,8 @@ void run_diagnose(Context& ctx, const DiagnoseArgs& a) {
       throw InputError("--plot " + a.plot + ": no folder " + dir.string());
   }
   const acq::Capture fit_attrs = capture_attributes(a.fit);
-  const std::string material = nominal_material(a, fit_attrs);
+  std::vector<std::string> material_warnings;
+  const std::string material = nominal_material(a, fit_attrs, material_warnings);
   require_repeated_shots(fit_attrs, a.fit);
   if (!a.holdout.empty()) require_repeated_shots(capture_attributes(a.holdout), a.holdout);
 
@@ -176,6 +175,7 @@ void run_diagnose(Context& ctx, const DiagnoseArgs& a) {
       throw InputError(a.fit + ": " + e.what());
     }
   }
+  res.warnings.insert(res.warnings.begin(), material_warnings.begin(), material_warnings.end());
   if (!res.diagnosis) throw InputError(a.fit + ": " + why_not_diagnosed(res));
   const auto& d = *res.diagnosis;
   if (!a.holdout.empty() && d.n_heldout == 0)

@@ -12,7 +12,6 @@
 #include <memory>
 
 #include "acquisition/capture_file.hpp"
-#include "ui/json_text.hpp"
 #include "acquisition/contained_read.hpp"
 #include "acquisition/divider_record.hpp"
 #include "acquisition/impedance_assessment.hpp"
@@ -25,6 +24,7 @@
 #include "dsp/stepped_sine.hpp"
 #include "ui/assessment_json.hpp"
 #include "ui/cli/cli_common.hpp"
+#include "ui/json_text.hpp"
 
 namespace piezo::cli {
 

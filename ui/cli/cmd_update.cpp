@@ -29,7 +29,7 @@ namespace pm = piezo::model;
 namespace pu = piezo::update;
 
 struct UpdateArgs {
-  std::string file, resonances, antiresonances, low_z, material = "apc850", set, method;
+  std::string file, resonances, antiresonances, low_z, material, set, method;
   std::string overlay, damping, capacitance = "fe";
   bool isotropic = false, cross_modes = false, transverse = false;
   int max_iterations = pu::CmcmOptions{}.max_iterations;
@@ -105,7 +105,7 @@ void run_update_features(Context& ctx, const UpdateArgs& a0, const std::string& 
   if (a.capacitance != "fe" && a.capacitance != "analytic")
     throw InputError("--capacitance must be fe or analytic");
   if (a.max_iterations < 1) throw InputError("--max-iterations must be >= 1");
-  const auto& preset = pm::find_preset(a.material);
+  const auto& preset = pm::find_preset(a.material.empty() ? "apc850" : a.material);
   pm::TubeGeometry geometry;
   geometry.density_kg_m3 = preset.density_kg_m3;
 
@@ -355,8 +355,8 @@ void register_update_command(CLI::App& app, Context& ctx) {
   cmd->add_option("--resonances", a->resonances, "Resonances F1,F2,… [Hz]");
   cmd->add_option("--antiresonances", a->antiresonances, "Anti-resonances F1,F2,… [Hz]");
   cmd->add_option("--low-z", a->low_z, "|Z| at a low frequency, OHM@HZ (e.g. 26804@400)");
-  cmd->add_option("--material", a->material, "Material preset of the original model")
-      ->capture_default_str();
+  cmd->add_option("--material", a->material,
+                  "Material preset of the original model (default: a capture's /setup/material, else apc850)");
   cmd->add_flag("--isotropic", a->isotropic,
                 "Isotropic-simplification class (seed §6.4.3; a capture's default)");
   cmd->add_option("--set", a->set, "Original parameters: YE11=…,nu12=…,d31=…,epsT33_rel=…");

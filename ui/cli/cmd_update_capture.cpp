@@ -16,6 +16,7 @@
 #include "model/material_spec.hpp"
 #include "model/tube_model.hpp"
 #include "ui/capture_fit.hpp"
+#include "ui/nominal_material.hpp"
 #include "ui/output_error_json.hpp"
 #include "update/least_squares.hpp"
 #include "update/updater.hpp"
@@ -89,10 +90,14 @@ nlohmann::json feature_methods(const acq::Capture& cap, const std::string& mater
 }  // namespace
 
 void run_update_capture(Context& ctx, const std::string& file, const std::string& method,
-                        const std::string& material, bool isotropic) {
+                        const std::string& material_option, bool isotropic) {
   if (method != "oe" && method != "cmcm" && method != "lm" && method != "all")
     throw InputError("--method for a capture must be oe, cmcm, lm or all");
   const auto cap = acq::read_capture_contained(file);  // a crash of libhdf5 costs the file only
+  // --material, else the capture's own (a description naming a preset, or none: a warning).
+  const auto nm = ui::nominal_material(material_option, cap.setup.material);
+  const std::string& material = nm.name;
+  if (nm.warning) std::fprintf(stderr, "piezobench: update: %s: %s\n", file.c_str(), nm.warning->c_str());
   ui::CaptureFitRequest req;
   req.material = material;
   req.isotropic = isotropic;
@@ -101,6 +106,7 @@ void run_update_capture(Context& ctx, const std::string& file, const std::string
   out["method"] = method;
   out["model_class"] = isotropic ? "isotropic" : "transversely_isotropic";
   out["material"] = material;
+  if (nm.warning) out["warnings"].push_back(*nm.warning);
   // (an unknown material throws here: exit 2)
   out["original"] = params_of(pm::isotropic_params(pm::resolve_material({material, isotropic, ""}).d));
   nlohmann::json methods;

@@ -1,5 +1,4 @@
 #include "ui/replay/merge.hpp"
-#include "ui/json_text.hpp"
 
 #include <fstream>
 #include <map>
@@ -9,6 +8,7 @@
 #include "acquisition/results_file.hpp"
 #include "ui/replay/replay_batch.hpp"
 #include "ui/replay/replay_record.hpp"
+#include "ui/json_text.hpp"
 
 namespace piezo::replay {
 

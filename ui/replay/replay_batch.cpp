@@ -1,5 +1,4 @@
 #include "ui/replay/replay_batch.hpp"
-#include "ui/json_text.hpp"
 
 #include <chrono>
 #include <fstream>
@@ -26,6 +25,8 @@
 #include "ui/replay/sha256.hpp"
 #include "ui/report/batch_summary.hpp"
 #include "ui/report/capture_report.hpp"
+#include "ui/json_text.hpp"
+#include "ui/nominal_material.hpp"
 
 namespace piezo::replay {
 
@@ -183,11 +184,14 @@ Outcome replay_capture(const fs::path& file, const ReplayOptions& opt, const Sin
   ui::PipelineResult result;
   try {
     stage("reading", sha);
+    std::optional<std::string> material_warning;
     if (material.empty()) {
       acq::ReadOptions ro;
       ro.load_samples = false;  // attributes only: which nominal model to update
       ro.skip_invalid_shots = true;
-      material = acq::read_capture(file, ro).setup.material.value_or("apc850");
+      const auto nm = ui::nominal_material("", acq::read_capture(file, ro).setup.material);
+      material = nm.name;
+      material_warning = nm.warning;
     }
     stage("processing", sha);
     ui::PipelineRequest req;
@@ -197,6 +201,7 @@ Outcome replay_capture(const fs::path& file, const ReplayOptions& opt, const Sin
     req.isotropic = opt.isotropic;
     req.seed_chain = opt.seed_chain;
     result = ui::run_pipeline(req, nullptr, cancel);
+    if (material_warning) result.warnings.insert(result.warnings.begin(), *material_warning);
   } catch (const acq::CaptureError& e) {
     return fail(sha, "bad capture", e.what());
   } catch (const std::invalid_argument& e) {

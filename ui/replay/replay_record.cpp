@@ -1,8 +1,8 @@
 #include "ui/replay/replay_record.hpp"
-#include "ui/json_text.hpp"
 
 #include "ui/replay/sha256.hpp"
 #include "ui/report_export.hpp"
+#include "ui/json_text.hpp"
 
 namespace piezo::replay {
 
