@@ -66,8 +66,13 @@ def replay_batch(a, d, files):
     p = subprocess.run(cmd, capture_output=True, text=True, errors="replace")
     if p.returncode not in (0, 2):
         return counts, ["replay %s: exit %d: %s" % (d, p.returncode, p.stderr[-400:])]
+    shutil.copyfile(jl, d + ".first.jsonl")  # the resume below rewrites jl
     lines = [json.loads(x) for x in open(jl)]
     seen = {os.path.basename(x["path"]) for x in lines}
+    if len(lines) != len(seen):
+        twice = sorted({os.path.basename(x["path"]) for x in lines
+                        if sum(1 for y in lines if y["path"] == x["path"]) > 1})
+        bad.append("replay %s: %d records for %d files (twice: %s)" % (d, len(lines), len(seen), twice[:5]))
     missing = [f for f in files if f not in seen]
     if missing:
         bad.append("replay %s: no record for %s" % (d, missing[:5]))
@@ -77,7 +82,7 @@ def replay_batch(a, d, files):
         else:
             counts["failed"] += 1
             kind = x.get("error", {}).get("kind", "")
-            if kind in counts:
+            if kind in ("crashed", "hung"):
                 counts[kind] += 1
             if not x.get("error", {}).get("message"):
                 bad.append("replay %s: failed record without a message" % x["path"])
