@@ -405,6 +405,7 @@ std::optional<update::OeResult> output_error_stage(const PipelineRequest& req, c
   CaptureFitRequest cr;
   cr.material = req.material;
   cr.isotropic = req.isotropic;
+  cr.options = req.oe_options;
   if (req.use_calibration) cr.fixture = out.fixture;
   try {
     const CaptureFit f = fit_capture(cap, cr, cm);

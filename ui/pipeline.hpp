@@ -60,6 +60,9 @@ struct PipelineRequest {
   // Also run least squares (LM) on the seed's features beside extended CMCM
   // (the demo's comparison table); otherwise LM runs only where CMCM fails.
   bool compare_lm = false;
+  // The output-error fit's options: the measurement chain's stated
+  // tolerances (`--r1-tolerance` …, ui/cli/cli_common.hpp) among them.
+  update::OeOptions oe_options;
 };
 
 struct Curve {

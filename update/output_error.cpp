@@ -400,6 +400,10 @@ OeResult fit_output_error(model::ModalSolver& solver, const MaterialClass& cls,
   OeResult out;
   out.original = nominal;
   out.shots_used = rec.shots;
+  out.r1_rel_sigma = opt.r1_rel_sigma;
+  out.cp_sigma_f = opt.cp_sigma_f;
+  out.gain_rel_sigma = opt.gain_rel_sigma;
+  out.skew_sigma_s = opt.skew_sigma_s;
   Coordinates5 co{nominal, opt.beta0_s};
   try {
     out.band_hz = opt.band_hz > 0 ? opt.band_hz

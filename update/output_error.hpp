@@ -140,6 +140,8 @@ struct OeResult {
   std::vector<TubeParams> optima;            // every refined start's optimum (best first)
   std::vector<double> optima_cost;
   double seconds = 0;
+  // The chain tolerances the sigmas hold (OeOptions, or a measured fixture's).
+  double r1_rel_sigma = 0, cp_sigma_f = 0, gain_rel_sigma = 0, skew_sigma_s = 0;
   bool ok() const { return status == UpdateStatus::converged; }
 };
 

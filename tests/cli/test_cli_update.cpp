@@ -87,3 +87,26 @@ TEST(CliUpdate, NonConvergenceExitsOneWithTheResult) {
 }
 
 }  // namespace
+
+// The measurement chain's stated tolerances (issue 17): R1's enters εT33's
+// sigma one for one (Z scales with R1, and so does C0), and the JSON says
+// which tolerances the sigmas hold.
+TEST(CliUpdate, ChainTolerancesAreOptionsAndWidenTheSigmasTheyAlias) {
+  const std::string cap = std::string(PIEZO_SOURCE_DIR) + "/fixtures/h5py-bvd-exp-decay.h5";
+  auto sigma_eps = [&](const std::string& opt) {
+    const auto r = run_cli("update " + cap + " --method oe --json " + opt);
+    EXPECT_EQ(r.exit_code, 0) << r.err;
+    const auto j = nlohmann::json::parse(r.out);
+    for (const auto& p : j["parameters"])
+      if (p["name"] == "epsT33_rel") return std::make_pair(p["sigma"].get<double>() / p["value"].get<double>(), j);
+    ADD_FAILURE() << "no epsT33_rel";
+    return std::make_pair(0.0, j);
+  };
+  const auto [tight, jt] = sigma_eps("--r1-tolerance 0.001 --cp-sigma 0 --gain-tolerance 0");
+  const auto [loose, jl] = sigma_eps("--r1-tolerance 0.05 --cp-sigma 0 --gain-tolerance 0");
+  EXPECT_EQ(jl["fit"]["chain_tolerances"]["r1_rel_sigma"], 0.05);
+  EXPECT_EQ(jt["fit"]["chain_tolerances"]["cp_sigma_f"], 0.0);
+  EXPECT_GT(loose, 0.045);  // ≈ R1's 5 % (plus the noise's part)
+  EXPECT_LT(tight, loose / 5);
+  EXPECT_EQ(run_cli("update " + cap + " --method oe --r1-tolerance -1").exit_code, 2);
+}

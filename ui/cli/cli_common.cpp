@@ -8,6 +8,7 @@
 
 #include "acquisition/capture.hpp"
 #include "ui/json_text.hpp"
+#include "update/output_error.hpp"
 
 namespace piezo::cli {
 
@@ -46,6 +47,23 @@ int run_command(Context& ctx, const std::function<void()>& body) {
 void print_json(const nlohmann::json& j) {
   ui::write_json(std::cout, j);
   std::cout << std::endl;
+}
+
+void add_chain_tolerance_options(CLI::App* cmd, update::OeOptions& o) {
+  cmd->add_option("--r1-tolerance", o.r1_rel_sigma,
+                  "Standard uncertainty of R1, a fraction (the samples cannot tell it from the constants)")
+      ->check(CLI::Range(0.0, 0.5))
+      ->capture_default_str();
+  cmd->add_option("--cp-sigma", o.cp_sigma_f,
+                  "Standard uncertainty of the capacitance across the transducer (cable, DAQ input), F")
+      ->check(CLI::Range(0.0, 1e-6))
+      ->capture_default_str();
+  cmd->add_option("--gain-tolerance", o.gain_rel_sigma, "Standard uncertainty of the channels' gain ratio, a fraction")
+      ->check(CLI::Range(0.0, 0.5))
+      ->capture_default_str();
+  cmd->add_option("--skew-sigma", o.skew_sigma_s, "Standard uncertainty of the channels' skew, s")
+      ->check(CLI::Range(0.0, 1e-3))
+      ->capture_default_str();
 }
 
 void add_json_flag(CLI::App* cmd, Context& ctx) {

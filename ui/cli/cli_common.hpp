@@ -7,6 +7,10 @@
 #include <nlohmann/json.hpp>
 #include <string>
 
+namespace piezo::update {
+struct OeOptions;
+}
+
 namespace piezo::cli {
 
 enum ExitCode : int { kOk = 0, kInternal = 1, kBadInput = 2 };
@@ -29,6 +33,10 @@ void print_json(const nlohmann::json& j);
 
 // Every command takes --json (also accepted before the command name).
 void add_json_flag(CLI::App* cmd, Context& ctx);
+// The measurement chain's tolerances that the output-error fit carries into
+// every sigma (update::OeOptions): --r1-tolerance, --cp-sigma,
+// --gain-tolerance, --skew-sigma, defaults as OeOptions states them.
+void add_chain_tolerance_options(CLI::App* cmd, update::OeOptions& o);
 
 // Text progress bar on stderr (only when stderr is a terminal or forced).
 class ProgressBar {

@@ -35,6 +35,7 @@ struct DiagnoseArgs {
   std::string fit, holdout, material, plot, plot_size = "1200x800";
   std::vector<std::string> candidates;
   bool isotropic = false, transverse = false;
+  update::OeOptions oe;
 };
 
 void require_file(const std::string& path, const char* what) {
@@ -164,6 +165,7 @@ void run_diagnose(Context& ctx, const DiagnoseArgs& a) {
   req.material = material;
   req.isotropic = !a.transverse;
   req.gap_candidates = a.candidates;
+  req.oe_options = a.oe;
   std::atomic<bool> cancel{false};
   ui::PipelineResult res;
   {
@@ -235,6 +237,7 @@ void register_diagnose_command(CLI::App& app, Context& ctx) {
   c->add_option("--candidates", a->candidates,
                 "Effects to try, comma-separated (default: all supported)")
       ->delimiter(',');
+  add_chain_tolerance_options(c, a->oe);
   add_json_flag(c, ctx);
   c->callback([&ctx, a] { ctx.exit_code = run_command(ctx, [&] { run_diagnose(ctx, *a); }); });
 }

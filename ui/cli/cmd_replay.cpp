@@ -64,6 +64,7 @@ void register_replay_commands(CLI::App& app, Context& ctx) {
     double timeout_s = 600.0;
     bool transverse = false;
     bool seed_chain = false;
+    update::OeOptions oe;
   };
   auto a = std::make_shared<Args>();
   r->add_option("PATH", a->inputs, "Capture files and folders (searched recursively for *.h5)")
@@ -91,6 +92,7 @@ void register_replay_commands(CLI::App& app, Context& ctx) {
   r->add_flag("--seed-chain", a->seed_chain,
               "Also run the seed's chain (Prony features -> extended CMCM, LM where it fails) beside the "
               "output-error fit; its constants go into parameters[].cmcm");
+  add_chain_tolerance_options(r, a->oe);
   add_json_flag(r, ctx);
   r->callback([&ctx, a] {
     ctx.exit_code = run_command(ctx, [&] {
@@ -103,6 +105,7 @@ void register_replay_commands(CLI::App& app, Context& ctx) {
       if (!a->report.empty()) opt.report_dir = a->report;
       if (!a->jsonl.empty()) opt.jsonl = a->jsonl;
       opt.material = a->material;
+      opt.oe_options = a->oe;
       opt.isotropic = !a->transverse;
       opt.seed_chain = a->seed_chain;
       opt.software = std::string("piezobench ") + kVersion + " replay";

@@ -18,6 +18,7 @@
 #include "ui/cli/cmd_update_capture.hpp"
 #include "update/impedance_file.hpp"
 #include "update/least_squares.hpp"
+#include "update/output_error.hpp"
 #include "update/rayleigh.hpp"
 #include "update/updater.hpp"
 
@@ -32,6 +33,7 @@ struct UpdateArgs {
   std::string file, resonances, antiresonances, low_z, material, set, method;
   std::string overlay, damping, capacitance = "fe";
   bool isotropic = false, cross_modes = false, transverse = false;
+  pu::OeOptions oe;  // a capture's output-error fit (the chain's tolerances)
   int max_iterations = pu::CmcmOptions{}.max_iterations;
   int n_radial = pm::MeshOptions{}.n_radial, n_axial = pm::MeshOptions{}.n_axial;
 };
@@ -90,7 +92,7 @@ void run_update(Context& ctx, const UpdateArgs& a) {
   if (a.file.size() > 3 && a.file.compare(a.file.size() - 3, 3, ".h5") == 0) {
     // A capture: the tube's constants from the recorded samples.
     if (a.isotropic && a.transverse) throw InputError("--isotropic and --transverse exclude each other");
-    run_update_capture(ctx, a.file, a.method.empty() ? "oe" : a.method, a.material, !a.transverse);
+    run_update_capture(ctx, a.file, a.method.empty() ? "oe" : a.method, a.material, !a.transverse, a.oe);
     return;
   }
   if (a.transverse) throw InputError("--transverse is for a capture (an impedance file's default class is transversely isotropic)");
@@ -376,6 +378,7 @@ void register_update_command(CLI::App& app, Context& ctx) {
                 "Include the i != j CMCM equations (seed-faithful, slow)");
   cmd->add_option("--nr", a->n_radial, "Elements through the wall")->capture_default_str();
   cmd->add_option("--nz", a->n_axial, "Elements along the length")->capture_default_str();
+  add_chain_tolerance_options(cmd, a->oe);
   add_json_flag(cmd, ctx);
   cmd->callback([&ctx, a] { ctx.exit_code = run_command(ctx, [&] { run_update(ctx, *a); }); });
 }

@@ -90,7 +90,7 @@ nlohmann::json feature_methods(const acq::Capture& cap, const std::string& mater
 }  // namespace
 
 void run_update_capture(Context& ctx, const std::string& file, const std::string& method,
-                        const std::string& material_option, bool isotropic) {
+                        const std::string& material_option, bool isotropic, const update::OeOptions& oe) {
   if (method != "oe" && method != "cmcm" && method != "lm" && method != "all")
     throw InputError("--method for a capture must be oe, cmcm, lm or all");
   const auto cap = acq::read_capture_contained(file);  // a crash of libhdf5 costs the file only
@@ -101,6 +101,7 @@ void run_update_capture(Context& ctx, const std::string& file, const std::string
   ui::CaptureFitRequest req;
   req.material = material;
   req.isotropic = isotropic;
+  req.options = oe;
   nlohmann::json out;
   out["capture"] = file;
   out["method"] = method;

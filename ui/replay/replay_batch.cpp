@@ -200,6 +200,7 @@ Outcome replay_capture(const fs::path& file, const ReplayOptions& opt, const Sin
     req.material = material;
     req.isotropic = opt.isotropic;
     req.seed_chain = opt.seed_chain;
+    req.oe_options = opt.oe_options;
     result = ui::run_pipeline(req, nullptr, cancel);
     if (material_warning) result.warnings.insert(result.warnings.begin(), *material_warning);
   } catch (const acq::CaptureError& e) {

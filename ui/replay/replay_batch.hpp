@@ -29,6 +29,7 @@
 #include <vector>
 
 #include "ui/replay/discover.hpp"
+#include "update/output_error.hpp"
 
 namespace piezo::replay {
 
@@ -42,6 +43,7 @@ struct ReplayOptions {
       jsonl;             // one line per capture of this run (truncated at start)
   std::string material;  // nominal model; empty: the capture's /setup/material, else apc850
   bool isotropic = true;
+  update::OeOptions oe_options;  // ui::PipelineRequest::oe_options (the chain's tolerances)
   bool seed_chain = false;  // also run the seed's CMCM/LM chain (ui::PipelineRequest::seed_chain)
   std::string software = "piezobench replay";
   // A capture whose worker has not answered after this long is a hang: the
