@@ -23,14 +23,19 @@ cd tube_admittance(const ModalPortModel& port, const RayleighDamping& d, const E
   return cd(0.0, omega) * q;
 }
 
+cd recorded_transfer(cd y_tube, const EffectSet& fx, double r1_nominal_ohm, double omega) {
+  if (!(r1_nominal_ohm > 0)) throw std::invalid_argument("recorded_transfer: R1 must be positive");
+  // Y_n = 1/Z_a + jωC_p + 1/R_daq with Z_a = 1/Y_t + R_s; H = 1/(1 + R1·Y_n).
+  cd y = fx.series_resistance_ohm > 0 ? y_tube / (1.0 + fx.series_resistance_ohm * y_tube) : y_tube;
+  y += cd(0.0, omega * fx.parallel_capacitance_f);
+  if (std::isfinite(fx.daq_input_resistance_ohm)) y += 1.0 / fx.daq_input_resistance_ohm;
+  const cd h = 1.0 / (1.0 + r1_nominal_ohm * (1.0 + fx.r1_tolerance) * y);
+  return h * (1.0 + fx.channel_gain) * std::exp(cd(0.0, -omega * fx.channel_skew_s));
+}
+
 cd reported_impedance(cd y_tube, const EffectSet& fx, double r1_nominal_ohm, double omega) {
   if (!(r1_nominal_ohm > 0)) throw std::invalid_argument("reported_impedance: R1 must be positive");
-  cd z = 1.0 / y_tube + fx.series_resistance_ohm;
-  cd y = 1.0 / z + cd(0.0, omega * fx.parallel_capacitance_f);
-  if (std::isfinite(fx.daq_input_resistance_ohm)) y += 1.0 / fx.daq_input_resistance_ohm;
-  const cd zn = 1.0 / y;
-  const cd h = zn / (zn + r1_nominal_ohm * (1.0 + fx.r1_tolerance));
-  const cd hm = h * (1.0 + fx.channel_gain) * std::exp(cd(0.0, -omega * fx.channel_skew_s));
+  const cd hm = recorded_transfer(y_tube, fx, r1_nominal_ohm, omega);
   return r1_nominal_ohm * hm / (1.0 - hm);
 }
 

@@ -37,6 +37,12 @@ std::complex<double> lossy_capacitance(double c, double tan_delta, double omega)
 std::complex<double> tube_admittance(const ModalPortModel& port, const RayleighDamping& d,
                                      const EffectSet& fx, double omega);
 
+// H'(ω) = v2/v1 as the DAQ records it (the divider, then channel 2's gain and
+// skew), from the tube's admittance and the circuit/DAQ effects: what the
+// output-error fit (update/output_error.hpp) applies to the recorded v1.
+std::complex<double> recorded_transfer(std::complex<double> y_tube, const EffectSet& fx,
+                                       double r1_nominal_ohm, double omega);
+
 // Z_reported(ω) from the tube's admittance (any source) and the circuit/DAQ effects.
 std::complex<double> reported_impedance(std::complex<double> y_tube, const EffectSet& fx,
                                         double r1_nominal_ohm, double omega);

@@ -69,6 +69,25 @@ nlohmann::json output_error_json(const update::OeResult& r, const std::string& e
             {"iterations", r.iterations},
             {"evaluations", r.evaluations},
             {"optima", optima}}},
+          {"effects",
+           [&] {
+             nlohmann::json a = nlohmann::json::array();
+             for (const auto& e : r.effects)
+               a.push_back({{"name", e.name},
+                            {"unit", e.unit},
+                            {"value", std::isfinite(e.value) ? nlohmann::json(e.value) : nlohmann::json(nullptr)},
+                            {"sigma", std::isfinite(e.sigma) ? nlohmann::json(e.sigma) : nlohmann::json(nullptr)},
+                            {"delta_chi2", e.delta_chi2},
+                            {"alias", e.alias},
+                            {"alias_residual", e.alias_residual},
+                            {"significant", e.significant},
+                            {"explains", e.explains},
+                            {"chi2_per_dof", e.chi2_per_dof},
+                            {"band_log10_p", e.band_log10_p},
+                            {"converged", e.converged},
+                            {"updated", tube_params_json(e.material)}});
+             return a;
+           }()},
           {"seconds", r.seconds}};
 }
 

@@ -13,14 +13,18 @@
 #include "acquisition/divider_record.hpp"
 #include "acquisition/runner.hpp"
 #include "dsp/cross_spectra.hpp"
+#include "dsp/fft.hpp"
 #include "dsp/fft_ratio.hpp"
 #include "dsp/prony_impedance.hpp"
+#include "dsp/prony_ss.hpp"
 #include "dsp/shot_ensemble.hpp"
+#include "model/bench_response.hpp"
 #include "model/effects.hpp"
 #include "model/harmonic.hpp"
 #include "model/material_spec.hpp"
 #include "model/modal.hpp"
 #include "model/tube_model.hpp"
+#include "update/gap_output_error.hpp"
 #include "update/least_squares.hpp"
 #include "update/port_fit.hpp"
 #include "ui/capture_fit.hpp"
@@ -545,6 +549,87 @@ std::vector<update::MeasuredEffect> measured_effects(const dsp::FixtureCalibrati
   return v;
 }
 
+// The curves of a diagnosis made in the output-error model (plots, GUI):
+// ln(Z_meas/Z_model) on the FFT ratio of the first shot (first-differenced,
+// 1 kHz to min(120 kHz, fs/4)), the noise band from each channel's white
+// noise (pretrigger, else high-pass estimate) propagated per bin; the model
+// is the bench's forward model with the base constants, and with the
+// verdict's effect and the constants refitted with it.
+void output_error_gap_curves(const acq::Capture& cap, const acq::Shot& shot, const CaptureModel& cm,
+                             const update::OeResult& r, const update::OeOptions& oo, update::GapDiagnosis& d) {
+  const dsp::DividerRecord rec = acq::divider_record(cap, shot);
+  const std::size_t pre = rec.pretrigger_samples < rec.v1.size() ? rec.pretrigger_samples : 0;
+  const std::size_t n = rec.v1.size() - pre;
+  if (n < 64) return;
+  auto mean_of = [&](std::span<const double> x) {
+    double m = 0;
+    for (std::size_t i = 0; i < pre; ++i) m += x[i];
+    return pre ? m / double(pre) : 0.0;
+  };
+  auto noise_of = [&](std::span<const double> x) {
+    if (pre >= 64) {
+      const double m = mean_of(x);
+      double q = 0;
+      for (std::size_t i = 0; i < pre; ++i) q += (x[i] - m) * (x[i] - m);
+      return std::sqrt(q / double(pre - 1));
+    }
+    return dsp::estimate_noise_std(Eigen::Map<const Eigen::VectorXd>(x.data(), static_cast<Eigen::Index>(x.size())));
+  };
+  const double s1 = noise_of(rec.v1), s2 = noise_of(rec.v2), m1 = mean_of(rec.v1), m2 = mean_of(rec.v2);
+  Eigen::VectorXd d1(static_cast<Eigen::Index>(n)), d2(static_cast<Eigen::Index>(n));
+  for (std::size_t i = 0; i < n; ++i) {  // first differences from t = 0 (the idle level before it)
+    const double a = rec.v1[pre + i] - m1, b = rec.v2[pre + i] - m2;
+    const double a0 = i ? rec.v1[pre + i - 1] - m1 : 0.0, b0 = i ? rec.v2[pre + i - 1] - m2 : 0.0;
+    d1[static_cast<Eigen::Index>(i)] = a - a0;
+    d2[static_cast<Eigen::Index>(i)] = b - b0;
+  }
+  const Eigen::VectorXcd x1 = dsp::rfft(d1, n), x2 = dsp::rfft(d2, n);
+  const double fs = rec.sample_rate_hz, r1 = rec.r1_ohm, fmax = std::min(120e3, fs / 4);
+  std::vector<double> f;
+  std::vector<std::complex<double>> zm;
+  std::vector<double> var;
+  for (Eigen::Index k = 1; k < x1.size(); ++k) {
+    const double fk = fs * double(k) / double(n);
+    if (fk < 1e3 || fk > fmax) continue;
+    const std::complex<double> xi = x1[k] - x2[k];
+    if (std::abs(xi) == 0.0 || std::abs(x2[k]) == 0.0) continue;
+    f.push_back(fk);
+    zm.push_back(r1 * x2[k] / xi);
+    const double dd = 4.0 * std::pow(std::sin(M_PI * double(k) / double(n)), 2) * double(n);
+    var.push_back(dd * (s2 * s2 * std::norm(1.0 / x2[k] + 1.0 / xi) + s1 * s1 * std::norm(1.0 / xi)));
+  }
+  if (f.size() < 2) return;
+  auto curve = [&](const update::TubeParams& p, const model::EffectSet& fx) {
+    model::ModalOptions mo = oo.modal;
+    mo.end_mass_fraction = fx.mass_loading;
+    const auto port = cm.solver->port_model(cm.cls.e_form(p), mo);
+    const auto z = model::bench_impedance(port, r.damping, fx, r1, f);
+    update::GapCurve c;
+    for (std::size_t i = 0; i < f.size(); ++i) {
+      const auto l = std::log(zm[i] / z[i]);
+      c.f_hz.push_back(f[i]);
+      c.residual_db.push_back(20.0 / std::log(10.0) * l.real());
+      c.residual_deg.push_back(180.0 / M_PI * std::remainder(l.imag(), 2 * M_PI));
+      const double sd = std::sqrt(0.5 * var[i]);
+      c.sigma_db.push_back(20.0 / std::log(10.0) * sd);
+      c.sigma_deg.push_back(180.0 / M_PI * std::min(sd, M_PI));
+      c.measured_abs_ohm.push_back(std::abs(zm[i]));
+    }
+    return c;
+  };
+  model::EffectSet base;
+  d.before = curve(r.updated, base);
+  d.after = d.before;
+  if (!d.steps.empty()) {
+    const auto* info = model::find_effect(d.steps.front().name);
+    if (info && std::isfinite(d.steps.front().value)) {
+      model::EffectSet fx;
+      fx.*(info->field) = d.steps.front().value;
+      d.after = curve(d.steps.front().material, fx);
+    }
+  }
+}
+
 void diagnose_stage(const PipelineRequest& req, const acq::Capture& cap, const CaptureModel& cm,
                     const acq::Capture* heldout_cap, const UpdateOutcome& u, PipelineResult& out,
                     const Stages& progress, const std::atomic<bool>& cancel) {
@@ -569,8 +654,33 @@ void diagnose_stage(const PipelineRequest& req, const acq::Capture& cap, const C
     ho_shots = odd;
     ho_what = "held-out odd-numbered shots";
   }
-  if (fit_shots.size() < 3)
-    throw std::invalid_argument("gap diagnosis: needs at least 3 repeated shots of one drive (the noise is measured from them)");
+  if (fit_shots.size() < 3) {
+    // One or two shots: the noise of Z(f) cannot be measured from repeats
+    // (nor is it Gaussian per bin at a few percent): the diagnosis runs in the
+    // output-error model instead, each effect a sixth parameter of the fit.
+    CaptureFitRequest cr;
+    cr.material = req.material;
+    cr.isotropic = req.isotropic;
+    cr.options = req.oe_options;
+    if (req.use_calibration) cr.fixture = out.fixture;
+    cr.options.scan_effects = req.gap_candidates.empty() ? update::supported_gap_effects() : req.gap_candidates;
+    progress(0.75, "diagnose: the catalogue's effects in the output-error model");
+    const CaptureFit f = fit_capture(cap, cr, cm);
+    if (!f.result.ok()) throw std::runtime_error("gap diagnosis: the output-error fit did not converge: " + f.result.message);
+    auto d = update::gap_from_output_error(
+        f.result, "fit data: " + std::to_string(f.result.shots_used) + " " + f.excitation + " shot(s)");
+    output_error_gap_curves(cap, *fit_shots.front(), cm, f.result, cr.options, d);
+    if (heldout_cap)
+      out.warnings.push_back("the held-out capture " + out.heldout_path +
+                             " is not used by the diagnosis of one or two shots yet (output-error model)");
+    char note[240];
+    std::snprintf(note, sizeof note, "output-error model, %d shot(s): chi2/dof %.2f; verdict: %s (%.1f s)",
+                  f.result.shots_used, f.result.chi2_per_dof, d.verdict_effect.c_str(), f.result.seconds);
+    out.stages.push_back({"diagnose", true, note});
+    out.verdict = d.verdict;
+    out.diagnosis = std::move(d);
+    return;
+  }
   const update::GapData fit = gap_data(cap, fit_shots, req.gap_floor, "fit data");
   std::optional<update::GapData> ho;
   if (ho_shots.size() >= 3) ho = gap_data(*ho_cap, ho_shots, req.gap_floor, ho_what);

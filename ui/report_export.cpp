@@ -109,6 +109,7 @@ nlohmann::json diagnosis_json(const update::GapDiagnosis& d) {
   j["measured"] = nlohmann::json::array();
   for (const auto& m : d.measured)
     j["measured"].push_back({{"name", m.name}, {"value", m.value}, {"sigma", m.sigma}, {"source", m.source}});
+  j["method"] = d.method;
   j["gap"] = d.gap;
   j["gap_fit"] = d.gap_fit;
   j["chi2_fit"] = d.chi2_fit;

@@ -69,6 +69,9 @@ struct GapCurve {  // misfit ln(Z_meas/Z_model) for plots
 };
 
 struct GapDiagnosis {
+  // "impedance": Z(f) of repeated shots (diagnose_gap); "output-error": the
+  // samples of one or two shots (update/gap_output_error.hpp).
+  std::string method = "impedance";
   bool gap = false;  // significant on the fit data or the held-out data
   double chi2_fit = 0;
   int n_fit = 0, dof_fit = 0;

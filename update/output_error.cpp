@@ -6,12 +6,15 @@
 #include <cmath>
 #include <complex>
 #include <cstdio>
+#include <functional>
 #include <optional>
 #include <stdexcept>
 
 #include "dsp/fft.hpp"
 #include "dsp/prony_ss.hpp"
 #include "dsp/windows.hpp"
+#include "model/bench_response.hpp"
+#include "model/effects.hpp"
 
 namespace piezo::update {
 
@@ -110,9 +113,14 @@ class Problem {
  public:
   Problem(model::ModalSolver& solver, const MaterialClass& cls, const Coordinates5& co,
           const Averaged& rec, const OeData& data, double band_hz, const model::ModalOptions& modal)
-      : solver_(solver), cls_(cls), co_(co), circuit_(data.circuit), modal_(modal),
-        fs_(data.sample_rate_hz), delay_(data.v2_delay_s), n_(rec.v1.size()),
+      : solver_(solver), cls_(cls), co_(co), modal_(modal), r1_(data.circuit.r1_ohm),
+        fs_(data.sample_rate_hz), n_(rec.v1.size()),
         nfft_(dsp::good_fft_size(std::max<std::size_t>(4 * n_, 1u << 14))), fft_(nfft_) {
+    fx_.series_resistance_ohm = data.circuit.r_lead_ohm;
+    fx_.parallel_capacitance_f = data.circuit.c_parallel_f;
+    fx_.daq_input_resistance_ohm = data.circuit.r_daq_ohm;
+    fx_.channel_skew_s = data.v2_delay_s;
+    fx_.mass_loading = modal_.end_mass_fraction;
     const Eigen::VectorXd h = dsp::blackman_lowpass(fs_, band_hz);
     if (static_cast<std::size_t>(h.size()) > nfft_ - n_) fail("record too short for the band");
     kmax_ = std::min<std::size_t>(fft_.bins() - 1,
@@ -170,28 +178,45 @@ class Problem {
     return slot->port ? &*slot->port : nullptr;
   }
 
-  // Perturbations of the measurement chain (for the type-B sensitivities).
-  struct Chain {
-    double r1_rel = 0, cp_f = 0, gain_rel = 0, skew_s = 0;
-  };
+  // The bench's known effects (OeData: a measured fixture's lead R, Cp, DAQ
+  // input R and skew), as the catalogue's EffectSet (model/effects.hpp).
+  const model::EffectSet& effects() const { return fx_; }
 
-  // T(f_k) of the divider for parameters x; empty when the model cannot be built.
+  // T(f_k) = v2/v1 as recorded, for parameters x, with the bench's effects
+  // (model/bench_response.hpp: the same forward model as the gap diagnosis
+  // and the simulated bench's frequency-domain twin); empty when the model
+  // cannot be built. An end mass other than the cached ports' builds its own.
   std::optional<std::vector<cd>> transfer(const Eigen::VectorXd& x) {
-    return transfer(x, Chain{0, 0, 0, 0});
+    if (x.size() > kParams && free_) {
+      model::EffectSet fx = fx_;
+      free_(fx, x[kParams]);
+      return transfer(x, fx);
+    }
+    return transfer(x, fx_);
   }
-  std::optional<std::vector<cd>> transfer(const Eigen::VectorXd& x, const Chain& b) {
-    const model::ModalPortModel* pp = port_of(x);
+  // A catalogue effect as a sixth coordinate of x (scan_effects below).
+  void free_effect(std::function<void(model::EffectSet&, double)> apply) { free_ = std::move(apply); }
+  std::optional<std::vector<cd>> transfer(const Eigen::VectorXd& x, const model::EffectSet& fx) {
+    std::optional<model::ModalPortModel> loaded;
+    if (fx.mass_loading != modal_.end_mass_fraction) {
+      model::ModalOptions mo = modal_;
+      mo.end_mass_fraction = fx.mass_loading;
+      ++evaluations_;
+      try {
+        loaded = solver_.port_model(cls_.e_form(co_.params(x)), mo);
+      } catch (const std::exception&) {
+        return std::nullopt;
+      }
+      if (!loaded->converged) return std::nullopt;
+    }
+    const model::ModalPortModel* pp = loaded ? &*loaded : port_of(x);
     if (!pp) return std::nullopt;
-    const model::ModalPortModel& port = *pp;
     const model::RayleighDamping damp{0.0, co_.beta(x)};
     std::vector<cd> t(kmax_ + 1);
-    const double r1 = circuit_.r1_ohm * (1.0 + b.r1_rel), cp = circuit_.c_parallel_f + b.cp_f;
     for (std::size_t k = 0; k <= kmax_; ++k) {
       const double w = kTwoPi * fs_ * double(k) / double(nfft_);
-      const cd yt = cd(0.0, w) * port.charge_per_volt(w, damp);
-      const cd yb = circuit_.r_lead_ohm > 0 ? yt / (1.0 + circuit_.r_lead_ohm * yt) : yt;
-      const cd y2 = yb + cd(0.0, w * cp) + 1.0 / circuit_.r_daq_ohm;
-      t[k] = (1.0 + b.gain_rel) * std::polar(1.0, -w * (delay_ + b.skew_s)) / (1.0 + r1 * y2);
+      const cd yt = w > 0 ? model::tube_admittance(*pp, damp, fx, w) : cd(0.0, 0.0);
+      t[k] = model::recorded_transfer(yt, fx, r1_, w);
     }
     return t;
   }
@@ -267,9 +292,11 @@ class Problem {
   model::ModalSolver& solver_;
   const MaterialClass& cls_;
   Coordinates5 co_;
-  model::DividerCircuit circuit_;
   model::ModalOptions modal_;
-  double fs_, delay_;
+  double r1_;
+  model::EffectSet fx_;
+  std::function<void(model::EffectSet&, double)> free_;
+  double fs_;
   std::size_t n_, nfft_;
   dsp::RealFft fft_;
   std::size_t kmax_ = 0, decim_ = 1;
@@ -531,9 +558,10 @@ OeResult fit_output_error(model::ModalSolver& solver, const MaterialClass& cls,
     return r;
   };
   auto jacobian = [&](const Eigen::VectorXd& x, const Eigen::VectorXd& r0, Eigen::MatrixXd& j) {
-    j.resize(r0.size(), kParams);
-    for (int c = 0; c < kParams; ++c) {
-      const double h = c == 4 ? 1e-4 : 1e-6;
+    const auto np = static_cast<int>(x.size());  // 5, or 6 with a free effect (scan_effects)
+    j.resize(r0.size(), np);
+    for (int c = 0; c < np; ++c) {
+      const double h = c >= 4 ? 1e-4 : 1e-6;
       Eigen::VectorXd xp = x;
       xp[c] += h;
       auto rp = weighted(xp);
@@ -583,7 +611,7 @@ OeResult fit_output_error(model::ModalSolver& solver, const MaterialClass& cls,
       bool accepted = false, done = false;
       for (int tries = 0; tries < 14 && !accepted; ++tries) {
         Eigen::MatrixXd a = jtj;
-        for (int p = 0; p < kParams; ++p) a(p, p) += mu * std::max(jtj(p, p), 1e-300);
+        for (Eigen::Index p = 0; p < a.rows(); ++p) a(p, p) += mu * std::max(jtj(p, p), 1e-300);
         Eigen::VectorXd step = a.ldlt().solve(-g);
         // Trust region: no constant moves by more than 30 % in one step.
         const double big = step.cwiseAbs().maxCoeff();
@@ -631,7 +659,7 @@ OeResult fit_output_error(model::ModalSolver& solver, const MaterialClass& cls,
       }
       if (!accepted) {
         double cosine = 0;
-        for (int p = 0; p < kParams; ++p)
+        for (Eigen::Index p = 0; p < g.size(); ++p)
           cosine = std::max(cosine, std::abs(g[p]) / std::sqrt(jtj(p, p) * 2.0 * cost + 1e-300));
         if (cosine < 1e-4) {
           o.converged = true;
@@ -743,12 +771,16 @@ OeResult fit_output_error(model::ModalSolver& solver, const MaterialClass& cls,
     const Eigen::MatrixXd& jb = best.j;  // weighted J at the answer
     const bool have_j = jb.rows() == out.residual_samples && jb.cols() == kParams;
     const Eigen::VectorXd r0 = prob.residual_of(*t_best);
-    using Chain = Problem::Chain;
-    const std::pair<Chain, double> chain[] = {
-        {Chain{1e-4, 0, 0, 0}, opt.r1_rel_sigma / 1e-4},
-        {Chain{0, 1e-12, 0, 0}, opt.cp_sigma_f / 1e-12},
-        {Chain{0, 0, 1e-4, 0}, opt.gain_rel_sigma / 1e-4},
-        {Chain{0, 0, 0, 1e-9}, opt.skew_sigma_s / 1e-9},
+    auto shifted = [&](double model::EffectSet::*field, double by) {
+      model::EffectSet fx = prob.effects();
+      fx.*field += by;
+      return fx;
+    };
+    const std::pair<model::EffectSet, double> chain[] = {
+        {shifted(&model::EffectSet::r1_tolerance, 1e-4), opt.r1_rel_sigma / 1e-4},
+        {shifted(&model::EffectSet::parallel_capacitance_f, 1e-12), opt.cp_sigma_f / 1e-12},
+        {shifted(&model::EffectSet::channel_gain, 1e-4), opt.gain_rel_sigma / 1e-4},
+        {shifted(&model::EffectSet::channel_skew_s, 1e-9), opt.skew_sigma_s / 1e-9},
     };
     if (have_j) {
       const Eigen::MatrixXd jtj = jb.transpose() * jb;
@@ -860,6 +892,113 @@ OeResult fit_output_error(model::ModalSolver& solver, const MaterialClass& cls,
     }
     out.parameters.push_back(p);
   }
+  // The catalogue's effects, one at a time, as a sixth coordinate from the
+  // optimum: x₆ in units of the effect's typical size (the daq input as a
+  // conductance, so that 0 is "none").
+  struct Scan {
+    const char* name;
+    double typical;
+    std::function<void(model::EffectSet&, double)> apply;
+    std::function<double(double)> value;  // SI from x₆
+  };
+  auto linear = [](double model::EffectSet::*f, double typ) {
+    return std::make_pair(std::function<void(model::EffectSet&, double)>(
+                              [f, typ](model::EffectSet& fx, double x) { fx.*f += typ * x; }),
+                          std::function<double(double)>([typ](double x) { return typ * x; }));
+  };
+  const std::vector<std::pair<std::string, std::pair<double model::EffectSet::*, double>>> linear_effects = {
+      {"series_resistance", {&model::EffectSet::series_resistance_ohm, 10.0}},
+      {"parallel_capacitance", {&model::EffectSet::parallel_capacitance_f, 100e-12}},
+      {"dielectric_loss", {&model::EffectSet::dielectric_loss, 0.01}},
+      {"channel_skew", {&model::EffectSet::channel_skew_s, 1e-7}},
+      {"channel_gain", {&model::EffectSet::channel_gain, 0.01}},
+      {"r1_tolerance", {&model::EffectSet::r1_tolerance, 0.01}},
+      {"mass_loading", {&model::EffectSet::mass_loading, 0.01}},
+      {"mechanical_damping", {&model::EffectSet::mechanical_damping, 1e-3}},
+  };
+  for (const auto& name : opt.scan_effects) {
+    if (!best.converged || best.j.rows() == 0 || !t_best) break;
+    const model::EffectInfo* info = model::find_effect(name);
+    if (!info) throw std::invalid_argument("scan_effects: no effect '" + name + "' in the catalogue");
+    std::function<void(model::EffectSet&, double)> apply;
+    std::function<double(double)> value;
+    double typical = 0;
+    if (name == "daq_input_resistance") {  // 1/R: x₆·1 µS
+      typical = 1e-6;
+      apply = [](model::EffectSet& fx, double x) {
+        const double g = (std::isfinite(fx.daq_input_resistance_ohm) ? 1.0 / fx.daq_input_resistance_ohm : 0.0) + 1e-6 * x;
+        fx.daq_input_resistance_ohm = g > 0 ? 1.0 / g : (g < 0 ? 1.0 / g : INFINITY);
+      };
+      value = [](double x) { return 1e-6 * x; };
+    } else {
+      auto it = std::find_if(linear_effects.begin(), linear_effects.end(), [&](const auto& e) { return e.first == name; });
+      if (it == linear_effects.end()) continue;  // in the catalogue, not in this model
+      typical = it->second.second;
+      std::tie(apply, value) = linear(it->second.first, typical);
+    }
+    OeEffect e;
+    e.name = name;
+    e.typical = name == "daq_input_resistance" ? 1.0 / typical : typical;
+    e.unit = info->unit;
+    prob.free_effect(apply);
+    Eigen::VectorXd x0(kParams + 1);
+    x0 << best.x, 0.0;
+    // Alias: the effect's column against the five's at their optimum.
+    if (auto r0 = weighted(x0)) {
+      Eigen::VectorXd xp = x0;
+      xp[kParams] = 1e-4;
+      if (auto rp = weighted(xp)) {
+        const Eigen::VectorXd je = (*rp - *r0) / 1e-4;
+        const Eigen::VectorXd c = best.j.colPivHouseholderQr().solve(je);
+        const Eigen::VectorXd proj = best.j * c;
+        e.alias_residual = je.norm() > 0 ? (je - proj).norm() / je.norm() : 0.0;
+        // x₆ = 1 is `typical`; the constants' coordinates are logs (nu12 relative).
+        for (int i = 0; i < 4; ++i) e.bias_pct[i] = 100.0 * c[i];
+      }
+    }
+    e.alias = e.alias_residual < opt.alias_threshold;
+    // An end mass moves the modes far along a curved valley the five already
+    // follow part way (4 % of added mass fits as YE11 −2.8 % at χ²/ν ≈ 1):
+    // from the optimum alone LM stays at none, so it also starts at 2 % and 4 %.
+    LmOutcome run = levenberg_marquardt(x0, nullptr);
+    if (name == "mass_loading")
+      for (double start : {2.0, 4.0}) {
+        Eigen::VectorXd xs = x0;
+        xs[kParams] = start;
+        LmOutcome other = levenberg_marquardt(xs, nullptr);
+        if (other.cost < run.cost) run = std::move(other);
+      }
+    finish(run);
+    e.converged = run.converged;
+    e.material = co.params(run.x.head(kParams));
+    const double dof_e = std::max(1.0, dof - 1.0);
+    e.chi2_per_dof = 2.0 * run.cost / dof_e;
+    e.delta_chi2 = 2.0 * (best.cost - run.cost);
+    double v = value(run.x[kParams]);
+    double sv = NAN;
+    if (run.jtj.rows() == kParams + 1) {
+      Eigen::FullPivLU<Eigen::MatrixXd> lu(run.jtj);
+      if (lu.isInvertible()) sv = typical * std::sqrt(std::max(0.0, std::max(1.0, e.chi2_per_dof) * lu.inverse()(kParams, kParams)));
+    }
+    if (name == "daq_input_resistance") {  // conductance → resistance, σ_R = σ_G/G²
+      e.value = v > 0 ? 1.0 / v : INFINITY;
+      e.sigma = v > 0 ? sv / (v * v) : NAN;
+    } else {
+      e.value = v;
+      e.sigma = sv;
+    }
+    const auto st = spectral_lack_of_fit(run.r, prob.residual_psd(*t_best, ch1, ch2), prob.residual_bin_hz());
+    e.band_log10_p = st.log10_p;
+    const bool physical = name == "daq_input_resistance" ? v > 0 : (e.value >= info->lower && e.value <= info->upper);
+    e.significant = !e.alias && run.converged && physical &&
+                    e.delta_chi2 > opt.effect_significance * std::max(1.0, e.chi2_per_dof);
+    e.explains = e.significant && e.chi2_per_dof <= out.chi2_limit && st.log10_p >= std::log10(opt.lack_of_fit_p);
+    out.effects.push_back(e);
+  }
+  prob.free_effect({});
+  std::sort(out.effects.begin(), out.effects.end(),
+            [](const OeEffect& a, const OeEffect& b) { return a.delta_chi2 > b.delta_chi2; });
+
   out.status = best.converged ? UpdateStatus::converged : UpdateStatus::max_iterations;
   out.message = best.converged ? "" : best.message;
   out.evaluations = prob.evaluations();

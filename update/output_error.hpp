@@ -100,6 +100,35 @@ struct OeOptions {
   // modes it moves (refsim corpus case 02: 4 % added mass, 10^-7.1 in
   // 40-56 kHz at χ²/ν 1.22); noise alone (our 20-tube study) stays above 0.1.
   double lack_of_fit_p = 1e-3;
+  // Effects of the catalogue to fit one at a time beside the five (names of
+  // model/effects.hpp; empty: none). Each costs an LM run from the optimum;
+  // mass_loading builds an FE model per evaluation.
+  std::vector<std::string> scan_effects;
+  double effect_significance = 25.0;  // Δχ² (one parameter) beyond this, scaled by χ²/ν when > 1
+  double alias_threshold = 0.05;
+};
+
+// One catalogue effect (model/effects.hpp) fitted as a sixth parameter beside
+// the five, from the five's optimum (issue 18: the gap of any capture, one
+// shot included, in the same output-error model as the estimate).
+struct OeEffect {
+  std::string name, unit;
+  double value = 0, sigma = 0;  // SI (daq_input_resistance: ohm, from a fitted conductance)
+  double delta_chi2 = 0;        // χ² of the five-parameter fit minus χ² with the effect
+  // ‖(I − P)j‖/‖j‖ of the effect's Jacobian column against the five's at their
+  // optimum: below OeOptions::alias_threshold the constants mimic the effect
+  // (R1's tolerance, a parallel capacitance): never a finding, only a bias.
+  double alias_residual = 1;
+  bool alias = false;
+  // What the constants take of it when it is not modelled: their shift, %,
+  // for `typical` (SI) of the effect (YE11, nu12, d31, εT33).
+  double typical = 0;
+  double bias_pct[4] = {0, 0, 0, 0};
+  bool significant = false;  // Δχ² beyond OeOptions::effect_significance·max(1, χ²/ν), physical value
+  bool explains = false;     // significant, and with it no lack of fit is left
+  double chi2_per_dof = 0, band_log10_p = 0;  // with the effect
+  bool converged = false;
+  TubeParams material;  // the constants refitted with it
 };
 
 struct OeParameter {
@@ -137,6 +166,7 @@ struct OeResult {
   int band_windows = 0;
   int residual_samples = 0;
   int starts = 0, iterations = 0, evaluations = 0;
+  std::vector<OeEffect> effects;             // OeOptions::scan_effects, largest Δχ² first
   std::vector<TubeParams> optima;            // every refined start's optimum (best first)
   std::vector<double> optima_cost;
   double seconds = 0;

@@ -65,6 +65,8 @@ inline nlohmann::json without_timing(nlohmann::json j) {
   if (j.contains("result") && j["result"].contains("stages"))
     for (auto& s : j["result"]["stages"]) s.erase("note");
   if (j.contains("result") && j["result"].contains("output_error")) j["result"]["output_error"].erase("seconds");
+  if (j.contains("result") && j["result"].contains("diagnosis") && j["result"]["diagnosis"].is_object())
+    j["result"]["diagnosis"].erase("seconds");
   return j;
 }
 

@@ -60,20 +60,15 @@ acq::Capture capture_attributes(const std::string& path) {
   return acq::read_capture_contained(path, ro);  // a crash of libhdf5 costs the file only
 }
 
-// The diagnosis measures the noise from repeated shots: it needs at least 3
-// transient dut shots of one drive in each capture (the pipeline's rule,
-// checked here first so that a short capture is refused before the update).
-void require_repeated_shots(const acq::Capture& cap, const std::string& path) {
-  std::map<acq::Excitation, int> n;
+// The diagnosis needs a transient dut shot in each capture (checked here
+// first, so that a capture without one is refused before the update). With 3
+// or more of one drive it works on Z(f) and measures the noise from the
+// repeats; with one or two, in the output-error model (the pipeline decides).
+void require_transient_shot(const acq::Capture& cap, const std::string& path) {
   for (const auto& s : cap.shots)
-    if (s.role == acq::Role::Dut && s.excitation != acq::Excitation::Sine) ++n[s.excitation];
-  int most = 0;
-  for (const auto& [kind, count] : n) most = std::max(most, count);
-  if (most < 3)
-    throw InputError(
-        path + ": " + std::to_string(most) +
-        " transient dut shot(s) of one drive; the gap diagnosis needs at least 3 repeated shots "
-        "(it measures the noise from them): record more with `piezobench measure --shots N`");
+    if (s.role == acq::Role::Dut && s.excitation != acq::Excitation::Sine) return;
+  throw InputError(path + ": no transient dut shot (exp_decay, chirp, noise, step): nothing to diagnose; "
+                   "record one with `piezobench measure`");
 }
 
 // The nominal material: --material, else the one the capture names (a
@@ -134,7 +129,8 @@ std::string plot_subtitle(const DiagnoseArgs& a, const std::string& material,
                           const update::GapDiagnosis& d) {
   std::string t = "fit: " + fs::path(a.fit).filename().string() + "; ";
   if (!a.holdout.empty())
-    t += "held out: " + fs::path(a.holdout).filename().string();
+    t += "held out: " + fs::path(a.holdout).filename().string() +
+         (d.method == "output-error" ? " (not used: one-shot diagnosis)" : "");
   else
     t += d.heldout_description.empty() ? std::string("no held-out data") : d.heldout_description;
   return t + "; nominal " + material + (a.transverse ? ", transversely isotropic" : ", isotropic") +
@@ -156,8 +152,8 @@ void run_diagnose(Context& ctx, const DiagnoseArgs& a) {
   const acq::Capture fit_attrs = capture_attributes(a.fit);
   std::vector<std::string> material_warnings;
   const std::string material = nominal_material(a, fit_attrs, material_warnings);
-  require_repeated_shots(fit_attrs, a.fit);
-  if (!a.holdout.empty()) require_repeated_shots(capture_attributes(a.holdout), a.holdout);
+  require_transient_shot(fit_attrs, a.fit);
+  if (!a.holdout.empty()) require_transient_shot(capture_attributes(a.holdout), a.holdout);
 
   ui::PipelineRequest req;
   req.replay_capture = a.fit;
@@ -180,7 +176,7 @@ void run_diagnose(Context& ctx, const DiagnoseArgs& a) {
   res.warnings.insert(res.warnings.begin(), material_warnings.begin(), material_warnings.end());
   if (!res.diagnosis) throw InputError(a.fit + ": " + why_not_diagnosed(res));
   const auto& d = *res.diagnosis;
-  if (!a.holdout.empty() && d.n_heldout == 0)
+  if (!a.holdout.empty() && d.n_heldout == 0 && d.method == "impedance")
     throw InputError(a.holdout +
                      ": fewer than 3 transient dut shots; the held-out data could not be used");
 
