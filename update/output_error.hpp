@@ -128,6 +128,9 @@ struct OeEffect {
   bool explains = false;     // significant, and with it no lack of fit is left
   double chi2_per_dof = 0, band_log10_p = 0;  // with the effect
   bool converged = false;
+  // Not refitted: its score at the optimum (the first-order Δχ²) was below a
+  // quarter of the significance, so value, σ and Δχ² are the linear ones.
+  bool linearised = false;
   TubeParams material;  // the constants refitted with it
 };
 
