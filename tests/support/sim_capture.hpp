@@ -2,6 +2,7 @@
 // A capture of the embedded simulated bench, written to `path` and read back
 // (the same files the CLI writes), for tests that need real shots.
 #include <filesystem>
+#include <string>
 
 #include "acquisition/bench.hpp"
 #include "acquisition/capture_file.hpp"
@@ -10,6 +11,14 @@
 #include "acquisition/sim_setup.hpp"
 
 namespace piezo::test {
+
+// A scratch folder under the build tree (PIEZO_BINARY_DIR/tests-tmp/NAME),
+// created if needed: captures the tests write and read back.
+inline std::filesystem::path scratch_dir(const std::string& name) {
+  const std::filesystem::path d = std::filesystem::path(PIEZO_BINARY_DIR) / "tests-tmp" / name;
+  std::filesystem::create_directories(d);
+  return d;
+}
 
 inline acq::MeasurementPlan seed_lab_plan(int shots) {
   acq::MeasurementPlan p;  // the seed's lab test: R1 = 3140 Ω, 1 V exp_decay at 3000 1/s, 10 MS/s

@@ -20,11 +20,7 @@ using namespace piezo;
 namespace fs = std::filesystem;
 
 namespace {
-fs::path tmp_dir(const std::string& name) {
-  fs::path d = fs::path(PIEZO_BINARY_DIR) / "tests-tmp" / name;
-  fs::create_directories(d);
-  return d;
-}
+fs::path tmp_dir(const std::string& name) { return test::scratch_dir(name); }
 
 acq::SimSpec spec_with(const char* effect, std::uint64_t seed) {
   acq::SimSpec s;

@@ -228,11 +228,7 @@ void print(const Tally& t) {
   return cases;
 }
 
-fs::path tmp_dir(const std::string& name) {
-  fs::path d = fs::path(PIEZO_BINARY_DIR) / "tests-tmp" / name;
-  fs::create_directories(d);
-  return d;
-}
+fs::path tmp_dir(const std::string& name) { return test::scratch_dir(name); }
 }  // namespace
 
 #ifndef PIEZO_GAP_FULL_STUDY
