@@ -404,6 +404,25 @@ SeedUpdate seed_update_stage(const PipelineRequest& req, const CaptureModel& cm,
 
 // The output-error fit of the constants and Rayleigh β to the capture's
 // samples (update/output_error.hpp): the pipeline's update. Never throws.
+// The diagnosis of this capture runs in the output-error model (fewer than 3
+// transient dut shots of its first drive, see diagnose_stage): the update's
+// fit then also scans the catalogue's effects, once, for it.
+bool diagnosed_by_output_error(const PipelineRequest& req, const acq::Capture& cap) {
+  if (!req.diagnose) return false;
+  const acq::Shot* first = nullptr;
+  int n = 0;
+  for (const auto& s : cap.shots) {
+    if (s.role != acq::Role::Dut || s.excitation == acq::Excitation::Sine) continue;
+    if (!first) first = &s;
+    n += s.excitation == first->excitation;
+  }
+  return first && n < 3;
+}
+
+std::vector<std::string> scanned_effects(const PipelineRequest& req) {
+  return req.gap_candidates.empty() ? update::supported_gap_effects() : req.gap_candidates;
+}
+
 std::optional<update::OeResult> output_error_stage(const PipelineRequest& req, const acq::Capture& cap,
                                                    const CaptureModel& cm, PipelineResult& out) {
   CaptureFitRequest cr;
@@ -411,6 +430,7 @@ std::optional<update::OeResult> output_error_stage(const PipelineRequest& req, c
   cr.isotropic = req.isotropic;
   cr.options = req.oe_options;
   if (req.use_calibration) cr.fixture = out.fixture;
+  if (diagnosed_by_output_error(req, cap)) cr.options.scan_effects = scanned_effects(req);
   try {
     const CaptureFit f = fit_capture(cap, cr, cm);
     const auto& r = f.result;
@@ -658,24 +678,35 @@ void diagnose_stage(const PipelineRequest& req, const acq::Capture& cap, const C
     // One or two shots: the noise of Z(f) cannot be measured from repeats
     // (nor is it Gaussian per bin at a few percent): the diagnosis runs in the
     // output-error model instead, each effect a sixth parameter of the fit.
+    // The update's fit scanned the effects already (output_error_stage); a
+    // fit of its own only where that one is missing.
+    const update::OeResult* r = out.output_error && out.output_error->ok() &&
+                                        out.output_error->effects.size() == scanned_effects(req).size()
+                                    ? &*out.output_error
+                                    : nullptr;
+    std::optional<CaptureFit> own;
     CaptureFitRequest cr;
     cr.material = req.material;
     cr.isotropic = req.isotropic;
     cr.options = req.oe_options;
     if (req.use_calibration) cr.fixture = out.fixture;
-    cr.options.scan_effects = req.gap_candidates.empty() ? update::supported_gap_effects() : req.gap_candidates;
-    progress(0.75, "diagnose: the catalogue's effects in the output-error model");
-    const CaptureFit f = fit_capture(cap, cr, cm);
-    if (!f.result.ok()) throw std::runtime_error("gap diagnosis: the output-error fit did not converge: " + f.result.message);
-    auto d = update::gap_from_output_error(
-        f.result, "fit data: " + std::to_string(f.result.shots_used) + " " + f.excitation + " shot(s)");
-    output_error_gap_curves(cap, *fit_shots.front(), cm, f.result, cr.options, d);
+    cr.options.scan_effects = scanned_effects(req);
+    if (!r) {
+      progress(0.75, "diagnose: the catalogue's effects in the output-error model");
+      own = fit_capture(cap, cr, cm);
+      if (!own->result.ok())
+        throw std::runtime_error("gap diagnosis: the output-error fit did not converge: " + own->result.message);
+      r = &own->result;
+    }
+    const std::string drive = own ? own->excitation : out.output_error_excitation;
+    auto d = update::gap_from_output_error(*r, "fit data: " + std::to_string(r->shots_used) + " " + drive + " shot(s)");
+    output_error_gap_curves(cap, *fit_shots.front(), cm, *r, cr.options, d);
     if (heldout_cap)
       out.warnings.push_back("the held-out capture " + out.heldout_path +
                              " is not used by the diagnosis of one or two shots yet (output-error model)");
     char note[240];
     std::snprintf(note, sizeof note, "output-error model, %d shot(s): chi2/dof %.2f; verdict: %s (%.1f s)",
-                  f.result.shots_used, f.result.chi2_per_dof, d.verdict_effect.c_str(), f.result.seconds);
+                  r->shots_used, r->chi2_per_dof, d.verdict_effect.c_str(), r->seconds);
     out.stages.push_back({"diagnose", true, note});
     out.verdict = d.verdict;
     out.diagnosis = std::move(d);
