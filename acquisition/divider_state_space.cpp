@@ -19,6 +19,12 @@ DebyeNetwork debye_network_for_loss(double c, double tan_delta, double f_lo, dou
     throw std::invalid_argument("debye_network_for_loss: need C > 0 and 0 < f_lo < f_hi");
   if (tan_delta < 0) throw std::invalid_argument("debye_network_for_loss: tan delta must be >= 0");
   if (tan_delta == 0) return {c, {}};
+  return debye_network_fit([&](double w) { return model::lossy_capacitance(c, tan_delta, w); }, f_lo, f_hi);
+}
+
+DebyeNetwork debye_network_fit(const std::function<std::complex<double>(double)>& target_of, double f_lo,
+                               double f_hi) {
+  if (!(f_hi > f_lo && f_lo > 0)) throw std::invalid_argument("debye_network_fit: need 0 < f_lo < f_hi");
   // Relaxation times four per decade, a decade beyond the band on each side;
   // column 0 is C_inf. Rows: real and imaginary parts relative to |C(ω)|.
   std::vector<double> tau;
@@ -29,7 +35,7 @@ DebyeNetwork debye_network_for_loss(double c, double tan_delta, double f_lo, dou
   Eigen::VectorXd y(2 * nw);
   for (int i = 0; i < nw; ++i) {
     const double w = 2 * M_PI * f_lo * std::pow(f_hi / f_lo, i / (nw - 1.0));
-    const std::complex<double> target = model::lossy_capacitance(c, tan_delta, w);
+    const std::complex<double> target = target_of(w);
     const double s = std::abs(target);
     a(2 * i, 0) = 1.0 / s;
     a(2 * i + 1, 0) = 0.0;
@@ -67,7 +73,7 @@ DebyeNetwork debye_network_for_loss(double c, double tan_delta, double f_lo, dou
   net.c_inf = x(0);
   for (int j = 1; j < nb; ++j)
     if (x(j) > 0) net.branches.emplace_back(x(j), tau[j - 1]);
-  if (!(net.c_inf > 0)) throw std::runtime_error("debye_network_for_loss: no positive high-frequency capacitance");
+  if (!(net.c_inf > 0)) throw std::runtime_error("debye_network_fit: no positive high-frequency capacitance");
   return net;
 }
 
@@ -84,7 +90,13 @@ DividerStateSpace::DividerStateSpace(const model::ModalPortModel& port, const Be
   std::vector<const model::PortMode*> modes;
   for (const auto& m : port.modes)
     if (m.omega > 0 && m.participation != 0.0) modes.push_back(&m);
-  const DebyeNetwork net = debye_network_for_loss(ce, k.dielectric_loss);
+  model::EffectSet loss;
+  loss.dielectric_loss = k.dielectric_loss;
+  loss.dielectric_constant_phase = true;
+  if (k.dielectric_loss < 0) throw std::invalid_argument("DividerStateSpace: tan delta must be >= 0");
+  const DebyeNetwork net = k.dielectric_loss == 0
+                               ? DebyeNetwork{ce, {}}
+                               : debye_network_fit([&](double w) { return model::port_capacitance(port, loss, w); });
   const auto& debye = net.branches;
   const double c_inf = net.c_inf;  // Ce itself when there is no loss
 

@@ -12,6 +12,7 @@
 // the system augmented by the input and its slope per distinct step length.
 #include <Eigen/Dense>
 #include <complex>
+#include <functional>
 #include <map>
 #include <span>
 #include <vector>
@@ -27,7 +28,9 @@ struct BenchCircuit {
   double series_resistance_ohm = 0.0;
   double parallel_capacitance_f = 0.0;
   double daq_input_resistance_ohm = std::numeric_limits<double>::infinity();
-  double dielectric_loss = 0.0;  // tan δ, realised by a Debye network on Ce
+  // tan δ of εT33 with the causal constant-phase law (model::port_capacitance
+  // with dielectric_constant_phase), realised by a Debye network on Ce.
+  double dielectric_loss = 0.0;
   model::RayleighDamping damping;
   double extra_damping_ratio = 0.0;  // mechanical_damping effect: c_k += 2 ξ_m ω_k
   // What sits at the terminals: the tube (the port model), or a calibration
@@ -81,5 +84,8 @@ struct DebyeNetwork {
 // model::lossy_capacitance(c, tanδ, ω) over [f_lo, f_hi] (non-negative least
 // squares, relative error). tanδ = 0 gives C_inf = c and no branches.
 DebyeNetwork debye_network_for_loss(double c, double tan_delta, double f_lo = 100.0, double f_hi = 1e6);
+// … or any causal target C(ω) (model::port_capacitance of the tube).
+DebyeNetwork debye_network_fit(const std::function<std::complex<double>(double)>& target, double f_lo = 100.0,
+                               double f_hi = 1e6);
 
 }  // namespace piezo::acq

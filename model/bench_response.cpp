@@ -14,8 +14,15 @@ cd lossy_capacitance(double c, double tan_delta, double omega) {
   return c * std::pow(omega / (2 * M_PI * kDielectricLossRefHz), -2.0 * delta / M_PI) * std::polar(1.0, -delta);
 }
 
+cd port_capacitance(const ModalPortModel& port, const EffectSet& fx, double omega) {
+  if (fx.dielectric_loss == 0.0) return port.c_clamped + port.c_residual;
+  const cd phi = fx.dielectric_constant_phase ? lossy_capacitance(1.0, fx.dielectric_loss, omega)
+                                              : cd(1.0, -fx.dielectric_loss);
+  return port.c_clamped * (1.0 + port.eps_t_over_s * (phi - 1.0)) + port.c_residual;
+}
+
 cd tube_admittance(const ModalPortModel& port, const RayleighDamping& d, const EffectSet& fx, double omega) {
-  cd q = lossy_capacitance(port.c_clamped + port.c_residual, fx.dielectric_loss, omega);
+  cd q = port_capacitance(port, fx, omega);
   for (const auto& m : port.modes) {
     const double ck = d.alpha + d.beta * m.kappa + 2.0 * fx.mechanical_damping * m.omega;
     q += m.participation * m.participation / cd(m.omega * m.omega - omega * omega, omega * ck);

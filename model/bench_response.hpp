@@ -32,6 +32,15 @@ namespace piezo::model {
 constexpr double kDielectricLossRefHz = 1e3;
 std::complex<double> lossy_capacitance(double c, double tan_delta, double omega);
 
+// The non-motional part of the tube's Q/V at ω: C0 + C_res with the
+// dielectric loss of `fx` applied to εT33 as the catalogue defines it
+// (εT33 → εT33·φ(ω), φ = 1 − j·tanδ or the constant-phase law): the clamped
+// capacitance is linear in εS33 = εT33 − 2d31e31 − d33e33, so
+//   C0(ω) = C0·(1 + (εT33/εS33)·(φ(ω) − 1)),
+// its loss tangent magnified by εT33/εS33 (ModalPortModel::eps_t_over_s);
+// C_res (the truncated modes) is mechanical and lossless.
+std::complex<double> port_capacitance(const ModalPortModel& port, const EffectSet& fx, double omega);
+
 // The tube alone: Y_t(ω) with the damping and loss effects of `fx` (circuit
 // and DAQ effects ignored).
 std::complex<double> tube_admittance(const ModalPortModel& port, const RayleighDamping& d,

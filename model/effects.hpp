@@ -16,6 +16,11 @@ struct EffectSet {
   double parallel_capacitance_f = 0.0;  // fixture and cable capacitance across the terminals
   double daq_input_resistance_ohm = std::numeric_limits<double>::infinity();  // loads the v2 node
   double dielectric_loss = 0.0;  // tan δ of the ceramic (εT33 → εT33·(1 − j·tanδ))
+  // Its law in frequency: false, εT33·(1 − j·tanδ) at every frequency (the FE
+  // convention: ANSYS's loss tangent, the refsim corpus); true, the causal
+  // constant-phase law of model/bench_response.hpp (ε' falling ≈ 1.5·tanδ per
+  // decade, as the simulated bench realises it with a Debye network).
+  bool dielectric_constant_phase = false;
   double channel_skew_s = 0.0;  // channel 2 samples later than channel 1
   double channel_gain = 0.0;  // relative gain error of channel 2
   double r1_tolerance = 0.0;  // true R1 = nominal·(1 + r1_tolerance)

@@ -206,6 +206,7 @@ ModalPortModel ModalSolver::port_model(const PiezoMaterialE& material, const Mod
   p.converged = sc.converged;
   p.c_clamped = sc.c_clamped;
   p.end_mass_fraction = opt.end_mass_fraction;
+  if (material.eps_s33 > 0) p.eps_t_over_s = to_d_form(material).eps_t33 / material.eps_s33;
   const SpMat& m_uu = mass(opt.end_mass_fraction);
   Eigen::VectorXd us;
   p.c_static = static_solve(material, m_uu, &us);

@@ -45,6 +45,10 @@ struct ModalPortModel {
   std::vector<PortMode> modes;  // elastic short-circuit modes, ascending (+ residual mode last)
   bool converged = true;        // the modal solve behind it converged
   double end_mass_fraction = 0;  // end-face mass loading of the modes (model/end_mass.hpp)
+  // εT33/εS33 of the material: a loss of the FREE permittivity (the ceramic's
+  // tanδ as datasheets quote it, εT33 → εT33·(1 − j·tanδ)) reaches the clamped
+  // capacitance magnified by this ratio (εS33 = εT33 − 2d31e31 − d33e33).
+  double eps_t_over_s = 1.0;
 
   // Q/V at angular frequency ω (≥ 0) with Rayleigh damping and, optionally,
   // Qm / tanδ (first-order modal approximation: ω_k² → ω_k² + jκ_k/Qm,

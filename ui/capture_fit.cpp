@@ -26,7 +26,8 @@ CaptureFit fit_capture(const acq::Capture& cap, const CaptureFitRequest& req) {
   return fit_capture(cap, req, capture_model(cap, req.material, req.isotropic));
 }
 
-CaptureFit fit_capture(const acq::Capture& cap, const CaptureFitRequest& req, const CaptureModel& m) {
+update::OeData capture_oe_data(const acq::Capture& cap, const std::optional<dsp::FixtureCalibration>& fixture,
+                               std::string* excitation) {
   // The dut transient shots of the first one's drive.
   const acq::Shot* first = nullptr;
   for (const auto& s : cap.shots)
@@ -35,9 +36,7 @@ CaptureFit fit_capture(const acq::Capture& cap, const CaptureFitRequest& req, co
       break;
     }
   if (!first) throw std::invalid_argument("the capture holds no dut transient shot to fit");
-  CaptureFit out;
-  update::OeOptions opts = req.options;
-  out.excitation = std::string(acq::to_string(first->excitation));
+  if (excitation) *excitation = std::string(acq::to_string(first->excitation));
   update::OeData data;
   data.sample_rate_hz = first->sample_rate_hz;
   data.circuit.r1_ohm = cap.setup.divider_r1_ohm;
@@ -45,16 +44,26 @@ CaptureFit fit_capture(const acq::Capture& cap, const CaptureFitRequest& req, co
     if (s.role != acq::Role::Dut || s.excitation != first->excitation ||
         s.sample_rate_hz != first->sample_rate_hz)
       continue;
-    ++out.shots_available;
     data.shots.push_back({s.v1, s.v2, static_cast<std::size_t>(std::max<std::int64_t>(0, s.pretrigger_samples))});
   }
-  if (req.fixture) {
-    const auto& fx = *req.fixture;
+  if (fixture) {
+    const auto& fx = *fixture;
     data.circuit.r1_ohm *= 1.0 + fx.r1_error.value_or(0.0);
     data.circuit.c_parallel_f = std::max(0.0, fx.fixture_capacitance_f.value_or(0.0));
     data.circuit.r_lead_ohm = std::max(0.0, fx.lead_resistance_ohm.value_or(0.0));
     data.v2_delay_s = fx.skew_s.value_or(0.0);
+  }
+  return data;
+}
+
+CaptureFit fit_capture(const acq::Capture& cap, const CaptureFitRequest& req, const CaptureModel& m) {
+  CaptureFit out;
+  update::OeOptions opts = req.options;
+  const update::OeData data = capture_oe_data(cap, req.fixture, &out.excitation);
+  out.shots_available = static_cast<int>(data.shots.size());
+  if (req.fixture) {
     // Measured: their sigmas replace the stated tolerances.
+    const auto& fx = *req.fixture;
     auto& o = opts;
     if (fx.r1_error) o.r1_rel_sigma = fx.r1_error_sigma.value_or(o.r1_rel_sigma);
     if (fx.fixture_capacitance_f) o.cp_sigma_f = fx.fixture_capacitance_sigma_f.value_or(o.cp_sigma_f);

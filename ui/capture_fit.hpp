@@ -42,6 +42,13 @@ struct CaptureFit {
   int shots_available = 0;
 };
 
+// The output-error data of a capture: its dut transient shots of the first
+// one's drive and rate, R1 from /setup, corrected by a measured fixture (true
+// R1, Cp, lead R, skew). `excitation` (optional) receives the drive's name.
+// Throws std::invalid_argument when the capture holds no dut transient shot.
+update::OeData capture_oe_data(const acq::Capture& cap, const std::optional<dsp::FixtureCalibration>& fixture,
+                               std::string* excitation = nullptr);
+
 // Throws std::invalid_argument when the capture holds no dut transient shot
 // or the fit cannot use it.
 CaptureFit fit_capture(const acq::Capture& cap, const CaptureFitRequest& req);

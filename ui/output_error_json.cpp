@@ -72,7 +72,7 @@ nlohmann::json output_error_json(const update::OeResult& r, const std::string& e
           {"effects",
            [&] {
              nlohmann::json a = nlohmann::json::array();
-             for (const auto& e : r.effects)
+             for (const auto& e : r.effects) {
                a.push_back({{"name", e.name},
                             {"unit", e.unit},
                             {"value", std::isfinite(e.value) ? nlohmann::json(e.value) : nlohmann::json(nullptr)},
@@ -86,6 +86,8 @@ nlohmann::json output_error_json(const update::OeResult& r, const std::string& e
                             {"band_log10_p", e.band_log10_p},
                             {"converged", e.converged},
                             {"updated", tube_params_json(e.material)}});
+               if (!e.law.empty()) a.back()["law"] = e.law;
+             }
              return a;
            }()},
           {"seconds", r.seconds}};

@@ -619,11 +619,11 @@ void output_error_gap_curves(const acq::Capture& cap, const acq::Shot& shot, con
     var.push_back(dd * (s2 * s2 * std::norm(1.0 / x2[k] + 1.0 / xi) + s1 * s1 * std::norm(1.0 / xi)));
   }
   if (f.size() < 2) return;
-  auto curve = [&](const update::TubeParams& p, const model::EffectSet& fx) {
+  auto curve = [&](const update::TubeParams& p, double beta_s, const model::EffectSet& fx) {
     model::ModalOptions mo = oo.modal;
     mo.end_mass_fraction = fx.mass_loading;
     const auto port = cm.solver->port_model(cm.cls.e_form(p), mo);
-    const auto z = model::bench_impedance(port, r.damping, fx, r1, f);
+    const auto z = model::bench_impedance(port, {0.0, beta_s}, fx, r1, f);
     update::GapCurve c;
     for (std::size_t i = 0; i < f.size(); ++i) {
       const auto l = std::log(zm[i] / z[i]);
@@ -637,17 +637,11 @@ void output_error_gap_curves(const acq::Capture& cap, const acq::Shot& shot, con
     }
     return c;
   };
-  model::EffectSet base;
-  d.before = curve(r.updated, base);
+  d.before = curve(r.updated, r.damping.beta, r.effect_set);
   d.after = d.before;
-  if (!d.steps.empty()) {
-    const auto* info = model::find_effect(d.steps.front().name);
-    if (info && std::isfinite(d.steps.front().value)) {
-      model::EffectSet fx;
-      fx.*(info->field) = d.steps.front().value;
-      d.after = curve(d.steps.front().material, fx);
-    }
-  }
+  if (!d.steps.empty())
+    for (const auto& e : r.effects)  // the fit with the verdict's effect: its constants, β and effects
+      if (e.name == d.steps.front().name && std::isfinite(e.value)) d.after = curve(e.material, e.beta_s, e.effect_set);
 }
 
 void diagnose_stage(const PipelineRequest& req, const acq::Capture& cap, const CaptureModel& cm,
@@ -674,10 +668,12 @@ void diagnose_stage(const PipelineRequest& req, const acq::Capture& cap, const C
     ho_shots = odd;
     ho_what = "held-out odd-numbered shots";
   }
-  if (fit_shots.size() < 3) {
+  if (fit_shots.size() < 3 || (heldout_cap && ho_shots.size() < 3)) {
     // One or two shots: the noise of Z(f) cannot be measured from repeats
     // (nor is it Gaussian per bin at a few percent): the diagnosis runs in the
-    // output-error model instead, each effect a sixth parameter of the fit.
+    // output-error model instead, each effect a sixth parameter of the fit —
+    // and so it does for a held-out capture of one or two shots, which the
+    // output-error model predicts from its own v1.
     // The update's fit scanned the effects already (output_error_stage); a
     // fit of its own only where that one is missing.
     const update::OeResult* r = out.output_error && out.output_error->ok() &&
@@ -699,11 +695,20 @@ void diagnose_stage(const PipelineRequest& req, const acq::Capture& cap, const C
       r = &own->result;
     }
     const std::string drive = own ? own->excitation : out.output_error_excitation;
-    auto d = update::gap_from_output_error(*r, "fit data: " + std::to_string(r->shots_used) + " " + drive + " shot(s)");
+    const std::string fit_what = "fit data: " + std::to_string(r->shots_used) + " " + drive + " shot(s)";
+    update::GapDiagnosis d;
+    if (heldout_cap) {
+      progress(0.9, "diagnose: predicting the held-out capture");
+      update::OeHeldout ho;
+      std::string ho_drive;
+      ho.data = capture_oe_data(*heldout_cap, cr.fixture, &ho_drive);
+      ho.description = "held-out capture " + out.heldout_path + ", " + std::to_string(ho.data.shots.size()) + " " +
+                       ho_drive + " shot(s)";
+      d = update::gap_from_output_error(*r, fit_what, *cm.solver, cm.cls, ho, cr.options);
+    } else {
+      d = update::gap_from_output_error(*r, fit_what);
+    }
     output_error_gap_curves(cap, *fit_shots.front(), cm, *r, cr.options, d);
-    if (heldout_cap)
-      out.warnings.push_back("the held-out capture " + out.heldout_path +
-                             " is not used by the diagnosis of one or two shots yet (output-error model)");
     char note[240];
     std::snprintf(note, sizeof note, "output-error model, %d shot(s): chi2/dof %.2f; verdict: %s (%.1f s)",
                   r->shots_used, r->chi2_per_dof, d.verdict_effect.c_str(), r->seconds);

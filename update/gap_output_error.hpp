@@ -20,11 +20,21 @@
 //              is a verdict), "none" without a gap, else "unexplained" (with
 //              the band where the residual stands out and the closest effect,
 //              which is not named as the cause).
-// Not yet: held-out data (predicting another capture's v2 from its v1), the
-// regions and curves of the impedance-domain diagnosis (empty here), more
-// than one effect at a time.
+//   held-out  another capture of the same transducer (any drive, one shot
+//              included): its v2 predicted from its own v1 by the fit's model
+//              without and with each significant effect (predict_output_error);
+//              shrink = 1 − g_after/g_before of the excess g = √max(0, χ²/ν − 1).
+//              An effect that leaves a lack of fit in the fit is named only when
+//              it removes most (OeHeldout::dominant_shrink) of a held-out gap.
+//              When the held-out capture shows a gap of its own, the verdict's
+//              effect must shrink it by OeHeldout::min_shrink (else "unexplained":
+//              the fit's effect does not carry over); when it shows none, the
+//              effect must not create one.
+// Not yet: the regions of the impedance-domain diagnosis, more than one effect
+// at a time.
 #include <string>
 
+#include "model/modal.hpp"
 #include "update/gap_diagnosis.hpp"
 #include "update/output_error.hpp"
 
@@ -32,5 +42,20 @@ namespace piezo::update {
 
 // `r` from fit_output_error with scan_effects set. `fit_description` names the data.
 GapDiagnosis gap_from_output_error(const OeResult& r, const std::string& fit_description);
+
+// The same, checked on held-out data: `heldout` another capture (its own R1
+// and noise), predicted by the fit's model with the solver and class of the
+// fit. Throws std::invalid_argument for unusable held-out data.
+struct OeHeldout {
+  OeData data;
+  std::string description;
+  double min_shrink = 0.3;  // the verdict's effect must shrink a held-out gap this much
+  // … and this much when it leaves a lack of fit in the fit (then the verdict
+  // says "not alone, or not exactly in the catalogue's form").
+  double dominant_shrink = 0.7;
+};
+GapDiagnosis gap_from_output_error(const OeResult& r, const std::string& fit_description,
+                                   model::ModalSolver& solver, const MaterialClass& cls, const OeHeldout& heldout,
+                                   const OeOptions& options);
 
 }  // namespace piezo::update

@@ -35,10 +35,13 @@
 //               3 sigma, is "not identifiable" (with its numbers and what would
 //               pin it).
 #include <Eigen/Core>
+#include <functional>
+#include <optional>
 #include <span>
 #include <string>
 #include <vector>
 
+#include "model/effects.hpp"
 #include "model/modal.hpp"
 #include "model/transient.hpp"
 #include "update/cmcm.hpp"
@@ -132,6 +135,17 @@ struct OeEffect {
   // quarter of the significance, so value, σ and Δχ² are the linear ones.
   bool linearised = false;
   TubeParams material;  // the constants refitted with it
+  double beta_s = 0;    // … and the Rayleigh β
+  // The whole effect set of the fit with it (the bench's known effects and
+  // this one at its value): what predicts another capture with it.
+  model::EffectSet effect_set;
+  // The fit's statistical covariance with it, relative coordinates as
+  // OeResult::covariance_rel plus the effect's (effect_coordinate units).
+  Eigen::MatrixXd covariance_rel;
+  // dielectric_loss: the law in frequency that fitted better (both are tried):
+  // "frequency-independent" (εT33·(1 − j·tanδ), the FE convention) or
+  // "constant-phase" (causal, ε' falling with frequency).
+  std::string law;
 };
 
 struct OeParameter {
@@ -170,6 +184,11 @@ struct OeResult {
   int residual_samples = 0;
   int starts = 0, iterations = 0, evaluations = 0;
   std::vector<OeEffect> effects;             // OeOptions::scan_effects, largest Δχ² first
+  model::EffectSet effect_set;               // the bench's known effects the fit held (a measured fixture's)
+  // Statistical covariance (Birge-widened, no type-B part) of the fit's
+  // coordinates at the answer, RELATIVE to it: ln YE11, nu12/nu12 − 1, ln d31,
+  // ln εT33, ln β (what the held-out prediction propagates).
+  Eigen::MatrixXd covariance_rel;
   std::vector<TubeParams> optima;            // every refined start's optimum (best first)
   std::vector<double> optima_cost;
   double seconds = 0;
@@ -184,5 +203,46 @@ struct OeResult {
 OeResult fit_output_error(model::ModalSolver& solver, const MaterialClass& cls,
                           const TubeParams& nominal, const OeData& data,
                           const OeOptions& options = {});
+
+// A catalogue effect as a coordinate of the output-error model: x·typical
+// added to its EffectSet field (the DAQ input as a conductance, x·1 µS, so
+// that 0 is "none"). Empty for effects this model cannot fit.
+struct EffectCoordinate {
+  double typical = 0;  // SI (the DAQ input: siemens)
+  std::function<void(model::EffectSet&, double)> apply;
+  std::function<double(double)> value;  // SI from x (the DAQ input: siemens)
+};
+std::optional<EffectCoordinate> effect_coordinate(const std::string& name);
+
+// The held-out check (issue 18): another capture of the same transducer —
+// any drive, one shot or more — its v2 predicted from its own v1 by given
+// constants, Rayleigh β and bench effects, nothing fitted; the filtered
+// residual (same low-pass, decimation, offset handling and noise sources as
+// the fit) against that capture's own noise.
+struct OePrediction {
+  double chi2_per_dof = 0;  // (residual/noise)² per degree of freedom
+  int samples = 0;          // filtered residual samples
+  double dof = 0;           // samples minus the offsets' projected dimension
+  double noise_rms_v = 0, residual_rms_v = 0;
+  double noise_dof = 0;     // degrees of freedom of the noise estimate
+  double chi2_limit = 0;    // chi2_per_dof beyond this: the prediction misses (OeOptions::lack_of_fit_z)
+  int shots_used = 0;
+  bool prediction_uncertainty = false;  // the fit's covariance was counted (see below)
+  std::string noise_source, offset_model;
+};
+
+// Throws std::invalid_argument for unusable data (as fit_output_error) and
+// std::runtime_error when the model cannot be simulated.
+//
+// With `covariance_rel` (OeResult/OeEffect::covariance_rel) the prediction's
+// own uncertainty counts as noise: χ² = min_θ ‖r(θ)/σ‖² + (θ − θ̂)ᵀC⁻¹(θ − θ̂)
+// over the fit's coordinates (and the effect's, `effect`), to first order
+// rᵀ(σ²I + J·C·Jᵀ)⁻¹r — a held-out record far richer than the fit's (a chirp)
+// sees the fit's constants' sigmas, which are no gap.
+OePrediction predict_output_error(model::ModalSolver& solver, const MaterialClass& cls, const TubeParams& params,
+                                  double beta_s, const model::EffectSet& effects, const OeData& data,
+                                  double band_hz, const OeOptions& options = {},
+                                  const Eigen::MatrixXd& covariance_rel = {},
+                                  const std::string& effect = "");
 
 }  // namespace piezo::update

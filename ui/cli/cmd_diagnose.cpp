@@ -130,7 +130,7 @@ std::string plot_subtitle(const DiagnoseArgs& a, const std::string& material,
   std::string t = "fit: " + fs::path(a.fit).filename().string() + "; ";
   if (!a.holdout.empty())
     t += "held out: " + fs::path(a.holdout).filename().string() +
-         (d.method == "output-error" ? " (not used: one-shot diagnosis)" : "");
+         (d.method == "output-error" ? " (predicted from its v1)" : "");
   else
     t += d.heldout_description.empty() ? std::string("no held-out data") : d.heldout_description;
   return t + "; nominal " + material + (a.transverse ? ", transversely isotropic" : ", isotropic") +
@@ -176,7 +176,7 @@ void run_diagnose(Context& ctx, const DiagnoseArgs& a) {
   res.warnings.insert(res.warnings.begin(), material_warnings.begin(), material_warnings.end());
   if (!res.diagnosis) throw InputError(a.fit + ": " + why_not_diagnosed(res));
   const auto& d = *res.diagnosis;
-  if (!a.holdout.empty() && d.n_heldout == 0 && d.method == "impedance")
+  if (!a.holdout.empty() && d.n_heldout == 0)
     throw InputError(a.holdout +
                      ": fewer than 3 transient dut shots; the held-out data could not be used");
 
