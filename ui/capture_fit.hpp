@@ -46,6 +46,7 @@ struct CaptureFit {
 // one's drive and rate, R1 from /setup, corrected by a measured fixture (true
 // R1, Cp, lead R, skew). `excitation` (optional) receives the drive's name.
 // Throws std::invalid_argument when the capture holds no dut transient shot.
+// The data's shots are views into `cap`: it must outlive them.
 update::OeData capture_oe_data(const acq::Capture& cap, const std::optional<dsp::FixtureCalibration>& fixture,
                                std::string* excitation = nullptr);
 

@@ -1,5 +1,7 @@
 #include "update/output_error.hpp"
 
+#include <Eigen/Eigenvalues>
+
 #include <Eigen/Dense>
 #include <algorithm>
 #include <chrono>
@@ -655,7 +657,9 @@ OeResult fit_output_error(model::ModalSolver& solver, const MaterialClass& cls,
   // shrinking by less than a tenth per iteration: a local optimum the data
   // reject, which the honesty check below ignores anyway).
   const double dof_fit = std::max(1.0, double(prob.samples()) - kParams - offset_dof);
-  auto levenberg_marquardt = [&](Eigen::VectorXd x, const LmOutcome* lead) {
+  // `j0`: the Jacobian at x when the caller has it (an effect scanned from the
+  // optimum: the five's columns there are the optimum's), saving its models.
+  auto levenberg_marquardt = [&](Eigen::VectorXd x, const LmOutcome* lead, const Eigen::MatrixXd* j0 = nullptr) {
     LmOutcome o;
     auto r = weighted(x);
     if (!r) {
@@ -673,7 +677,9 @@ OeResult fit_output_error(model::ModalSolver& solver, const MaterialClass& cls,
     Eigen::MatrixXd j;
     for (int it = 1; it <= opt.max_iterations; ++it) {
       o.iterations = it;
-      if (!jacobian(x, *r, j)) {
+      if (it == 1 && j0 && j0->rows() == r->size() && j0->cols() == x.size()) {
+        j = *j0;
+      } else if (!jacobian(x, *r, j)) {
         o.message = "the model could not be simulated near the estimate";
         break;
       }
@@ -996,17 +1002,23 @@ OeResult fit_output_error(model::ModalSolver& solver, const MaterialClass& cls,
     // the score test there (Rao): the χ² drop the effect would bring to first
     // order, (j⊥ᵀr)²/‖j⊥‖², j⊥ its column beyond the five's span.
     double score = INFINITY, step_lin = 0, jperp2 = 0;
+    Eigen::MatrixXd j_start;  // J at x0: the five's columns at the optimum and the effect's
     if (auto r0 = weighted(x0)) {
       Eigen::VectorXd xp = x0;
       xp[kParams] = 1e-4;
       if (auto rp = weighted(xp)) {
         const Eigen::VectorXd je = (*rp - *r0) / 1e-4;
+        if (best.j.rows() == je.size()) {
+          j_start.resize(je.size(), kParams + 1);
+          j_start << best.j, je;
+        }
         const Eigen::VectorXd c = best.j.colPivHouseholderQr().solve(je);
         const Eigen::VectorXd jperp = je - best.j * c;
         e.alias_residual = je.norm() > 0 ? jperp.norm() / je.norm() : 0.0;
         // x₆ = 1 is `typical`; the constants' coordinates are logs (nu12 relative).
         for (int i = 0; i < 4; ++i) e.bias_pct[i] = 100.0 * c[i];
         jperp2 = jperp.squaredNorm();
+        e.detectability = std::sqrt(jperp2);
         if (jperp2 > 0) {
           const double g = jperp.dot(*r0);
           score = g * g / jperp2;
@@ -1041,7 +1053,8 @@ OeResult fit_output_error(model::ModalSolver& solver, const MaterialClass& cls,
     // follow part way (4 % of added mass fits as YE11 −2.8 % at χ²/ν ≈ 1):
     // from the optimum alone LM stays at none, so where the capture shows a
     // misfit it also starts at 2 % and 4 % (each evaluation an FE model).
-    LmOutcome run = levenberg_marquardt(x0, nullptr);
+    const Eigen::MatrixXd* j0 = j_start.size() ? &j_start : nullptr;
+    LmOutcome run = levenberg_marquardt(x0, nullptr, j0);
     if (name == "mass_loading" && out.lack_of_fit)
       for (double start : {2.0, 4.0}) {
         Eigen::VectorXd xs = x0;
@@ -1058,12 +1071,36 @@ OeResult fit_output_error(model::ModalSolver& solver, const MaterialClass& cls,
         apply(fx, x);
         fx.dielectric_constant_phase = true;
       });
-      LmOutcome causal = levenberg_marquardt(x0, nullptr);
+      LmOutcome causal = levenberg_marquardt(x0, nullptr);  // (its effect column is another)
       if (causal.cost < run.cost) {
         run = std::move(causal);
         e.law = "constant-phase";
       } else {
         prob.free_effect(apply);
+      }
+    }
+    // Under a lack of fit the five may sit in another basin (β and a shifted
+    // YE11/nu12 absorbing part of the effect: a 30 Ω lead on one 2 % shot
+    // fits as YE11 −3.5 %, nu12 −12 %, β ×1.8); from there the sixth
+    // coordinate cannot leave it. A significant effect gets the coarse grid
+    // again, at its fitted value, and LM from the grid's best point.
+    if (out.lack_of_fit && 2.0 * (best.cost - run.cost) > opt.effect_significance) {
+      Eigen::VectorXd xg_best;
+      double cg_best = INFINITY;
+      for (int a = -1; a <= 1; ++a)
+        for (int b = -1; b <= 1; ++b) {
+          Eigen::VectorXd xg = Eigen::VectorXd::Zero(kParams + 1);
+          xg[0] = std::log1p(a * opt.grid_span_ye11);
+          xg[1] = b * opt.grid_span_nu12;
+          xg[4] = run.x[4];
+          xg[kParams] = run.x[kParams];
+          const auto rg = weighted(xg);
+          const double cg = rg ? 0.5 * rg->squaredNorm() : INFINITY;
+          if (cg < cg_best) cg_best = cg, xg_best = xg;
+        }
+      if (std::isfinite(cg_best)) {
+        LmOutcome other = levenberg_marquardt(xg_best, nullptr);
+        if (other.cost < run.cost) run = std::move(other);
       }
     }
     finish(run);
@@ -1156,10 +1193,14 @@ OePrediction predict_output_error(model::ModalSolver& solver, const MaterialClas
   // linearly: a few Gauss-Newton steps of the penalised problem.
   const Eigen::Index np = covariance_rel.rows();
   const auto coord = effect.empty() ? std::nullopt : effect_coordinate(effect);
-  Eigen::FullPivLU<Eigen::MatrixXd> lc(covariance_rel);
-  if ((np == kParams || (np == kParams + 1 && coord)) && covariance_rel.cols() == np && covariance_rel.allFinite() &&
-      lc.isInvertible()) {
-    const Eigen::MatrixXd cinv = lc.inverse();
+  if ((np == kParams || (np == kParams + 1 && coord)) && covariance_rel.cols() == np && covariance_rel.allFinite()) {
+    // C⁻¹ on C's positive eigenvalues (a covariance from a nearly singular
+    // JᵀJ can carry rounding-negative ones; a direction C does not constrain
+    // gets no penalty-free freedom: its eigenvalue is floored).
+    const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> es(0.5 * (covariance_rel + covariance_rel.transpose()));
+    const double lmax = es.eigenvalues().cwiseAbs().maxCoeff();
+    const Eigen::VectorXd lam = es.eigenvalues().cwiseMax(1e-12 * lmax + 1e-300);
+    const Eigen::MatrixXd cinv = es.eigenvectors() * lam.cwiseInverse().asDiagonal() * es.eigenvectors().transpose();
     auto residual_at = [&](const Eigen::VectorXd& z) -> std::optional<Eigen::VectorXd> {
       model::EffectSet fx = effects;
       if (np > kParams) coord->apply(fx, z[kParams]);
@@ -1204,9 +1245,12 @@ OePrediction predict_output_error(model::ModalSolver& solver, const MaterialClas
       }
       if (!accepted) break;
     }
-    chi2 = cost;
-    out.prediction_uncertainty = true;
+    if (std::isfinite(cost) && cost >= 0) {
+      chi2 = cost;
+      out.prediction_uncertainty = true;
+    }
   }
+  if (!std::isfinite(chi2)) throw std::runtime_error("predict_output_error: the prediction is not finite");
   out.chi2_per_dof = chi2 / out.dof;
   out.chi2_limit = 1.0 + opt.lack_of_fit_z * std::sqrt(2.0 / out.dof + (out.noise_dof > 0 ? 2.0 / out.noise_dof : 0.0));
   return out;

@@ -123,6 +123,9 @@ struct OeEffect {
   // (R1's tolerance, a parallel capacitance): never a finding, only a bias.
   double alias_residual = 1;
   bool alias = false;
+  // ‖(I − P)j‖ at `typical` in noise units: the Δχ² would be its square for
+  // an effect of the typical size (what this capture can see of it).
+  double detectability = 0;
   // What the constants take of it when it is not modelled: their shift, %,
   // for `typical` (SI) of the effect (YE11, nu12, d31, εT33).
   double typical = 0;

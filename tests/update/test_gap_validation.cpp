@@ -33,6 +33,7 @@ struct Case {
   std::uint64_t seed = 1;
   double scale[4] = {1, 1, 1, 1};
   double beta = 1e-7;
+  int shots = 16;  // of the fit capture and of the held-out one
 };
 
 // Realistic bench magnitudes.
@@ -75,7 +76,7 @@ double truth_chi2(const acq::SimSpec& spec, const fs::path& capture) {
 ui::PipelineResult run_case(const Case& c, const fs::path& dir) {
   ui::PipelineRequest req;
   req.instrument = "sim";
-  req.plan = test::seed_lab_plan(16);
+  req.plan = test::seed_lab_plan(c.shots);
   req.plan.setup.transducer_id = "validation";
   auto p = model::isotropic_params(model::find_preset("apc850").material);
   char set[200];
@@ -94,10 +95,10 @@ ui::PipelineResult run_case(const Case& c, const fs::path& dir) {
     model::apply_effect_assignment(req.sim.effects, assignment);
   }
   req.capture_out = (dir / "fit.h5").string();
-  req.heldout_plan = test::chirp_plan(16);
+  req.heldout_plan = test::chirp_plan(c.shots);
   std::atomic<bool> cancel{false};
   auto r = ui::run_pipeline(req, {}, cancel);
-  if (std::getenv("GAP_VERBOSE")) {
+  if (std::getenv("GAP_VERBOSE") && c.shots >= 3) {  // (the shot ensemble needs repeats)
     const acq::SimSpec& spec = req.sim;
     std::printf("    truth: chi2/N of the fit capture %.2f, of the held-out capture %.2f (estimates vs the true bench)\n",
                 truth_chi2(spec, dir / "fit.h5"), truth_chi2(spec, dir / "fit-heldout.h5"));
@@ -144,7 +145,9 @@ void score(const Case& c, const ui::PipelineResult& r, Tally& t) {
     if (verdict == "none" || verdict == "unexplained") ++t.aliases_reported;  // listed as alias, no false claim
   } else if (undetectable) {
     ++t.undetectable;
-    if (verdict == "none" || verdict == "unexplained") ++t.undetectable_quiet;  // no false claim
+    // No false claim: none/unexplained, or the injected effect itself (below
+    // the FIT's noise, the held-out record of another drive can still show it).
+    if (verdict == "none" || verdict == "unexplained" || verdict == c.effect) ++t.undetectable_quiet;
   } else {
     ++t.identifiable;
     // Named: the verdict's effect, or an effect the verdict names as its
@@ -289,9 +292,12 @@ TEST(GapDiagnosisCi, StrippingTruthChangesNothing) {
 }
 
 #else
-TEST(GapDiagnosisValidation, ThirtySixTransducers) {
+// GAP_CASES (default 36), GAP_SHOTS (default `shots`), GAP_ONLY, GAP_SEED,
+// GAP_VALUE, GAP_NOISE, GAP_VERBOSE: see below.
+void study(int shots) {
   const char* env = std::getenv("GAP_CASES");
   const int n = env ? std::atoi(env) : 36;
+  if (const char* s = std::getenv("GAP_SHOTS")) shots = std::atoi(s);
   Tally t;
   // GAP_ONLY=i,j,...: only these case indices (0-based), for looking into them.
   std::vector<int> only;
@@ -306,6 +312,7 @@ TEST(GapDiagnosisValidation, ThirtySixTransducers) {
   const std::uint64_t draw = std::getenv("GAP_SEED") ? std::strtoull(std::getenv("GAP_SEED"), nullptr, 10) : 2026;
   for (auto c : draw_cases(n, draw)) {
     ++index;
+    c.shots = shots;
     // GAP_VALUE / GAP_NOISE: the drawn case with another magnitude or noise (looking into a case).
     if (const char* v = std::getenv("GAP_VALUE")) c.value = std::atof(v);
     if (const char* v = std::getenv("GAP_NOISE")) c.noise = std::atof(v);
@@ -329,6 +336,19 @@ TEST(GapDiagnosisValidation, ThirtySixTransducers) {
   EXPECT_GE(t.controls_none, 0.9 * t.controls);
   EXPECT_EQ(t.aliases_reported, t.aliased);
   EXPECT_EQ(t.undetectable_quiet, t.undetectable);
-  for (double s : t.shrinks) EXPECT_GE(s, 0.7);
+  if (shots >= 3) {
+    for (double s : t.shrinks) EXPECT_GE(s, 0.7);
+  } else if (!t.shrinks.empty()) {  // issue 18's figure for one shot: the median
+    auto v = t.shrinks;
+    std::sort(v.begin(), v.end());
+    EXPECT_GE(v[v.size() / 2], 0.7);
+  }
 }
+
+// 16 averaged shots of each drive: the impedance-domain diagnosis.
+TEST(GapDiagnosisValidation, ThirtySixTransducers) { study(16); }
+
+// ONE exp_decay shot to fit and ONE chirp shot held out (issue 18): the
+// output-error diagnosis, the held-out capture predicted from its own v1.
+TEST(GapDiagnosisValidation, ThirtySixTransducersOneShot) { study(1); }
 #endif
