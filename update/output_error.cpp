@@ -980,6 +980,56 @@ OeResult fit_output_error(model::ModalSolver& solver, const MaterialClass& cls,
     }
     out.parameters.push_back(p);
   }
+  // An effect's LM run and how it enters (its coordinate, with the law chosen).
+  struct Refit {
+    std::size_t index;  // in out.effects
+    std::function<void(model::EffectSet&, double)> apply;
+    std::function<double(double)> value;
+    double typical;
+    const model::EffectInfo* info;
+    LmOutcome run;
+  };
+  std::vector<Refit> refits;
+  // The effect's numbers from its run.
+  auto fill = [&](OeEffect& e, Refit& rf) {
+    LmOutcome& run = rf.run;
+    finish(run);
+    e.converged = run.converged;
+    e.material = co.params(run.x.head(kParams));
+    e.beta_s = co.beta(run.x.head(kParams));
+    e.effect_set = prob.effects();
+    rf.apply(e.effect_set, run.x[kParams]);
+    const double dof_e = std::max(1.0, dof - 1.0);
+    e.chi2_per_dof = 2.0 * run.cost / dof_e;
+    e.delta_chi2 = 2.0 * (best.cost - run.cost);
+    const double v = rf.value(run.x[kParams]);
+    double sv = NAN;
+    if (run.jtj.rows() == kParams + 1) {
+      Eigen::FullPivLU<Eigen::MatrixXd> lu(run.jtj);
+      if (lu.isInvertible()) {
+        const Eigen::MatrixXd ce = std::max(1.0, e.chi2_per_dof) * lu.inverse();
+        sv = rf.typical * std::sqrt(std::max(0.0, ce(kParams, kParams)));
+        e.covariance_rel = ce;
+        const double k = nominal.nu12 / e.material.nu12;
+        e.covariance_rel.row(1) *= k;
+        e.covariance_rel.col(1) *= k;
+      }
+    }
+    const bool daq = e.name == "daq_input_resistance";
+    if (daq) {  // conductance → resistance, σ_R = σ_G/G²
+      e.value = v > 0 ? 1.0 / v : INFINITY;
+      e.sigma = v > 0 ? sv / (v * v) : NAN;
+    } else {
+      e.value = v;
+      e.sigma = sv;
+    }
+    const auto st = spectral_lack_of_fit(run.r, prob.residual_psd(*t_best, ch1, ch2), prob.residual_bin_hz());
+    e.band_log10_p = st.log10_p;
+    const bool physical = daq ? v > 0 : (e.value >= rf.info->lower && e.value <= rf.info->upper);
+    e.significant = !e.alias && run.converged && physical &&
+                    e.delta_chi2 > opt.effect_significance * std::max(1.0, e.chi2_per_dof);
+    e.explains = e.significant && e.chi2_per_dof <= out.chi2_limit && st.log10_p >= std::log10(opt.lack_of_fit_p);
+  };
   // The catalogue's effects, one at a time, as a sixth coordinate from the
   // optimum (effect_coordinate).
   for (const auto& name : opt.scan_effects) {
@@ -1079,12 +1129,31 @@ OeResult fit_output_error(model::ModalSolver& solver, const MaterialClass& cls,
         prob.free_effect(apply);
       }
     }
-    // Under a lack of fit the five may sit in another basin (β and a shifted
-    // YE11/nu12 absorbing part of the effect: a 30 Ω lead on one 2 % shot
-    // fits as YE11 −3.5 %, nu12 −12 %, β ×1.8); from there the sixth
-    // coordinate cannot leave it. A significant effect gets the coarse grid
-    // again, at its fitted value, and LM from the grid's best point.
-    if (out.lack_of_fit && 2.0 * (best.cost - run.cost) > opt.effect_significance) {
+    Refit rf{out.effects.size(), apply, value, typical, info, std::move(run)};
+    if (e.law == "constant-phase")
+      rf.apply = [apply](model::EffectSet& fx, double x) {
+        apply(fx, x);
+        fx.dielectric_constant_phase = true;
+      };
+    fill(e, rf);
+    out.effects.push_back(e);
+    refits.push_back(std::move(rf));
+  }
+  // Under a lack of fit the five may sit in another basin (β and a shifted
+  // YE11/nu12 absorbing part of the effect: a 30 Ω lead on one 2 % shot fits
+  // as YE11 −3.5 %, nu12 −12 %, β ×1.8); from there the sixth coordinate
+  // cannot leave it. The two most significant effects get the coarse grid
+  // again, at their fitted value, and LM from the grid's best point.
+  if (out.lack_of_fit) {
+    std::vector<Refit*> order;
+    for (auto& rf : refits)
+      if (out.effects[rf.index].delta_chi2 > opt.effect_significance) order.push_back(&rf);
+    std::sort(order.begin(), order.end(), [&](const Refit* a, const Refit* b) {
+      return out.effects[a->index].delta_chi2 > out.effects[b->index].delta_chi2;
+    });
+    if (order.size() > 2) order.resize(2);
+    for (Refit* rf : order) {
+      prob.free_effect(rf->apply);
       Eigen::VectorXd xg_best;
       double cg_best = INFINITY;
       for (int a = -1; a <= 1; ++a)
@@ -1092,58 +1161,19 @@ OeResult fit_output_error(model::ModalSolver& solver, const MaterialClass& cls,
           Eigen::VectorXd xg = Eigen::VectorXd::Zero(kParams + 1);
           xg[0] = std::log1p(a * opt.grid_span_ye11);
           xg[1] = b * opt.grid_span_nu12;
-          xg[4] = run.x[4];
-          xg[kParams] = run.x[kParams];
+          xg[4] = rf->run.x[4];
+          xg[kParams] = rf->run.x[kParams];
           const auto rg = weighted(xg);
           const double cg = rg ? 0.5 * rg->squaredNorm() : INFINITY;
           if (cg < cg_best) cg_best = cg, xg_best = xg;
         }
-      if (std::isfinite(cg_best)) {
-        LmOutcome other = levenberg_marquardt(xg_best, nullptr);
-        if (other.cost < run.cost) run = std::move(other);
+      if (!std::isfinite(cg_best)) continue;
+      LmOutcome other = levenberg_marquardt(xg_best, nullptr);
+      if (other.cost < rf->run.cost) {
+        rf->run = std::move(other);
+        fill(out.effects[rf->index], *rf);
       }
     }
-    finish(run);
-    e.converged = run.converged;
-    e.material = co.params(run.x.head(kParams));
-    e.beta_s = co.beta(run.x.head(kParams));
-    {
-      Eigen::VectorXd xe = run.x;
-      model::EffectSet fx = prob.effects();
-      if (e.law == "constant-phase") fx.dielectric_constant_phase = true;
-      apply(fx, xe[kParams]);
-      e.effect_set = fx;
-    }
-    const double dof_e = std::max(1.0, dof - 1.0);
-    e.chi2_per_dof = 2.0 * run.cost / dof_e;
-    e.delta_chi2 = 2.0 * (best.cost - run.cost);
-    double v = value(run.x[kParams]);
-    double sv = NAN;
-    if (run.jtj.rows() == kParams + 1) {
-      Eigen::FullPivLU<Eigen::MatrixXd> lu(run.jtj);
-      if (lu.isInvertible()) {
-        const Eigen::MatrixXd ce = std::max(1.0, e.chi2_per_dof) * lu.inverse();
-        sv = typical * std::sqrt(std::max(0.0, ce(kParams, kParams)));
-        e.covariance_rel = ce;
-        const double k = nominal.nu12 / e.material.nu12;
-        e.covariance_rel.row(1) *= k;
-        e.covariance_rel.col(1) *= k;
-      }
-    }
-    if (name == "daq_input_resistance") {  // conductance → resistance, σ_R = σ_G/G²
-      e.value = v > 0 ? 1.0 / v : INFINITY;
-      e.sigma = v > 0 ? sv / (v * v) : NAN;
-    } else {
-      e.value = v;
-      e.sigma = sv;
-    }
-    const auto st = spectral_lack_of_fit(run.r, prob.residual_psd(*t_best, ch1, ch2), prob.residual_bin_hz());
-    e.band_log10_p = st.log10_p;
-    const bool physical = name == "daq_input_resistance" ? v > 0 : (e.value >= info->lower && e.value <= info->upper);
-    e.significant = !e.alias && run.converged && physical &&
-                    e.delta_chi2 > opt.effect_significance * std::max(1.0, e.chi2_per_dof);
-    e.explains = e.significant && e.chi2_per_dof <= out.chi2_limit && st.log10_p >= std::log10(opt.lack_of_fit_p);
-    out.effects.push_back(e);
   }
   prob.free_effect({});
   std::sort(out.effects.begin(), out.effects.end(),
