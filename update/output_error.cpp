@@ -630,10 +630,14 @@ OeResult fit_output_error(model::ModalSolver& solver, const MaterialClass& cls,
     if (!r->allFinite()) return std::nullopt;
     return r;
   };
-  auto jacobian = [&](const Eigen::VectorXd& x, const Eigen::VectorXd& r0, Eigen::MatrixXd& j) {
+  // Columns from `first` on (the others kept as they are in j).
+  auto jacobian = [&](const Eigen::VectorXd& x, const Eigen::VectorXd& r0, Eigen::MatrixXd& j, int first = 0) {
     const auto np = static_cast<int>(x.size());  // 5, or 6 with a free effect (scan_effects)
-    j.resize(r0.size(), np);
-    for (int c = 0; c < np; ++c) {
+    if (j.rows() != r0.size() || j.cols() != np) {
+      j.resize(r0.size(), np);
+      first = 0;
+    }
+    for (int c = first; c < np; ++c) {
       const double h = c >= 4 ? 1e-4 : 1e-6;
       Eigen::VectorXd xp = x;
       xp[c] += h;
@@ -659,7 +663,13 @@ OeResult fit_output_error(model::ModalSolver& solver, const MaterialClass& cls,
   const double dof_fit = std::max(1.0, double(prob.samples()) - kParams - offset_dof);
   // `j0`: the Jacobian at x when the caller has it (an effect scanned from the
   // optimum: the five's columns there are the optimum's), saving its models.
-  auto levenberg_marquardt = [&](Eigen::VectorXd x, const LmOutcome* lead, const Eigen::MatrixXd* j0 = nullptr) {
+  // `freeze_material`: with j0, the four material columns stay j0's (an
+  // effect scanned from the optimum moves the constants by a fraction of their
+  // sigmas: their columns barely change, and each costs an FE port model);
+  // β's and the effect's are recomputed (no new model). finish() computes the
+  // exact J at the answer for the covariance.
+  auto levenberg_marquardt = [&](Eigen::VectorXd x, const LmOutcome* lead, const Eigen::MatrixXd* j0 = nullptr,
+                                 bool freeze_material = false) {
     LmOutcome o;
     auto r = weighted(x);
     if (!r) {
@@ -677,8 +687,15 @@ OeResult fit_output_error(model::ModalSolver& solver, const MaterialClass& cls,
     Eigen::MatrixXd j;
     for (int it = 1; it <= opt.max_iterations; ++it) {
       o.iterations = it;
-      if (it == 1 && j0 && j0->rows() == r->size() && j0->cols() == x.size()) {
+      const bool have_j0 = j0 && j0->rows() == r->size() && j0->cols() == x.size();
+      if (it == 1 && have_j0) {
         j = *j0;
+      } else if (freeze_material && have_j0) {
+        j = *j0;
+        if (!jacobian(x, *r, j, 4)) {
+          o.message = "the model could not be simulated near the estimate";
+          break;
+        }
       } else if (!jacobian(x, *r, j)) {
         o.message = "the model could not be simulated near the estimate";
         break;
@@ -994,6 +1011,19 @@ OeResult fit_output_error(model::ModalSolver& solver, const MaterialClass& cls,
   auto fill = [&](OeEffect& e, Refit& rf) {
     LmOutcome& run = rf.run;
     finish(run);
+    // One Gauss-Newton step on the exact J (a run with the material columns
+    // frozen stops where J₀ᵀr = 0, a fraction of a sigma from Jᵀr = 0).
+    if (run.jtj.rows() == run.x.size() && run.r.size() == run.j.rows()) {
+      const Eigen::VectorXd step = -run.jtj.ldlt().solve(run.j.transpose() * run.r);
+      if (step.allFinite() && step.cwiseAbs().maxCoeff() < 0.3) {
+        const Eigen::VectorXd xt = run.x + step;
+        if (const auto rt = weighted(xt); rt && 0.5 * rt->squaredNorm() < run.cost) {
+          run.x = xt;
+          run.r = *rt;
+          run.cost = 0.5 * rt->squaredNorm();
+        }
+      }
+    }
     e.converged = run.converged;
     e.material = co.params(run.x.head(kParams));
     e.beta_s = co.beta(run.x.head(kParams));
@@ -1104,7 +1134,13 @@ OeResult fit_output_error(model::ModalSolver& solver, const MaterialClass& cls,
     // from the optimum alone LM stays at none, so where the capture shows a
     // misfit it also starts at 2 % and 4 % (each evaluation an FE model).
     const Eigen::MatrixXd* j0 = j_start.size() ? &j_start : nullptr;
-    LmOutcome run = levenberg_marquardt(x0, nullptr, j0);
+    // (The end mass moves the modes themselves: its runs keep the exact J.)
+    LmOutcome run = levenberg_marquardt(x0, nullptr, j0, name != "mass_loading");
+    if (!run.converged && name != "mass_loading" && std::isfinite(run.cost)) {
+      // The frozen columns did not get there: on from where it stopped, exactly.
+      LmOutcome exact = levenberg_marquardt(run.x, nullptr);
+      if (exact.converged || exact.cost < run.cost) run = std::move(exact);
+    }
     if (name == "mass_loading" && out.lack_of_fit)
       for (double start : {2.0, 4.0}) {
         Eigen::VectorXd xs = x0;
