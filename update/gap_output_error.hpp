@@ -15,21 +15,21 @@
 //              OeOptions::effect_significance·max(1, χ²/ν) at a physical value);
 //   twins      significant effects whose χ² with them differs by less than
 //              max(4, 1 %) from the verdict's: this capture cannot tell them;
-//   verdict    the most significant effect when it explains the capture (no
-//              lack of fit left with it; without held-out data nothing less
-//              is a verdict), "none" without a gap, else "unexplained" (with
-//              the band where the residual stands out and the closest effect,
-//              which is not named as the cause).
-//   held-out  another capture of the same transducer (any drive, one shot
+//   verdict    the first significant effect (largest Δχ² first) that explains
+//              the capture (no lack of fit left with it; without held-out data
+//              nothing less is a verdict) and passes the held-out check below;
+//              "none" without a gap; else "unexplained" (with the band where the
+//              residual stands out and the closest effect, not named as cause).
+//   held-out   another capture of the same transducer (any drive, one shot
 //              included): its v2 predicted from its own v1 by the fit's model
-//              without and with each significant effect (predict_output_error);
-//              shrink = 1 − g_after/g_before of the excess g = √max(0, χ²/ν − 1).
-//              An effect that leaves a lack of fit in the fit is named only when
-//              it removes most (OeHeldout::dominant_shrink) of a held-out gap.
-//              When the held-out capture shows a gap of its own, the verdict's
-//              effect must shrink it by OeHeldout::min_shrink (else "unexplained":
-//              the fit's effect does not carry over); when it shows none, the
-//              effect must not create one.
+//              without and with each candidate (predict_output_error, the fit's
+//              covariance counted); shrink = 1 − g_after/g_before of the excess
+//              g = √max(0, χ²/ν − 1). Where the held-out capture shows a gap,
+//              the verdict's effect must shrink it by OeHeldout::min_shrink; an
+//              effect that leaves a lack of fit in the fit, or one seen in the
+//              fit below its significance (Δχ² ≥ 9), only by dominant_shrink.
+//              Where it shows none, the effect must not create one. An effect
+//              that fails is said not to carry over.
 // Not yet: the regions of the impedance-domain diagnosis, more than one effect
 // at a time.
 #include <string>
