@@ -365,9 +365,9 @@ SeedUpdate seed_update_stage(const PipelineRequest& req, const CaptureModel& cm,
     std::string note;
     {
       char buf[200];
-      std::snprintf(buf, sizeof buf, "extended CMCM %s: %d elastic + %d piezo iterations in %d sweeps, %.2f s",
+      std::snprintf(buf, sizeof buf, "extended CMCM %s: %d elastic + %d piezo iterations in %d sweeps",
                     r.ok() ? "converged" : "did NOT converge", r.iterations_elastic, r.iterations_piezo,
-                    r.sweeps, r.seconds);
+                    r.sweeps);
       note = buf;
       if (!r.ok()) note += ": " + r.message;
     }
@@ -382,8 +382,8 @@ SeedUpdate seed_update_stage(const PipelineRequest& req, const CaptureModel& cm,
       try {
         const auto lm = update::update_lm(*cm.tube, *cm.solver, cm.cls, cm.p0, feat);
         char buf[200];
-        std::snprintf(buf, sizeof buf, "; least squares (LM) on the same features %s in %d iterations, %.2f s",
-                      lm.ok() ? "converged" : "did NOT converge", lm.iterations, lm.seconds);
+        std::snprintf(buf, sizeof buf, "; least squares (LM) on the same features %s in %d iterations",
+                      lm.ok() ? "converged" : "did NOT converge", lm.iterations);
         note += buf;
         if (!lm.ok()) note += ": " + lm.message;
         if (lm.ok()) {
@@ -439,9 +439,9 @@ std::optional<update::OeResult> output_error_stage(const PipelineRequest& req, c
     char note[320];
     std::snprintf(note, sizeof note,
                   "output-error fit of %d shot(s) %s: chi2/dof %.3g (limit %.3g), %d of %zu constants ok, "
-                  "%d FE port models, %.2f s%s%s",
+                  "%d FE port models%s%s",
                   r.shots_used, r.ok() ? "converged" : "did NOT converge", r.chi2_per_dof, r.chi2_limit, ok,
-                  r.parameters.size(), r.evaluations, r.seconds, r.message.empty() ? "" : ": ",
+                  r.parameters.size(), r.evaluations, r.message.empty() ? "" : ": ",
                   r.message.c_str());
     out.stages.push_back({"update (output-error)", r.ok(), note});
     if (r.ok() && r.lack_of_fit) {
@@ -710,8 +710,8 @@ void diagnose_stage(const PipelineRequest& req, const acq::Capture& cap, const C
     }
     output_error_gap_curves(cap, *fit_shots.front(), cm, *r, cr.options, d);
     char note[240];
-    std::snprintf(note, sizeof note, "output-error model, %d shot(s): chi2/dof %.2f; verdict: %s (%.1f s)",
-                  r->shots_used, r->chi2_per_dof, d.verdict_effect.c_str(), r->seconds);
+    std::snprintf(note, sizeof note, "output-error model, %d shot(s): chi2/dof %.2f; verdict: %s",
+                  r->shots_used, r->chi2_per_dof, d.verdict_effect.c_str());
     out.stages.push_back({"diagnose", true, note});
     out.verdict = d.verdict;
     out.diagnosis = std::move(d);
@@ -733,9 +733,9 @@ void diagnose_stage(const PipelineRequest& req, const acq::Capture& cap, const C
       solver, cls, u.updated, u.damping, cap.setup.divider_r1_ohm, fit, ho ? &*ho : nullptr, go,
       [&](double f, const std::string& s) { progress(0.7 + 0.29 * f, s); }, &cancel);
   char note[200];
-  std::snprintf(note, sizeof note, "gap chi2/dof %.2f on %s%s; verdict: %s (%.1f s)", d.gap_fit,
+  std::snprintf(note, sizeof note, "gap chi2/dof %.2f on %s%s; verdict: %s", d.gap_fit,
                 fit.description.c_str(), ho ? (", held-out " + std::to_string(d.gap_heldout.value_or(0)).substr(0, 5)).c_str() : "",
-                d.verdict_effect.c_str(), d.seconds);
+                d.verdict_effect.c_str());
   out.stages.push_back({"diagnose", true, note});
   out.verdict = d.verdict;
   out.diagnosis = std::move(d);
