@@ -831,8 +831,15 @@ PipelineResult run_pipeline(const PipelineRequest& req, const std::function<void
     std::optional<acq::Capture> heldout;
     if (!req.heldout_capture.empty()) {
       out.heldout_path = req.heldout_capture;
-      heldout = req.replay_contained ? acq::read_capture_contained(req.heldout_capture)
-                                     : acq::read_capture(req.heldout_capture);
+      try {
+        heldout = req.replay_contained ? acq::read_capture_contained(req.heldout_capture)
+                                       : acq::read_capture(req.heldout_capture);
+      } catch (const std::exception& e) {
+        if (!req.heldout_optional) throw;
+        out.warnings.push_back("the held-out capture " + req.heldout_capture + " cannot be read (" + e.what() +
+                               "): diagnosed without it");
+        out.heldout_path.clear();
+      }
     } else if (req.heldout_plan && req.replay_capture.empty()) {
       progress(0.65, "acquire: held-out capture");
       heldout = acquire_heldout(req, *req.heldout_plan, sim, out, cancel);

@@ -42,6 +42,9 @@ struct PipelineRequest {
   bool diagnose = true;
   std::optional<acq::MeasurementPlan> heldout_plan;
   std::string heldout_capture;
+  // An unreadable `heldout_capture` is a warning (the capture is diagnosed
+  // without it) instead of the capture's failure: replay's pairing by name.
+  bool heldout_optional = false;
   std::vector<std::string> gap_candidates;  // empty: all supported
   // Relative floor added in quadrature to the measured noise of ln Z (model
   // and estimator systematics that repeated shots cannot see).

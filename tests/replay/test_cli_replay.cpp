@@ -267,3 +267,55 @@ TEST(CliReplay, BadOptionsAndFilesAreRefusedClearly) {
   EXPECT_FALSE(fs::exists(dir / "m.h5.partial"));
   fs::remove_all(dir);
 }
+
+// Issue 18: `replay --holdout NAME` pairs each capture with the held-out
+// capture beside it (the refsim corpus's folders: fit.h5 + holdout.h5); the
+// one-shot diagnosis predicts it. An unreadable held-out file is a warning,
+// not the capture's failure; the held-out files are replayed on their own too.
+TEST(CliReplay, HoldoutPairsEachCaptureWithTheFileBesideIt) {
+  const fs::path corpus = fs::path(PIEZO_SOURCE_DIR) / ".." / "shared" / "corpus" / "refsim-v1";
+  if (!fs::exists(corpus / "05" / "fit.h5")) GTEST_SKIP() << "no corpus at " << corpus;
+  const auto dir = test::fresh_dir("replay-holdout");
+  for (const char* c : {"05", "12"}) {
+    fs::create_directories(dir / "in" / c);
+    for (const char* f : {"fit.h5", "holdout.h5"}) fs::copy_file(corpus / c / f, dir / "in" / c / f);
+  }
+  const auto out = dir / "results.h5", jsonl = dir / "results.jsonl";
+  auto r = test::run_cli("replay '" + (dir / "in").string() + "' --holdout holdout.h5 --jobs 2 --out '" +
+                         out.string() + "' --jsonl '" + jsonl.string() + "'");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  int paired = 0, alone = 0;
+  for (const auto& j : test::read_lines(jsonl)) {
+    ASSERT_EQ(j["status"], "ok") << j.dump().substr(0, 400);
+    const auto& d = j["result"]["diagnosis"];
+    const std::string path = j["path"];
+    if (path.find("fit.h5") != std::string::npos) {
+      ++paired;
+      EXPECT_FALSE(d["gap_heldout"].is_null()) << path;
+      EXPECT_NE(d["heldout_data"].get<std::string>().find("holdout.h5"), std::string::npos) << path;
+      const std::string want = path.find("/05/") != std::string::npos ? "series_resistance" : "none";
+      EXPECT_EQ(d["verdict"]["effect"], want) << path;
+    } else {
+      ++alone;
+      EXPECT_TRUE(d["gap_heldout"].is_null()) << path;  // a held-out file has no partner of its own
+    }
+  }
+  EXPECT_EQ(paired, 2);
+  EXPECT_EQ(alone, 2);
+
+  // {stem}: fit.h5 → fit-heldout.h5, here not a capture at all.
+  const auto dir2 = dir / "junk";
+  fs::create_directories(dir2);
+  fs::copy_file(corpus / "12" / "fit.h5", dir2 / "fit.h5");
+  std::ofstream(dir2 / "fit-heldout.h5") << "not HDF5";
+  const auto jsonl2 = dir / "junk.jsonl";
+  r = test::run_cli("replay '" + (dir2 / "fit.h5").string() + "' --holdout '{stem}-heldout.h5' --out '" +
+                    (dir / "junk.h5").string() + "' --jsonl '" + jsonl2.string() + "'");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const auto lines = test::read_lines(jsonl2);
+  ASSERT_EQ(lines.size(), 1u);
+  const auto& j = lines.front();
+  EXPECT_EQ(j["status"], "ok");
+  EXPECT_NE(j.dump().find("fit-heldout.h5 cannot be read"), std::string::npos) << j.dump().substr(0, 600);
+  fs::remove_all(dir);
+}

@@ -64,6 +64,7 @@ void register_replay_commands(CLI::App& app, Context& ctx) {
     double timeout_s = 600.0;
     bool transverse = false;
     bool seed_chain = false;
+    std::string holdout;
     update::OeOptions oe;
   };
   auto a = std::make_shared<Args>();
@@ -92,6 +93,10 @@ void register_replay_commands(CLI::App& app, Context& ctx) {
   r->add_flag("--seed-chain", a->seed_chain,
               "Also run the seed's chain (Prony features -> extended CMCM, LM where it fails) beside the "
               "output-error fit; its constants go into parameters[].cmcm");
+  r->add_option("--holdout", a->holdout,
+                "Held-out capture beside each capture, by name: {stem} is the capture's name without .h5 "
+                "(e.g. holdout.h5, or {stem}-heldout.h5 for piezobench's own pairs); the diagnosis "
+                "predicts it from its v1");
   add_chain_tolerance_options(r, a->oe);
   add_json_flag(r, ctx);
   r->callback([&ctx, a] {
@@ -108,6 +113,7 @@ void register_replay_commands(CLI::App& app, Context& ctx) {
       opt.oe_options = a->oe;
       opt.isotropic = !a->transverse;
       opt.seed_chain = a->seed_chain;
+      opt.holdout = a->holdout;
       opt.software = std::string("piezobench ") + kVersion + " replay";
       g_stop = false;
       std::signal(SIGINT, on_signal);

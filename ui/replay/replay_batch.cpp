@@ -145,6 +145,20 @@ class Sink {
   Clock::time_point t0_ = Clock::now();
 };
 
+// ReplayOptions::holdout for `file`: the named file beside it, if it exists
+// and is not the capture itself.
+std::optional<fs::path> heldout_for(const fs::path& file, const std::string& pattern) {
+  if (pattern.empty()) return std::nullopt;
+  std::string name = pattern;
+  const std::string stem = file.stem().string();
+  for (std::size_t p = name.find("{stem}"); p != std::string::npos; p = name.find("{stem}", p + stem.size()))
+    name.replace(p, 6, stem);
+  const fs::path ho = file.parent_path() / name;
+  std::error_code ec;
+  if (!fs::is_regular_file(ho, ec) || fs::equivalent(ho, file, ec)) return std::nullopt;
+  return ho;
+}
+
 // ------------------------------------------------------------- one capture
 // Runs in a worker process: everything but the results file. `stage` tells the
 // batch what the worker is doing, so that a crash can be named.
@@ -201,6 +215,10 @@ Outcome replay_capture(const fs::path& file, const ReplayOptions& opt, const Sin
     req.isotropic = opt.isotropic;
     req.seed_chain = opt.seed_chain;
     req.oe_options = opt.oe_options;
+    if (const auto ho = heldout_for(file, opt.holdout)) {
+      req.heldout_capture = ho->string();
+      req.heldout_optional = true;
+    }
     result = ui::run_pipeline(req, nullptr, cancel);
     if (material_warning) result.warnings.insert(result.warnings.begin(), *material_warning);
   } catch (const acq::CaptureError& e) {

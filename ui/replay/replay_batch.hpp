@@ -45,6 +45,12 @@ struct ReplayOptions {
   bool isotropic = true;
   update::OeOptions oe_options;  // ui::PipelineRequest::oe_options (the chain's tolerances)
   bool seed_chain = false;  // also run the seed's CMCM/LM chain (ui::PipelineRequest::seed_chain)
+  // Each capture's held-out capture, by name in the capture's folder: "{stem}"
+  // stands for the capture's file name without ".h5" (the refsim corpus:
+  // "holdout.h5"; piezobench's own demo/measure pairs: "{stem}-heldout.h5").
+  // Empty, missing, or the capture itself: none. A held-out file is also
+  // replayed as a capture of its own.
+  std::string holdout;
   std::string software = "piezobench replay";
   // A capture whose worker has not answered after this long is a hang: the
   // worker is killed and the capture recorded as failed ("hung").
