@@ -54,6 +54,7 @@ void start_job(AppState& s, bool replay) {
                         "Type the path of a recorded capture (.h5) next to 'Replay capture'."};
       return;
     }
+    req.heldout_capture = s.heldout_path;  // optional; read (contained) by the pipeline
   } else if (req.instrument == "sim") {
     try {
       req.sim = sim_spec(s);

@@ -79,6 +79,7 @@ struct AppState {
   int material_index = 0;       // into model::material_presets(): the nominal model to update
   char capture_out[256] = "piezobench-capture.h5";
   char replay_path[256] = "";
+  char heldout_path[256] = "";  // optional: the replayed capture's held-out capture (issue 18)
   // Issue 10: fixture standards before the shots. The prompt is declared before
   // the job so that it outlives the job's thread, which may be waiting in it;
   // ~AppState declines that question before the job joins.

@@ -131,7 +131,7 @@ nlohmann::json frame_stats(const AppState& s, const TestScript& script) {
 int main(int argc, char** argv) {
   CLI::App cli{"piezobench-gui — Measure and update", "piezobench-gui"};
   std::vector<std::string> clicks;
-  std::string screenshot, stats_file, replay, instrument = "sim", daq, sim_effects;
+  std::string screenshot, stats_file, replay, replay_heldout, instrument = "sim", daq, sim_effects;
   std::vector<float> hover;
   bool wait_job = false;
   double timeout_s = 0;
@@ -143,6 +143,8 @@ int main(int argc, char** argv) {
                  "Effects of the simulated bench, NAME=VALUE[,NAME=VALUE...]");
   cli.add_option("--shots", shots, "Shots in the plan")->check(CLI::PositiveNumber);
   cli.add_option("--replay", replay, "Put this recorded capture in the plan panel for replay");
+  cli.add_option("--replay-heldout", replay_heldout,
+                 "… and this one beside it as its held-out capture (another drive of the same transducer)");
   cli.add_option("--click", clicks, "Test hook: click these buttons in order once drawn");
   cli.add_flag("--wait-job", wait_job, "Test hook: exit when the clicked work has finished");
   cli.add_option("--hover", hover, "Test hook: rest the mouse at X Y after the clicks")
@@ -201,6 +203,7 @@ int main(int argc, char** argv) {
     std::snprintf(state.instrument.sim_effects, sizeof state.instrument.sim_effects, "%s",
                   sim_effects.c_str());
     std::snprintf(state.replay_path, sizeof state.replay_path, "%s", replay.c_str());
+    std::snprintf(state.heldout_path, sizeof state.heldout_path, "%s", replay_heldout.c_str());
     connect_instruments(state);  // on the task thread: *IDN? shows as soon as the bench answers
 
     const auto t_start = std::chrono::steady_clock::now();

@@ -70,6 +70,10 @@ void render_plan_window(AppState& s) {
     ImGui::InputTextWithHint("##replay", "capture.h5", s.replay_path, sizeof s.replay_path);
     ImGui::SameLine();
     if (tracked_button(s, "Replay capture", ImVec2(-1, 0))) start_job(s, true);
+    ImGui::SetNextItemWidth(ImGui::GetContentRegionAvail().x - 130);
+    ImGui::InputTextWithHint("##heldout", "held-out capture (optional)", s.heldout_path, sizeof s.heldout_path);
+    ImGui::SameLine();
+    ImGui::TextDisabled("held out");
     ImGui::EndDisabled();
   } else {
     ImGui::ProgressBar(s.job.progress(), ImVec2(-1, 24), s.job.stage().c_str());
