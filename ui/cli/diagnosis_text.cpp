@@ -17,10 +17,10 @@ void print_diagnosis(std::ostream& os, const update::GapDiagnosis& d) {
   os << "\n  gap diagnosis (" << d.fit_description;
   if (!d.heldout_description.empty()) os << "; " << d.heldout_description;
   os << ")\n";
-  os << fmt("    misfit chi2/dof %.2f on the fit data", d.gap_fit);
+  os << fmt("    misfit sqrt(chi2/dof) %.2f on the fit data", d.gap_fit);
   if (d.gap_heldout) os << fmt(", %.2f held out", *d.gap_heldout);
   os << " (1 = at the noise)\n";
-  os << "    where (share of chi2, kind):\n";
+  if (!d.regions.empty()) os << "    where (share of chi2, kind):\n";
   for (const auto& g : d.regions) {
     if (g.points == 0) continue;
     os << fmt("      %5.1f %%  ", 100 * g.share) << g.name << fmt(" [%.1f-%.1f kHz]: ", g.f_lo_hz / 1e3, g.f_hi_hz / 1e3)

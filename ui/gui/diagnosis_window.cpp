@@ -109,9 +109,9 @@ void render_diagnosis_window(AppState& s) {
   ImGui::PopStyleColor();
   s.diagnosis_shown.verdict = d.verdict;
   if (d.gap_heldout)
-    ImGui::Text("misfit chi2/dof %.2f on the fit data, %.2f held out", d.gap_fit, *d.gap_heldout);
+    ImGui::Text("misfit sqrt(chi2/dof) %.2f on the fit data, %.2f held out", d.gap_fit, *d.gap_heldout);
   else
-    ImGui::Text("misfit chi2/dof %.2f on the fit data", d.gap_fit);
+    ImGui::Text("misfit sqrt(chi2/dof) %.2f on the fit data", d.gap_fit);
   if (ImGui::IsItemHovered())
     ImGui::SetTooltip("1 = at the noise of the repeated shots.\n%s\n%s", d.fit_description.c_str(),
                       d.heldout_description.c_str());

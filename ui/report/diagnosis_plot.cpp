@@ -113,7 +113,7 @@ std::string verdict_line(const update::GapDiagnosis& d) {
   } else {
     s = "unexplained by the candidate effects";
   }
-  s += fmt("   |   misfit chi2/dof %.2f on the fit data", d.gap_fit);
+  s += fmt("   |   misfit sqrt(chi2/dof) %.2f on the fit data", d.gap_fit);
   if (d.gap_heldout) s += fmt(", %.2f held out", *d.gap_heldout);
   return s;
 }
