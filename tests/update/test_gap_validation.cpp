@@ -318,7 +318,8 @@ void study(int shots) {
     if (const char* v = std::getenv("GAP_NOISE")) c.noise = std::atof(v);
     if (!only.empty() && std::find(only.begin(), only.end(), index) == only.end()) continue;
     std::printf("case %d:\n", index);
-    auto r = run_case(c, tmp_dir("gap-validation"));
+    // One folder per study (ctest -j runs the two side by side).
+    auto r = run_case(c, tmp_dir("gap-validation-" + std::to_string(shots)));
     if (std::getenv("GAP_VERBOSE")) {
       for (const auto& st : r.stages) std::printf("    [%s] %s\n", st.name.c_str(), st.note.c_str());
       for (const auto& w : r.warnings) std::printf("    warning: %s\n", w.c_str());
