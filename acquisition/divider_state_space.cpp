@@ -1,5 +1,6 @@
 #include "acquisition/divider_state_space.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <stdexcept>
 #include <unsupported/Eigen/MatrixFunctions>
@@ -73,6 +74,14 @@ DebyeNetwork debye_network_fit(const std::function<std::complex<double>(double)>
   net.c_inf = x(0);
   for (int j = 1; j < nb; ++j)
     if (x(j) > 0) net.branches.emplace_back(x(j), tau[j - 1]);
+  if (!(net.c_inf > 0) && !net.branches.empty()) {
+    // The fastest branch (τ a decade below the band) is a capacitance over
+    // the whole band: it becomes C_inf (the state space needs one at the node).
+    auto fastest = std::min_element(net.branches.begin(), net.branches.end(),
+                                    [](const auto& a, const auto& b) { return a.second < b.second; });
+    net.c_inf += fastest->first;
+    net.branches.erase(fastest);
+  }
   if (!(net.c_inf > 0)) throw std::runtime_error("debye_network_fit: no positive high-frequency capacitance");
   return net;
 }

@@ -3,6 +3,7 @@
 #include <Eigen/Dense>
 #include <algorithm>
 #include <cmath>
+#include <optional>
 #include <limits>
 #include <stdexcept>
 
@@ -52,9 +53,30 @@ std::vector<std::vector<double>> gap_jacobian(const GapModel& m, const GapData& 
     std::vector<double> xp = x, xm = x;
     xp[static_cast<std::size_t>(j)] += kStep;
     xm[static_cast<std::size_t>(j)] -= kStep;
-    auto a = gap_residuals(m, d, xp), b = gap_residuals(m, d, xm);
-    for (std::size_t i = 0; i < a.size(); ++i) a[i] = (a[i] - b[i]) / (2 * kStep);
-    out.push_back(std::move(a));
+    // Central differences; at the edge of the physical domain (one side a
+    // coupling factor > 1) the one-sided difference from the side that exists.
+    std::optional<std::vector<double>> a, b;
+    try {
+      a = gap_residuals(m, d, xp);
+    } catch (const std::invalid_argument&) {
+    }
+    try {
+      b = gap_residuals(m, d, xm);
+    } catch (const std::invalid_argument&) {
+    }
+    std::vector<double> col;
+    if (a && b) {
+      col = std::move(*a);
+      for (std::size_t i = 0; i < col.size(); ++i) col[i] = (col[i] - (*b)[i]) / (2 * kStep);
+    } else if (a || b) {
+      const auto r0 = gap_residuals(m, d, x);  // throws where x itself is not physical
+      col = a ? std::move(*a) : std::move(*b);
+      const double h = a ? kStep : -kStep;
+      for (std::size_t i = 0; i < col.size(); ++i) col[i] = (col[i] - r0[i]) / h;
+    } else {
+      (void)gap_residuals(m, d, xp);  // rethrows the reason
+    }
+    out.push_back(std::move(col));
   }
   return out;
 }
