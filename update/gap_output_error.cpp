@@ -92,12 +92,11 @@ GapDiagnosis build(const OeResult& r, const std::string& fit_description, const 
   //    data nothing less is a verdict (issue 21: never a false name); and
   //  - with held-out data showing a gap, shrinks it by OeHeldout::min_shrink;
   //    where the held-out data show none, does not create one.
-  // With a held-out gap, an effect that leaves some misfit in the fit is still
-  // the verdict when it removes most of the held-out gap (dominant_shrink):
-  // the cause, though not alone or not exactly in the catalogue's form.
-  // With a held-out gap, effects seen in the fit below its significance
-  // (weak_candidate) come after the significant ones: the held-out data alone
-  // must confirm them (dominant_shrink).
+  // An effect that leaves some misfit in the fit, or one seen only below the
+  // fit's significance (weak_candidate, ranked after the significant ones),
+  // must remove most of a held-out gap (dominant_shrink): the verdict then
+  // says "not alone, or not exactly in the catalogue's form" / "below the
+  // fit's own significance".
   const bool ho_gap = ho && ho->base.chi2_per_dof > ho->base.chi2_limit;
   std::vector<const OeEffect*> ranked, weak;
   for (const auto& e : r.effects)
@@ -136,7 +135,6 @@ GapDiagnosis build(const OeResult& r, const std::string& fit_description, const 
     if (ho && p && (e->explains || ho_gap) && e->significant) failed_heldout.push_back(e);
   }
   if (!top && n_significant > 0) closest = ranked.front();
-  if (!top && !ranked.empty() && n_significant == 0) closest = nullptr;
   // Held out: another drive, another record.
   std::string heldout_note;
   if (ho) {
