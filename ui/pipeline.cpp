@@ -407,8 +407,7 @@ SeedUpdate seed_update_stage(const PipelineRequest& req, const CaptureModel& cm,
 // The diagnosis of this capture runs in the output-error model (fewer than 3
 // transient dut shots of its first drive, see diagnose_stage): the update's
 // fit then also scans the catalogue's effects, once, for it.
-bool diagnosed_by_output_error(const PipelineRequest& req, const acq::Capture& cap) {
-  if (!req.diagnose) return false;
+int first_drive_shots(const acq::Capture& cap) {
   const acq::Shot* first = nullptr;
   int n = 0;
   for (const auto& s : cap.shots) {
@@ -416,7 +415,27 @@ bool diagnosed_by_output_error(const PipelineRequest& req, const acq::Capture& c
     if (!first) first = &s;
     n += s.excitation == first->excitation;
   }
-  return first && n < 3;
+  return n;
+}
+
+// … or a held-out capture of one or two shots (its attributes read here; an
+// unreadable one is the diagnosis stage's to report).
+bool diagnosed_by_output_error(const PipelineRequest& req, const acq::Capture& cap) {
+  if (!req.diagnose) return false;
+  const int n = first_drive_shots(cap);
+  if (n == 0) return false;
+  if (n < 3) return true;
+  if (req.heldout_capture.empty()) return false;
+  try {
+    acq::ContainedReadOptions ro;
+    ro.read.load_samples = false;
+    ro.read.skip_invalid_shots = true;
+    const auto ho = req.replay_contained ? acq::read_capture_contained(req.heldout_capture, ro)
+                                         : acq::read_capture(req.heldout_capture, ro.read);
+    return first_drive_shots(ho) < 3;
+  } catch (const std::exception&) {
+    return false;
+  }
 }
 
 std::vector<std::string> scanned_effects(const PipelineRequest& req) {
