@@ -45,6 +45,7 @@ void BM_OneShotDiagnosis(benchmark::State& state, const std::string& which, bool
       d = piezo::update::gap_from_output_error(fit, which);
     }
     benchmark::DoNotOptimize(d);
+    state.counters["fe_models_fit"] = fit.evaluations;
   }
 }
 BENCHMARK_CAPTURE(BM_OneShotDiagnosis, control_12, std::string("12"), false)->Unit(benchmark::kMillisecond)->Iterations(1);

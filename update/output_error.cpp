@@ -4,6 +4,7 @@
 
 #include <Eigen/Dense>
 #include <algorithm>
+#include <array>
 #include <chrono>
 #include <cmath>
 #include <complex>
@@ -143,17 +144,19 @@ class Problem {
     for (std::size_t i = 0; i < n_; i += decim_) idx_.push_back(i);
     spec_.assign(fft_.bins(), cd(0.0, 0.0));
     buf_.resize(n_);
+    cache_.reserve(kCache);
   }
 
   std::size_t samples() const { return idx_.size(); }
   int evaluations() const { return evaluations_; }  // FE port models built
 
-  // The FE port model of the material part of x (θ without β), from a small
-  // cache: the Jacobian's β column, the type-B perturbations of the chain and
-  // the re-evaluations at an answer need no new modal solve. nullptr when
-  // the model cannot be built.
-  const model::ModalPortModel* port_of(const Eigen::VectorXd& x) {
-    const Eigen::Vector4d key = x.head<4>();
+  // The FE port model of the material part of x (θ without β) with an end
+  // mass, from a small cache: the Jacobian's β and effect columns, the
+  // type-B perturbations of the chain and the re-evaluations at an answer
+  // need no new modal solve. nullptr when the model cannot be built.
+  const model::ModalPortModel* port_of(const Eigen::VectorXd& x, double end_mass) {
+    Key key;
+    key << x.head<4>(), end_mass;
     for (auto& c : cache_)
       if (c.key == key) {
         c.used = ++clock_;
@@ -162,7 +165,9 @@ class Problem {
     ++evaluations_;
     std::optional<model::ModalPortModel> port;
     try {
-      port = solver_.port_model(cls_.e_form(co_.params(x)), modal_);
+      model::ModalOptions mo = modal_;
+      mo.end_mass_fraction = end_mass;
+      port = solver_.port_model(cls_.e_form(co_.params(x)), mo);
       if (!port->converged) port.reset();
     } catch (const std::exception&) {
       port.reset();
@@ -183,44 +188,104 @@ class Problem {
   // The bench's known effects (OeData: a measured fixture's lead R, Cp, DAQ
   // input R and skew), as the catalogue's EffectSet (model/effects.hpp).
   const model::EffectSet& effects() const { return fx_; }
+  // … with the free effect (scan_effects) at x's sixth coordinate.
+  model::EffectSet effects_at(const Eigen::VectorXd& x) const {
+    model::EffectSet fx = fx_;
+    if (x.size() > kParams && free_) free_(fx, x[kParams]);
+    return fx;
+  }
 
   // T(f_k) = v2/v1 as recorded, for parameters x, with the bench's effects
   // (model/bench_response.hpp: the same forward model as the gap diagnosis
   // and the simulated bench's frequency-domain twin); empty when the model
-  // cannot be built. An end mass other than the cached ports' builds its own.
-  std::optional<std::vector<cd>> transfer(const Eigen::VectorXd& x) {
-    if (x.size() > kParams && free_) {
-      model::EffectSet fx = fx_;
-      free_(fx, x[kParams]);
-      return transfer(x, fx);
-    }
-    return transfer(x, fx_);
-  }
+  // cannot be built.
+  std::optional<std::vector<cd>> transfer(const Eigen::VectorXd& x) { return transfer(x, effects_at(x)); }
   // A catalogue effect as a sixth coordinate of x (scan_effects below).
   void free_effect(std::function<void(model::EffectSet&, double)> apply) { free_ = std::move(apply); }
   std::optional<std::vector<cd>> transfer(const Eigen::VectorXd& x, const model::EffectSet& fx) {
-    std::optional<model::ModalPortModel> loaded;
-    if (fx.mass_loading != modal_.end_mass_fraction) {
-      model::ModalOptions mo = modal_;
-      mo.end_mass_fraction = fx.mass_loading;
-      ++evaluations_;
-      try {
-        loaded = solver_.port_model(cls_.e_form(co_.params(x)), mo);
-      } catch (const std::exception&) {
-        return std::nullopt;
-      }
-      if (!loaded->converged) return std::nullopt;
-    }
-    const model::ModalPortModel* pp = loaded ? &*loaded : port_of(x);
+    const model::ModalPortModel* pp = port_of(x, fx.mass_loading);
     if (!pp) return std::nullopt;
-    const model::RayleighDamping damp{0.0, co_.beta(x)};
-    std::vector<cd> t(kmax_ + 1);
-    for (std::size_t k = 0; k <= kmax_; ++k) {
-      const double w = kTwoPi * fs_ * double(k) / double(nfft_);
-      const cd yt = w > 0 ? model::tube_admittance(*pp, damp, fx, w) : cd(0.0, 0.0);
-      t[k] = model::recorded_transfer(yt, fx, r1_, w);
+    return transfer_of(*pp, co_.beta(x), fx);
+  }
+
+  // The port models' tangent ∂port/∂x_c (c < 4: the constants) by forward
+  // differences at x_ref, from the models an exact Jacobian built there. Near
+  // x_ref (|Δx| ≤ kTangentReach in every constant's coordinate, the same end
+  // mass) a material column of the Jacobian is then the residual at x with
+  // the port model port(x) + h·∂port/∂x_c — the frequency response still
+  // computed exactly at x, only the modal quantities' slopes taken from
+  // x_ref, a few per mille off: no FE model per column. The residuals, the
+  // costs and the answers stay exact; an optimiser's fixed point moves by that
+  // error times the residual's projection, a tiny fraction of a sigma.
+  void set_tangent(const Eigen::VectorXd& x, double h) { set_tangent(x, h, effects_at(x).mass_loading); }
+  void set_tangent(const Eigen::VectorXd& x, double h, double mass) {
+    tangent_.valid = false;
+    const model::ModalPortModel* base = port_of(x, mass);
+    if (!base) return;
+    const model::ModalPortModel b = *base;
+    for (int c = 0; c < 4; ++c) {
+      Eigen::VectorXd xp = x;
+      xp[c] += h;
+      const model::ModalPortModel* p = port_of(xp, mass);
+      if (!p || !same_structure(*p, b)) return;
+      tangent_.plus[static_cast<std::size_t>(c)] = *p;
     }
-    return t;
+    tangent_.base = b;
+    tangent_.x_ref = x.head<4>();
+    tangent_.mass = mass;
+    tangent_.h = h;
+    tangent_.valid = true;
+  }
+  bool tangent_near(const Eigen::VectorXd& x) { return tangent_near(x, effects_at(x).mass_loading); }
+  // … and it still holds there: x's own port model is its linear prediction
+  // from x_ref to within kTangentTolerance in every electrically active mode's
+  // frequency and participation. Two modes near a veering (an avoided
+  // crossing, where a few per mille of a constant swaps their shapes and
+  // participations) fail it: their columns are computed exactly.
+  bool tangent_near(const Eigen::VectorXd& x, double mass) {
+    if (!tangent_.valid || mass != tangent_.mass ||
+        (x.head<4>() - tangent_.x_ref).cwiseAbs().maxCoeff() > kTangentReach)
+      return false;
+    const model::ModalPortModel* at = port_of(x, mass);
+    if (!at || !same_structure(*at, tangent_.base)) return false;
+    model::ModalPortModel q = tangent_.base;
+    for (int c = 0; c < 4; ++c) shift(q, tangent_.plus[static_cast<std::size_t>(c)], (x[c] - tangent_.x_ref[c]) / tangent_.h);
+    for (std::size_t i = 0; i < q.modes.size(); ++i) {
+      const auto &a = at->modes[i], &b = q.modes[i];
+      const double pa = std::abs(a.participation);
+      if (!(a.omega > 0) || pa * pa < kActiveCoupling * a.omega * a.omega * at->c_clamped) continue;
+      if (std::abs(b.omega - a.omega) > kTangentOmegaTolerance * a.omega ||
+          std::abs(b.participation - pa) > kTangentTolerance * pa)
+        return false;
+    }
+    return true;
+  }
+  // T at x on the tangent anchored at a point whose model is cached:
+  // port(anchor) + Σ_c (x_c − anchor_c)·∂port/∂x_c — no FE model; exact at
+  // the anchor, its slopes x_ref's (a trial step's screening). Empty when
+  // the anchor is not near x_ref or x not near the anchor.
+  std::optional<std::vector<cd>> tangent_model(const Eigen::VectorXd& anchor, const Eigen::VectorXd& x) {
+    const model::EffectSet fx = effects_at(x);
+    if (!tangent_near(anchor, fx.mass_loading) || effects_at(anchor).mass_loading != fx.mass_loading ||
+        (x.head<4>() - anchor.head<4>()).cwiseAbs().maxCoeff() > kTangentReach)
+      return std::nullopt;
+    const model::ModalPortModel* at = port_of(anchor, fx.mass_loading);
+    if (!at || !same_structure(*at, tangent_.base)) return std::nullopt;
+    model::ModalPortModel p = *at;
+    for (int c = 0; c < 4; ++c) shift(p, tangent_.plus[static_cast<std::size_t>(c)], (x[c] - anchor[c]) / tangent_.h);
+    return transfer_of(p, co_.beta(x), fx);
+  }
+  // T at x with the constant c moved by h, through the tangent (tangent_near).
+  std::optional<std::vector<cd>> tangent_transfer(const Eigen::VectorXd& x, int c, double h) {
+    return tangent_transfer(x, c, h, effects_at(x));
+  }
+  std::optional<std::vector<cd>> tangent_transfer(const Eigen::VectorXd& x, int c, double h,
+                                                  const model::EffectSet& fx) {
+    const model::ModalPortModel* at = port_of(x, fx.mass_loading);
+    if (!at || !same_structure(*at, tangent_.base)) return std::nullopt;
+    model::ModalPortModel p = *at;
+    shift(p, tangent_.plus[static_cast<std::size_t>(c)], h / tangent_.h);
+    return transfer_of(p, co_.beta(x), fx);
   }
 
   // Filtered output error for a given transfer.
@@ -282,6 +347,41 @@ class Problem {
   }
 
  private:
+  // The same modes in the same order (a mode crossing the truncation or the
+  // residual pseudo-mode appearing changes the list: no tangent across it).
+  static bool same_structure(const model::ModalPortModel& a, const model::ModalPortModel& b) {
+    if (a.modes.size() != b.modes.size()) return false;
+    for (std::size_t i = 0; i < a.modes.size(); ++i)
+      if (a.modes[i].symmetric != b.modes[i].symmetric || a.modes[i].residual != b.modes[i].residual) return false;
+    return true;
+  }
+  // p += k·(plus − base), the tangent's difference (same_structure).
+  void shift(model::ModalPortModel& p, const model::ModalPortModel& plus, double k) const {
+    const model::ModalPortModel& base = tangent_.base;
+    p.c_clamped += k * (plus.c_clamped - base.c_clamped);
+    p.c_static += k * (plus.c_static - base.c_static);
+    p.c_residual += k * (plus.c_residual - base.c_residual);
+    p.eps_t_over_s += k * (plus.eps_t_over_s - base.eps_t_over_s);
+    for (std::size_t i = 0; i < p.modes.size(); ++i) {
+      auto& m = p.modes[i];
+      const auto &mp = plus.modes[i], &mb = base.modes[i];
+      m.omega += k * (mp.omega - mb.omega);
+      m.kappa += k * (mp.kappa - mb.kappa);
+      // p_k = gᵀφ_k: its sign is the eigenvector's, arbitrary per solve.
+      m.participation = std::abs(m.participation) + k * (std::abs(mp.participation) - std::abs(mb.participation));
+    }
+  }
+  std::vector<cd> transfer_of(const model::ModalPortModel& port, double beta, const model::EffectSet& fx) const {
+    const model::RayleighDamping damp{0.0, beta};
+    std::vector<cd> t(kmax_ + 1);
+    for (std::size_t k = 0; k <= kmax_; ++k) {
+      const double w = kTwoPi * fs_ * double(k) / double(nfft_);
+      const cd yt = w > 0 ? model::tube_admittance(port, damp, fx, w) : cd(0.0, 0.0);
+      t[k] = model::recorded_transfer(yt, fx, r1_, w);
+    }
+    return t;
+  }
+
   Eigen::VectorXd invert() {
     for (std::size_t k = kmax_ + 1; k < spec_.size(); ++k) spec_[k] = 0.0;
     fft_.inverse(spec_.data(), buf_.data(), n_);
@@ -306,12 +406,27 @@ class Problem {
   std::vector<double> buf_;
   std::vector<std::size_t> idx_;
   int evaluations_ = 0;
+  using Key = Eigen::Matrix<double, 5, 1>;  // the constants' coordinates, the end mass
   struct Cached {
-    Eigen::Vector4d key;
+    Key key;
     std::optional<model::ModalPortModel> port;
     unsigned long used = 0;
   };
-  static constexpr std::size_t kCache = 4;
+  static constexpr std::size_t kCache = 8;  // an exact Jacobian's five models and the trials
+  static constexpr double kTangentReach = 0.05;
+  // The check of tangent_near: relative error of the prediction (a veering
+  // swaps participations by tens of percent, the curvature away from one
+  // moves them by well under a percent within the reach).
+  static constexpr double kTangentTolerance = 0.01;        // participation
+  static constexpr double kTangentOmegaTolerance = 1e-3;   // frequency
+  static constexpr double kActiveCoupling = 1e-4;          // p²/(ω²C0) of a mode it looks at
+  struct Tangent {
+    bool valid = false;
+    Eigen::Vector4d x_ref;
+    double mass = 0, h = 0;
+    model::ModalPortModel base;
+    std::array<model::ModalPortModel, 4> plus;
+  } tangent_;
   std::vector<Cached> cache_;
   unsigned long clock_ = 0;
 };
@@ -630,15 +745,28 @@ OeResult fit_output_error(model::ModalSolver& solver, const MaterialClass& cls,
     if (!r->allFinite()) return std::nullopt;
     return r;
   };
-  // Columns from `first` on (the others kept as they are in j).
-  auto jacobian = [&](const Eigen::VectorXd& x, const Eigen::VectorXd& r0, Eigen::MatrixXd& j, int first = 0) {
+  // Columns from `first` on (the others kept as they are in j). The
+  // constants' columns through the port models' tangent near the last exact
+  // Jacobian (Problem::set_tangent), unless `exact`.
+  auto jacobian = [&](const Eigen::VectorXd& x, const Eigen::VectorXd& r0, Eigen::MatrixXd& j, int first = 0,
+                      bool exact = false) {
     const auto np = static_cast<int>(x.size());  // 5, or 6 with a free effect (scan_effects)
     if (j.rows() != r0.size() || j.cols() != np) {
       j.resize(r0.size(), np);
       first = 0;
     }
+    const bool tangent = !exact && first < 4 && prob.tangent_near(x);
     for (int c = first; c < np; ++c) {
       const double h = c >= 4 ? 1e-4 : 1e-6;
+      if (c < 4 && tangent) {
+        if (const auto tt = prob.tangent_transfer(x, c, h)) {
+          const Eigen::VectorXd rt = whiten(prob.residual_of(*tt)) / sigma;
+          if (rt.allFinite()) {
+            j.col(c) = (rt - r0) / h;
+            continue;
+          }
+        }
+      }
       Eigen::VectorXd xp = x;
       xp[c] += h;
       auto rp = weighted(xp);
@@ -651,7 +779,16 @@ OeResult fit_output_error(model::ModalSolver& solver, const MaterialClass& cls,
         j.col(c) = (*rp - r0) / h;
       }
     }
+    if (first == 0 && !tangent) prob.set_tangent(x, 1e-6);
     return true;
+  };
+  // ½‖r/σ‖² at x on the port models' tangent anchored at `anchor`
+  // (Problem::tangent_model), NaN away from it.
+  auto tangent_cost = [&](const Eigen::VectorXd& anchor, const Eigen::VectorXd& x) -> double {
+    const auto t = prob.tangent_model(anchor, x);
+    if (!t) return NAN;
+    const Eigen::VectorXd r = whiten(prob.residual_of(*t)) / sigma;
+    return r.allFinite() ? 0.5 * r.squaredNorm() : NAN;
   };
   // LM from x. A later start (`lead`: the optimum of the first) stops early
   // once it is inside the lead's optimum (ΔxᵀJᵀJΔx < 9 at no lower cost: it
@@ -681,28 +818,43 @@ OeResult fit_output_error(model::ModalSolver& solver, const MaterialClass& cls,
     double cost = 0.5 * r->squaredNorm();
     double mu = 1e-3, last_drop = INFINITY;
     // J by forward differences at every iterate: four FE port models (β's
-    // column reuses the cached one). Broyden's rank-one updates instead were
-    // measured on the corpus: fewer models on the first start, but later starts
-    // crawl and can look stalled where the exact J joins the best optimum.
+    // column reuses the cached one), or none near the last exact J (the
+    // port models' tangent, Problem::set_tangent). Broyden's rank-one updates
+    // instead were measured on the corpus: fewer models on the first start,
+    // but later starts crawl and can look stalled where the exact J joins the
+    // best optimum.
     Eigen::MatrixXd j;
+    // An iteration that finds no lower cost (its J perhaps through the
+    // tangent or j0's frozen columns, its trials screened) runs again on the
+    // exact J, unscreened, before the run gives up.
+    bool strict = false;
     for (int it = 1; it <= opt.max_iterations; ++it) {
       o.iterations = it;
       const bool have_j0 = j0 && j0->rows() == r->size() && j0->cols() == x.size();
-      if (it == 1 && have_j0) {
+      bool j_ok = true;
+      if (strict) {
+        j_ok = jacobian(x, *r, j, 0, true);
+      } else if (it == 1 && have_j0) {
         j = *j0;
       } else if (freeze_material && have_j0) {
         j = *j0;
-        if (!jacobian(x, *r, j, 4)) {
-          o.message = "the model could not be simulated near the estimate";
-          break;
-        }
-      } else if (!jacobian(x, *r, j)) {
+        j_ok = jacobian(x, *r, j, 4);
+      } else {
+        j_ok = jacobian(x, *r, j);
+      }
+      if (!j_ok) {
         o.message = "the model could not be simulated near the estimate";
         break;
       }
       const Eigen::MatrixXd jtj = j.transpose() * j;
       const Eigen::VectorXd g = j.transpose() * *r;
       bool accepted = false, done = false;
+      // A trial near x is screened on the tangent anchored at x first (its
+      // model exact at x, the slopes x_ref's): a step it says raises the cost
+      // is rejected without an FE model; one it says lowers it is computed.
+      auto screen = [&](const Eigen::VectorXd& anchor, const Eigen::VectorXd& xt) {
+        return strict ? NAN : tangent_cost(anchor, xt);
+      };
       for (int tries = 0; tries < 14 && !accepted; ++tries) {
         Eigen::MatrixXd a = jtj;
         for (Eigen::Index p = 0; p < a.rows(); ++p) a(p, p) += mu * std::max(jtj(p, p), 1e-300);
@@ -711,6 +863,11 @@ OeResult fit_output_error(model::ModalSolver& solver, const MaterialClass& cls,
         const double big = step.cwiseAbs().maxCoeff();
         if (big > 0.3) step *= 0.3 / big;
         const Eigen::VectorXd trial = x + step;
+        if (screen(x, trial) >= cost) {
+          mu *= 4.0;
+          if (step.cwiseAbs().maxCoeff() < opt.step_tolerance) accepted = done = true;
+          continue;
+        }
         const auto rt = weighted(trial);
         const double ct = rt ? 0.5 * rt->squaredNorm() : INFINITY;
         if (ct < cost) {
@@ -721,12 +878,13 @@ OeResult fit_output_error(model::ModalSolver& solver, const MaterialClass& cls,
           // Along a curved valley (resonances sliding into place) the
           // Gauss-Newton step is far shorter than the way to the minimum: go
           // on along it, doubling, while the cost keeps falling (one model per
-          // try instead of a Jacobian per step).
+          // try instead of a Jacobian per step; screened as above).
           Eigen::VectorXd ext = step;
           for (int d = 0; d < 4 && mu < 1e-2; ++d) {
             ext *= 2.0;
             if (ext.cwiseAbs().maxCoeff() > 0.3) break;
             const Eigen::VectorXd xe = x_old + ext;
+            if (screen(x, xe) >= c_new) break;
             const auto re = weighted(xe);
             const double ce = re ? 0.5 * re->squaredNorm() : INFINITY;
             if (!(ce < c_new)) break;
@@ -752,6 +910,11 @@ OeResult fit_output_error(model::ModalSolver& solver, const MaterialClass& cls,
         break;
       }
       if (!accepted) {
+        if (!strict) {
+          strict = true;
+          --it;
+          continue;
+        }
         double cosine = 0;
         for (Eigen::Index p = 0; p < g.size(); ++p)
           cosine = std::max(cosine, std::abs(g[p]) / std::sqrt(jtj(p, p) * 2.0 * cost + 1e-300));
@@ -762,6 +925,7 @@ OeResult fit_output_error(model::ModalSolver& solver, const MaterialClass& cls,
         }
         break;
       }
+      strict = false;
       if (lead && lead->jtj.rows() == kParams) {
         const Eigen::VectorXd dx = x - lead->x;
         const double gap = cost - lead->cost;
@@ -784,10 +948,12 @@ OeResult fit_output_error(model::ModalSolver& solver, const MaterialClass& cls,
     o.r = *r;
     return o;
   };
-  // J and JᵀJ at a run's answer (only the best one's are used).
+  // J and JᵀJ at a run's answer (only the best one's are used), exact: the
+  // covariances are read from it (through the tangent, an effect's sigma
+  // came out up to a tenth off where it trades with epsT33).
   auto finish = [&](LmOutcome& o) {
     Eigen::MatrixXd j;
-    if (o.r.size() > 0 && jacobian(o.x, o.r, j)) {
+    if (o.r.size() > 0 && jacobian(o.x, o.r, j, 0, true)) {
       o.j = j;
       o.jtj = j.transpose() * j;
     }
@@ -1011,8 +1177,8 @@ OeResult fit_output_error(model::ModalSolver& solver, const MaterialClass& cls,
   auto fill = [&](OeEffect& e, Refit& rf) {
     LmOutcome& run = rf.run;
     finish(run);
-    // One Gauss-Newton step on the exact J (a run with the material columns
-    // frozen stops where J₀ᵀr = 0, a fraction of a sigma from Jᵀr = 0).
+    // One Gauss-Newton step on J at the answer (a run with the material
+    // columns frozen stops where J₀ᵀr = 0, a fraction of a sigma from Jᵀr = 0).
     if (run.jtj.rows() == run.x.size() && run.r.size() == run.j.rows()) {
       const Eigen::VectorXd step = -run.jtj.ldlt().solve(run.j.transpose() * run.r);
       if (step.allFinite() && step.cwiseAbs().maxCoeff() < 0.3) {
@@ -1282,14 +1448,29 @@ OePrediction predict_output_error(model::ModalSolver& solver, const MaterialClas
     for (int it = 0; it < 4; ++it) {
       Eigen::MatrixXd w(rz.size(), np);
       bool ok = true;
+      // The constants' columns through the port models' tangent (Problem::set_tangent).
+      model::EffectSet fz = effects;
+      if (np > kParams) coord->apply(fz, z[kParams]);
+      const Eigen::VectorXd zm = z.head(kParams);
+      const bool tangent = prob.tangent_near(zm, fz.mass_loading);
       for (Eigen::Index c = 0; c < np && ok; ++c) {
+        const double h = c >= 4 ? 1e-4 : 1e-6;
+        if (c < 4 && tangent)
+          if (const auto tt = prob.tangent_transfer(zm, static_cast<int>(c), h, fz)) {
+            const Eigen::VectorXd rt = whiten(prob.residual_of(*tt)) / sigma;
+            if (rt.allFinite()) {
+              w.col(c) = (rt - rz) / h;
+              continue;
+            }
+          }
         Eigen::VectorXd zp = z;
-        zp[c] += c >= 4 ? 1e-4 : 1e-6;
+        zp[c] += h;
         const auto rp = residual_at(zp);
         if (!rp) ok = false;
         else w.col(c) = (*rp - rz) / (zp[c] - z[c]);
       }
       if (!ok) break;
+      if (!tangent) prob.set_tangent(zm, 1e-6, fz.mass_loading);
       const Eigen::VectorXd g = w.transpose() * rz + cinv * z;
       const Eigen::MatrixXd a = w.transpose() * w + cinv;
       Eigen::VectorXd step = -a.ldlt().solve(g);
