@@ -44,15 +44,15 @@ AnalyticRing analytic_ring(const PiezoMaterialD& m, const RingGeometry& g) {
   const double k2 = m.d31 * m.d31 / (m.s_e11 * m.eps_t33);  // eq 29
   if (!(k2 < 1)) fail(fn, "k31² = d31²/(sE11 εT33) must be < 1");
   r.k31 = std::sqrt(k2);
-  r.omega_r = 1.0 / (a * std::sqrt(rho * m.s_e11));  // eqs 34, 42
-  r.omega_a = r.omega_r / std::sqrt(1.0 - k2);       // eq 43
-  r.c_free = 2.0 * M_PI * a * l * m.eps_t33 / t;     // eq 48
-  r.c_clamped = r.c_free * (1.0 - k2);               // eq 47
-  r.c_motional = r.c_free * k2;                      // eq 50
+  r.omega_r = 1.0 / (a * std::sqrt(rho * m.s_e11));                            // eqs 34, 42
+  r.omega_a = r.omega_r / std::sqrt(1.0 - k2);                                 // eq 43
+  r.c_free = 2.0 * M_PI * a * l * m.eps_t33 / t;                               // eq 48
+  r.c_clamped = r.c_free * (1.0 - k2);                                         // eq 47
+  r.c_motional = r.c_free * k2;                                                // eq 50
   r.l_motional = k2 > 0 ? 1.0 / (r.omega_r * r.omega_r * r.c_motional) : 0.0;  // eq 54
-  r.mass_kg = 2.0 * M_PI * a * t * l * rho;          // eq 55
-  r.compliance_m_n = a * m.s_e11 / (2.0 * M_PI * l * t);  // eq 52
-  r.turns_ratio = 2.0 * M_PI * l * m.d31 / m.s_e11;       // eq 53
+  r.mass_kg = 2.0 * M_PI * a * t * l * rho;                                    // eq 55
+  r.compliance_m_n = a * m.s_e11 / (2.0 * M_PI * l * t);                       // eq 52
+  r.turns_ratio = 2.0 * M_PI * l * m.d31 / m.s_e11;                            // eq 53
   return r;
 }
 

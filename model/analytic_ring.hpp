@@ -27,16 +27,16 @@ RingGeometry ring_geometry(const TubeGeometry& tube);
 
 // Everything eqs 29-55 define, SI units (rad/s, F, H, kg).
 struct AnalyticRing {
-  double k31 = 0;              // eq 29: k31² = d31²/(sE11 εT33), k31 ≥ 0
-  double omega_r = 0;          // eqs 34, 42: ωr = ω1 = 1/(a sqrt(ρ sE11))
-  double omega_a = 0;          // eq 43: ωa = ωr / sqrt(1 − k31²)
-  double c_free = 0;           // eq 48: Cf = 2π a ℓ εT33 / t
-  double c_clamped = 0;        // eq 47: C0 = Cf (1 − k31²) (laterally clamped, 1-D)
-  double c_motional = 0;       // eq 50: C1 = Cf k31²
-  double l_motional = 0;       // eq 54: L1 = 1/(ω1² C1)
-  double mass_kg = 0;          // eq 55: M = 2π a t ℓ ρ
-  double compliance_m_n = 0;   // eq 52: Cm = a sE11 / (2π ℓ t)
-  double turns_ratio = 0;      // eq 53: N = 2π ℓ d31 / sE11 (C/m, sign of d31)
+  double k31 = 0;             // eq 29: k31² = d31²/(sE11 εT33), k31 ≥ 0
+  double omega_r = 0;         // eqs 34, 42: ωr = ω1 = 1/(a sqrt(ρ sE11))
+  double omega_a = 0;         // eq 43: ωa = ωr / sqrt(1 − k31²)
+  double c_free = 0;          // eq 48: Cf = 2π a ℓ εT33 / t
+  double c_clamped = 0;       // eq 47: C0 = Cf (1 − k31²) (laterally clamped, 1-D)
+  double c_motional = 0;      // eq 50: C1 = Cf k31²
+  double l_motional = 0;      // eq 54: L1 = 1/(ω1² C1)
+  double mass_kg = 0;         // eq 55: M = 2π a t ℓ ρ
+  double compliance_m_n = 0;  // eq 52: Cm = a sE11 / (2π ℓ t)
+  double turns_ratio = 0;     // eq 53: N = 2π ℓ d31 / sE11 (C/m, sign of d31)
 };
 
 // Uses sE11, d31, εT33 of the d-form only (the 3-1 vibrator ignores the rest).

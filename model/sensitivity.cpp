@@ -56,7 +56,8 @@ std::vector<TrackedMode> track(const ModalResult& nominal, const std::vector<int
     t.nominal_hz = nominal.modes[k].frequency_hz;
     for (std::size_t j = 0; j < perturbed.modes.size(); ++j) {
       if (perturbed.modes[j].symmetric_fraction < 0.5) continue;
-      const double mac = overlap[static_cast<Eigen::Index>(j)] * overlap[static_cast<Eigen::Index>(j)];
+      const double mac =
+          overlap[static_cast<Eigen::Index>(j)] * overlap[static_cast<Eigen::Index>(j)];
       if (mac > t.mac) {
         t.mac = mac;
         t.perturbed_hz = perturbed.modes[j].frequency_hz;
@@ -71,23 +72,33 @@ std::vector<TrackedMode> track(const ModalResult& nominal, const std::vector<int
 }  // namespace
 
 const char* d_param_name(DParam p) {
-  static constexpr const char* names[kNumDParams] = {"sE11", "sE12", "sE13", "sE33", "sE44",
+  static constexpr const char* names[kNumDParams] = {"sE11", "sE12", "sE13", "sE33",   "sE44",
                                                      "d31",  "d33",  "d15",  "epsT11", "epsT33"};
   return names[static_cast<int>(p)];
 }
 
 double& d_param(PiezoMaterialD& m, DParam p) {
   switch (p) {
-    case DParam::s_e11: return m.s_e11;
-    case DParam::s_e12: return m.s_e12;
-    case DParam::s_e13: return m.s_e13;
-    case DParam::s_e33: return m.s_e33;
-    case DParam::s_e44: return m.s_e44;
-    case DParam::d31: return m.d31;
-    case DParam::d33: return m.d33;
-    case DParam::d15: return m.d15;
-    case DParam::eps_t11: return m.eps_t11;
-    case DParam::eps_t33: return m.eps_t33;
+    case DParam::s_e11:
+      return m.s_e11;
+    case DParam::s_e12:
+      return m.s_e12;
+    case DParam::s_e13:
+      return m.s_e13;
+    case DParam::s_e33:
+      return m.s_e33;
+    case DParam::s_e44:
+      return m.s_e44;
+    case DParam::d31:
+      return m.d31;
+    case DParam::d33:
+      return m.d33;
+    case DParam::d15:
+      return m.d15;
+    case DParam::eps_t11:
+      return m.eps_t11;
+    case DParam::eps_t33:
+      return m.eps_t33;
   }
   throw std::invalid_argument("d_param: unknown parameter");
 }

@@ -26,9 +26,9 @@ double& d_param(PiezoMaterialD& m, DParam p);
 bool seed_says_sensitive(DParam p);
 
 struct SensitivityOptions {
-  double band_hz = 200e3;               // upper band edge (Tables C.1, C.3: 0-200 kHz)
+  double band_hz = 200e3;  // upper band edge (Tables C.1, C.3: 0-200 kHz)
   std::vector<double> factors = {2.0, 0.5};
-  MeshOptions mesh;                     // default 2 × 24
+  MeshOptions mesh;  // default 2 × 24
   // Electrical-activity thresholds as in ModalOptions; open circuit 1e-4 as the
   // updaters use (the anti-resonance mode's charge drops when d31 is halved).
   double active_coupling = 1e-3;
@@ -36,7 +36,7 @@ struct SensitivityOptions {
   // Perturbed modes are computed up to track_margin × band_hz, so a nominal mode
   // that a change pushes above the band edge is still found.
   double track_margin = 1.5;
-  void validate() const;                // throws std::invalid_argument
+  void validate() const;  // throws std::invalid_argument
 };
 
 // Active modes in the band and the static capacitance for one material.
@@ -61,19 +61,19 @@ struct TrackedMode {
 struct SensitivityCase {
   DParam param = DParam::s_e11;
   double factor = 1;
-  bool valid = false;       // false: the scaled material is not physical (reason says why)
+  bool valid = false;  // false: the scaled material is not physical (reason says why)
   std::string reason;
   ElectricalSignature perturbed;
   std::vector<TrackedMode> short_modes, open_modes;  // one per nominal active mode
   double c_static_change = 0;
   // max |change| over the tracked frequencies and C_static.
   double max_abs_change = 0;
-  double min_mac = 1;       // smallest MAC of the pairings
+  double min_mac = 1;  // smallest MAC of the pairings
 };
 
 struct SensitivityResult {
   bool converged = true;
-  std::string message;              // first non-convergence, when !converged
+  std::string message;  // first non-convergence, when !converged
   ElectricalSignature nominal;
   std::vector<SensitivityCase> cases;  // param-major, factors in option order
   // Largest max_abs_change over the valid cases of one parameter (0 if none valid).

@@ -105,11 +105,26 @@ TEST(AnalyticRing, PreconditionsThrowNamingTheFunction) {
   };
   auto m = fig18_material();
   auto g = fig18_geometry();
-  expect_throw([&] { g.wall_m = 0; analytic_ring(m, g); }, "RingGeometry::validate");
+  expect_throw(
+      [&] {
+        g.wall_m = 0;
+        analytic_ring(m, g);
+      },
+      "RingGeometry::validate");
   g = fig18_geometry();
-  expect_throw([&] { m.s_e11 = -1; analytic_ring(m, g); }, "analytic_ring");
+  expect_throw(
+      [&] {
+        m.s_e11 = -1;
+        analytic_ring(m, g);
+      },
+      "analytic_ring");
   m = fig18_material();
-  expect_throw([&] { m.d31 = -1e-9; analytic_ring(m, g); }, "analytic_ring");  // k31 > 1
+  expect_throw(
+      [&] {
+        m.d31 = -1e-9;
+        analytic_ring(m, g);
+      },
+      "analytic_ring");  // k31 > 1
   const auto r = analytic_ring(fig18_material(), g);
   expect_throw([&] { ring_admittance(r, -1.0); }, "ring_admittance");
   expect_throw([&] { k31_from_frequencies(2.0, 1.0); }, "k31_from_frequencies");
@@ -166,10 +181,11 @@ TEST(AnalyticRing, FeThinRingMatchesEqs42To44WithinHalfPercent) {
   for (const auto& p : material_presets()) {
     const auto r = fe_ring(p, 0.6e-3);
     const double fr = r.ring.omega_r / (2 * M_PI), fa = r.ring.omega_a / (2 * M_PI);
-    std::printf("%-7s ring fr %.2f fa %.2f k31 %.5f | FE fr %.2f (%+.4f %%) fa %.2f (%+.4f %%)"
-                " k31 %.5f (%+.4f %%)\n",
-                p.name.c_str(), fr, fa, r.ring.k31, r.fr, 100 * (r.fr / fr - 1), r.fa,
-                100 * (r.fa / fa - 1), r.k31, 100 * (r.k31 / r.ring.k31 - 1));
+    std::printf(
+        "%-7s ring fr %.2f fa %.2f k31 %.5f | FE fr %.2f (%+.4f %%) fa %.2f (%+.4f %%)"
+        " k31 %.5f (%+.4f %%)\n",
+        p.name.c_str(), fr, fa, r.ring.k31, r.fr, 100 * (r.fr / fr - 1), r.fa,
+        100 * (r.fa / fa - 1), r.k31, 100 * (r.k31 / r.ring.k31 - 1));
     EXPECT_NEAR(r.fr / fr, 1.0, 5e-3) << p.name;
     EXPECT_NEAR(r.fa / fa, 1.0, 5e-3) << p.name;
     EXPECT_NEAR(r.k31 / r.ring.k31, 1.0, 5e-3) << p.name;
@@ -190,7 +206,10 @@ TEST(AnalyticRing, FeDeviationFromTheRingIsSecondOrderInWallAndHeight) {
     for (int i = 0; i < 3; ++i) {
       const double ratio = dev_c[i] / dev_f[i];
       std::printf("%-7s %s deviation %+.3e → %+.3e, ratio %.3f\n", p.name.c_str(),
-                  i == 0 ? "fr " : i == 1 ? "fa " : "k31", dev_c[i], dev_f[i], ratio);
+                  i == 0   ? "fr "
+                  : i == 1 ? "fa "
+                           : "k31",
+                  dev_c[i], dev_f[i], ratio);
       EXPECT_GT(ratio, 3.5) << p.name << " " << i;
       EXPECT_LT(ratio, 4.5) << p.name << " " << i;
     }

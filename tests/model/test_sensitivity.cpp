@@ -32,7 +32,9 @@ constexpr double kMatters = 1e-2;
 // place the seed's claim fails with this measure (APC850's analogue, 83.9 kHz,
 // has coupling 2e-4 and is not active). d15 halved moves it −0.80 %, εT11 doubled
 // −0.49 %, still under the threshold.
-bool is_pzt8_weak_mode(const std::string& preset, std::size_t k) { return preset == "pzt8" && k == 3; }
+bool is_pzt8_weak_mode(const std::string& preset, std::size_t k) {
+  return preset == "pzt8" && k == 3;
+}
 
 SensitivityResult run(const MaterialPreset& p) {
   TubeGeometry g;

@@ -2,7 +2,7 @@
 //   model materials                      presets and their sources
 //   model modal     --material M [--isotropic] [--set k=v,…] [--modes N] [--json]
 //   model impedance --material M --fmin HZ --fmax HZ --step HZ [--rayleigh-beta S] [--csv|--json]
-//   model sensitivity [--material M] [--band HZ] [--json]   seed Appendix C.1 (model/sensitivity.hpp)
+//   model sensitivity [--material M] [--band HZ] [--json]   (Appendix C.1, model/sensitivity.hpp)
 // Exit codes: 0 ok, 2 bad input (unknown material, bad --set), 1 non-convergence
 // or internal failure.
 #include <cmath>
