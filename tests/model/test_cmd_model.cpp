@@ -56,3 +56,24 @@ TEST(CmdModel, BadInputExitsTwo) {
   EXPECT_EQ(run("model modal --isotropic --set sE33=1e-11").code, 2);
   EXPECT_EQ(run("model impedance --fmin 10 --fmax 5 --step 1").code, 2);
 }
+
+TEST(CmdModel, SensitivityJsonHasEveryConstantTwice) {
+  auto r = run("model sensitivity --material apc850 --json");
+  ASSERT_EQ(r.code, 0) << r.out;
+  auto j = nlohmann::json::parse(r.out);
+  ASSERT_EQ(j["cases"].size(), 20u);  // 10 d-form constants × {2, 0.5}
+  EXPECT_EQ(j["nominal"]["short_circuit_hz"].size(), 3u);
+  EXPECT_EQ(j["band_hz"].get<double>(), 200e3);
+  EXPECT_TRUE(j["converged"].get<bool>());
+  for (const auto& c : j["cases"]) {
+    if (c["valid"].get<bool>()) {
+      EXPECT_EQ(c["short_circuit"].size(), 3u);
+      EXPECT_TRUE(c.contains("c_static_change"));
+    } else {
+      EXPECT_FALSE(c["reason"].get<std::string>().empty());
+    }
+  }
+  // εT33 doubled doubles C_static (within 1 %).
+  EXPECT_NEAR(j["cases"][18]["c_static_change"].get<double>(), 1.0, 0.01);
+  EXPECT_EQ(run("model sensitivity --band -5").code, 2);
+}

@@ -2,6 +2,7 @@
 //   model materials                      presets and their sources
 //   model modal     --material M [--isotropic] [--set k=v,…] [--modes N] [--json]
 //   model impedance --material M --fmin HZ --fmax HZ --step HZ [--rayleigh-beta S] [--csv|--json]
+//   model sensitivity [--material M] [--band HZ] [--json]   (Appendix C.1, model/sensitivity.hpp)
 // Exit codes: 0 ok, 2 bad input (unknown material, bad --set), 1 non-convergence
 // or internal failure.
 #include <cmath>
@@ -13,6 +14,7 @@
 #include "model/material_presets.hpp"
 #include "model/modal.hpp"
 #include "model/material_spec.hpp"
+#include "model/sensitivity.hpp"
 #include "ui/cli/cli_common.hpp"
 
 namespace piezo::cli {
@@ -184,6 +186,101 @@ void run_impedance(Context& ctx, ModelArgs a, const SweepArgs& s) {
   }
 }
 
+nlohmann::json tracked_json(const std::vector<pm::TrackedMode>& v) {
+  nlohmann::json a = nlohmann::json::array();
+  for (const auto& t : v)
+    a.push_back({{"nominal_hz", t.nominal_hz},
+                 {"perturbed_hz", t.perturbed_hz},
+                 {"change", t.change},
+                 {"mac", t.mac}});
+  return a;
+}
+
+std::string percent_list(const std::vector<pm::TrackedMode>& v) {
+  std::string s;
+  char buf[32];
+  for (const auto& t : v) {
+    std::snprintf(buf, sizeof buf, "%+9.3f", 100 * t.change);
+    s += buf;
+  }
+  return s;
+}
+
+void run_sensitivity(Context& ctx, ModelArgs a, double band_hz) {
+  const auto r = resolve(a);
+  const auto m = pm::resolve_material({a.material, a.isotropic, a.set});
+  pm::SensitivityOptions o;
+  o.band_hz = band_hz;
+  o.mesh = {a.n_radial, a.n_axial};
+  try {
+    o.validate();
+  } catch (const std::invalid_argument& e) {
+    throw InputError(e.what());
+  }
+  const auto res = pm::d_form_sensitivity(a.geometry, m.d, o);
+  nlohmann::json j;
+  j["material"] = a.material;
+  j["model_class"] = r.model_class;
+  j["mesh"] = {{"n_radial", a.n_radial}, {"n_axial", a.n_axial}};
+  j["band_hz"] = band_hz;
+  j["nominal"] = {{"short_circuit_hz", res.nominal.short_hz},
+                  {"open_circuit_hz", res.nominal.open_hz},
+                  {"c_static_f", res.nominal.c_static_f}};
+  j["cases"] = nlohmann::json::array();
+  for (const auto& c : res.cases) {
+    nlohmann::json cj = {{"param", pm::d_param_name(c.param)},
+                         {"factor", c.factor},
+                         {"seed_says_sensitive", pm::seed_says_sensitive(c.param)},
+                         {"valid", c.valid}};
+    if (!c.valid) {
+      cj["reason"] = c.reason;
+    } else {
+      cj["short_circuit"] = tracked_json(c.short_modes);
+      cj["open_circuit"] = tracked_json(c.open_modes);
+      cj["c_static_change"] = c.c_static_change;
+      cj["max_abs_change"] = c.max_abs_change;
+      cj["min_mac"] = c.min_mac;
+      cj["perturbed_short_circuit_hz"] = c.perturbed.short_hz;
+      cj["perturbed_open_circuit_hz"] = c.perturbed.open_hz;
+    }
+    j["cases"].push_back(std::move(cj));
+  }
+  j["converged"] = res.converged;
+  if (ctx.json) {
+    print_json(j);
+  } else {
+    std::printf("%s (%s class), mesh %d x %d, active modes below %.0f Hz; each d-form constant "
+                "scaled alone\n",
+                a.material.c_str(), r.model_class.c_str(), a.n_radial, a.n_axial, band_hz);
+    std::printf("nominal: short");
+    for (double f : res.nominal.short_hz) std::printf(" %.1f", f);
+    std::printf(" Hz | open");
+    for (double f : res.nominal.open_hz) std::printf(" %.1f", f);
+    std::printf(" Hz | C_static %.5g F\n", res.nominal.c_static_f);
+    std::printf("relative change [%%] of each nominal active mode (followed by shape, MAC) and of "
+                "C_static; * = sensitive per seed eq 16\n");
+    std::printf("  %-8s %-6s | %-*s | %-*s | %9s | %8s | %5s\n", "param", "factor",
+                static_cast<int>(9 * res.nominal.short_hz.size()), "short circuit",
+                static_cast<int>(9 * res.nominal.open_hz.size()), "open circuit", "C_static",
+                "max", "MAC");
+    for (const auto& c : res.cases) {
+      std::printf("%c %-8s x%-5g | ", pm::seed_says_sensitive(c.param) ? '*' : ' ',
+                  pm::d_param_name(c.param), c.factor);
+      if (!c.valid) {
+        std::printf("not physical: %s\n", c.reason.c_str());
+        continue;
+      }
+      std::printf("%s | %s | %+9.3f | %8.3f | %5.3f\n", percent_list(c.short_modes).c_str(),
+                  percent_list(c.open_modes).c_str(), 100 * c.c_static_change,
+                  100 * c.max_abs_change, c.min_mac);
+    }
+  }
+  if (!res.converged) {
+    std::fprintf(stderr, "piezobench: modal solve did not converge: %s\n", res.message.c_str());
+    ctx.exit_code = kInternal;
+  }
+}
+
 }  // namespace
 
 void register_model_commands(CLI::App& app, Context& ctx) {
@@ -233,6 +330,18 @@ void register_model_commands(CLI::App& app, Context& ctx) {
   add_json_flag(imp, ctx);
   imp->callback([&ctx, iargs, sargs] {
     ctx.exit_code = run_command(ctx, [&] { run_impedance(ctx, *iargs, *sargs); });
+  });
+
+  auto sens_args = std::make_shared<ModelArgs>();
+  auto band = std::make_shared<double>(pm::SensitivityOptions{}.band_hz);
+  auto* sens = model->add_subcommand(
+      "sensitivity", "Seed Appendix C.1: each d-form constant doubled and halved");
+  add_model_options(sens, *sens_args);
+  sens->add_option("--band", *band, "Upper band edge [Hz] (seed Tables C.1, C.3: 200 kHz)")
+      ->capture_default_str();
+  add_json_flag(sens, ctx);
+  sens->callback([&ctx, sens_args, band] {
+    ctx.exit_code = run_command(ctx, [&] { run_sensitivity(ctx, *sens_args, *band); });
   });
 }
 
