@@ -16,20 +16,22 @@ void add_entry(std::vector<DriverEntry<Role>>& v, DriverEntry<Role> e) {
   if (e.key.empty() || !e.accepts || !e.open)
     throw std::invalid_argument("DriverRegistry: an entry needs a key, accepts() and open()");
   for (const auto& x : v)
-    if (x.key == e.key) throw std::invalid_argument("DriverRegistry: duplicate driver key '" + e.key + "'");
+    if (x.key == e.key)
+      throw std::invalid_argument("DriverRegistry: duplicate driver key '" + e.key + "'");
   v.push_back(std::move(e));
 }
 
 template <class Role>
-std::unique_ptr<Role> open_by_idn(const std::vector<DriverEntry<Role>>& v, std::unique_ptr<Transport> t,
-                                  const char* role) {
+std::unique_ptr<Role> open_by_idn(const std::vector<DriverEntry<Role>>& v,
+                                  std::unique_ptr<Transport> t, const char* role) {
   if (!t) throw std::invalid_argument("DriverRegistry: null transport");
   const std::string idn = query_idn(*t);
   for (const auto& e : v)
     if (e.accepts(idn)) return e.open(std::move(t));
   std::string known;
   for (const auto& e : v) known += (known.empty() ? "" : ", ") + e.key + " (" + e.description + ")";
-  throw InstrumentError(t->address() + ": no " + role + " driver for '" + idn + "'; known: " + known);
+  throw InstrumentError(t->address() + ": no " + role + " driver for '" + idn +
+                        "'; known: " + known);
 }
 }  // namespace
 
@@ -43,18 +45,21 @@ std::unique_ptr<Daq> DriverRegistry::open_daq(std::unique_ptr<Transport> t) cons
   return open_by_idn(daqs_, std::move(t), "DAQ");
 }
 
-std::unique_ptr<Awg> DriverRegistry::open_awg(const std::string& key, std::unique_ptr<Transport> t) const {
+std::unique_ptr<Awg> DriverRegistry::open_awg(const std::string& key,
+                                              std::unique_ptr<Transport> t) const {
   for (const auto& e : awgs_)
     if (e.key == key) return e.open(std::move(t));
   throw std::invalid_argument("DriverRegistry: no AWG driver '" + key + "'");
 }
 
 void register_builtin_drivers(DriverRegistry& r) {
-  r.add_awg({"keysight33500", "Keysight 33500B/33600A Trueform generators", keysight33500::Driver::supports,
+  r.add_awg({"keysight33500", "Keysight 33500B/33600A Trueform generators",
+             keysight33500::Driver::supports,
              [](std::unique_ptr<Transport> t) -> std::unique_ptr<Awg> {
                return std::make_unique<keysight33500::Driver>(std::move(t));
              }});
-  r.add_awg({"tektronix_awg", "Tektronix AWG5000/AWG7000 generators", tektronix_awg::Driver::supports,
+  r.add_awg({"tektronix_awg", "Tektronix AWG5000/AWG7000 generators",
+             tektronix_awg::Driver::supports,
              [](std::unique_ptr<Transport> t) -> std::unique_ptr<Awg> {
                return std::make_unique<tektronix_awg::Driver>(std::move(t));
              }});
@@ -89,7 +94,8 @@ std::string query_idn(Transport& t) {
     line.append(reinterpret_cast<char*>(buf), reinterpret_cast<char*>(nl));
     if (nl != buf + n) {
       if (nl + 1 != buf + n)
-        throw InstrumentError(t.address() + ": unexpected bytes after the *IDN? reply '" + line + "'");
+        throw InstrumentError(t.address() + ": unexpected bytes after the *IDN? reply '" + line +
+                              "'");
       break;
     }
     if (eom) break;

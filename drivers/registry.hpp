@@ -35,7 +35,8 @@ class DriverRegistry {
   // InstrumentError naming the reply and the known drivers if none does.
   std::unique_ptr<Awg> open_awg(std::unique_ptr<Transport> t) const;
   std::unique_ptr<Daq> open_daq(std::unique_ptr<Transport> t) const;
-  // The driver of that key (no *IDN? match needed); throws std::invalid_argument for an unknown key.
+  // The driver of that key (no *IDN? match needed); throws std::invalid_argument for an unknown
+  // key.
   std::unique_ptr<Awg> open_awg(const std::string& key, std::unique_ptr<Transport> t) const;
 
  private:

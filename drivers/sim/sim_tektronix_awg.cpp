@@ -14,15 +14,20 @@ bool parse_num(const std::string& p, double* v) {
   *v = std::strtod(p.c_str(), &end);
   return end != p.c_str() && std::isfinite(*v);
 }
-bool parse_one(const std::vector<std::string>& p, double* v) { return p.size() == 1 && parse_num(p[0], v); }
+bool parse_one(const std::vector<std::string>& p, double* v) {
+  return p.size() == 1 && parse_num(p[0], v);
+}
 std::string upper(std::string s) {
   for (auto& ch : s) ch = static_cast<char>(std::toupper(static_cast<unsigned char>(ch)));
   return s;
 }
-bool is_on(const std::vector<std::string>& p) { return !p.empty() && (upper(p[0]) == "ON" || p[0] == "1"); }
-// A <string> parameter: "name" or 'name'; nullopt-like empty result if unquoted.
+bool is_on(const std::vector<std::string>& p) {
+  return !p.empty() && (upper(p[0]) == "ON" || p[0] == "1");
+}
+// A <string> parameter: "name" or 'name'; false if unquoted or empty.
 bool unquote(const std::string& p, std::string* out) {
-  if (p.size() < 2 || (p.front() != '"' && p.front() != '\'') || p.back() != p.front()) return false;
+  if (p.size() < 2 || (p.front() != '"' && p.front() != '\'') || p.back() != p.front())
+    return false;
   *out = p.substr(1, p.size() - 2);
   return !out->empty();
 }
@@ -51,7 +56,8 @@ void SimTektronixAwg::reset() {
   order_.clear();
   Waveform dc{std::vector<float>(1000, 0.0f), std::vector<std::uint8_t>(1000, 0), true};
   Waveform sine{std::vector<float>(100), std::vector<std::uint8_t>(100, 0), true};
-  for (std::size_t i = 0; i < 100; ++i) sine.values[i] = static_cast<float>(std::sin(2 * M_PI * i / 100.0));
+  for (std::size_t i = 0; i < 100; ++i)
+    sine.values[i] = static_cast<float>(std::sin(2 * M_PI * i / 100.0));
   for (auto& [name, w] : {std::pair{"*DC", dc}, std::pair{"*Sine100", sine}}) {
     list_[name] = w;
     order_.push_back(name);
@@ -72,11 +78,13 @@ void SimTektronixAwg::trigger() {
   a.vpp = 2.0 * s_.amplitude_vpp;
   a.offset_v = 2.0 * s_.offset_v;
   a.output_on = s_.output_on;
-  const bool edge = !w.markers.empty() && (w.markers[0] & tek::kMarker1Bit) && s_.marker_high_v > s_.marker_low_v;
+  const bool edge =
+      !w.markers.empty() && (w.markers[0] & tek::kMarker1Bit) && s_.marker_high_v > s_.marker_low_v;
   if (edge) bench_->fire();
 }
 
-bool SimTektronixAwg::waveform_list(const scpi::Command& c, const scpi::ProgramMessage& msg, Reply& out) {
+bool SimTektronixAwg::waveform_list(const scpi::Command& c, const scpi::ProgramMessage& msg,
+                                    Reply& out) {
   using scpi::match;
   std::vector<std::string> p = c.params;
   while (!p.empty() && p.back().empty()) p.pop_back();  // "name,0,N," before a block
@@ -85,7 +93,8 @@ bool SimTektronixAwg::waveform_list(const scpi::Command& c, const scpi::ProgramM
   if (match("WLISt:SIZE", c.header) && c.query) {
     append(out, std::to_string(order_.size()) + "\n");
   } else if (match("WLISt:NAME", c.header) && c.query) {
-    if (!parse_one(p, &v) || v < 0 || v >= static_cast<double>(order_.size()) || v != std::floor(v)) {
+    if (!parse_one(p, &v) || v < 0 || v >= static_cast<double>(order_.size()) ||
+        v != std::floor(v)) {
       push_error(-222, "Data out of range; waveform list index");
       append(out, "\"\"\n");
     } else {
@@ -118,13 +127,14 @@ bool SimTektronixAwg::waveform_list(const scpi::Command& c, const scpi::ProgramM
     }
     auto pts = tek::decode_real_points(msg.block);
     double start = 0, size = pts ? static_cast<double>(pts->values.size()) : 0;
-    if (!pts || (p.size() >= 2 && !parse_num(p[1], &start)) || (p.size() == 3 && !parse_num(p[2], &size))) {
+    if (!pts || (p.size() >= 2 && !parse_num(p[1], &start)) ||
+        (p.size() == 3 && !parse_num(p[2], &size))) {
       push_error(-104, "Data type error; REAL data is 5 bytes per point");
       return true;
     }
     Waveform& w = it->second;
-    if (size != static_cast<double>(pts->values.size()) || start < 0 || start != std::floor(start) ||
-        start + size > static_cast<double>(w.values.size())) {
+    if (size != static_cast<double>(pts->values.size()) || start < 0 ||
+        start != std::floor(start) || start + size > static_cast<double>(w.values.size())) {
       push_error(-222, "Data out of range; start/size do not fit the block or the waveform");
       return true;
     }
@@ -134,8 +144,10 @@ bool SimTektronixAwg::waveform_list(const scpi::Command& c, const scpi::ProgramM
         return true;
       }
     const auto s0 = static_cast<std::size_t>(start);
-    std::copy(pts->values.begin(), pts->values.end(), w.values.begin() + static_cast<std::ptrdiff_t>(s0));
-    std::copy(pts->markers.begin(), pts->markers.end(), w.markers.begin() + static_cast<std::ptrdiff_t>(s0));
+    std::copy(pts->values.begin(), pts->values.end(),
+              w.values.begin() + static_cast<std::ptrdiff_t>(s0));
+    std::copy(pts->markers.begin(), pts->markers.end(),
+              w.markers.begin() + static_cast<std::ptrdiff_t>(s0));
   } else if (match("WLISt:WAVeform:DELete", c.header) && !c.query) {
     auto it = p.size() == 1 && unquote(p[0], &name) ? list_.find(name) : list_.end();
     if (it == list_.end() || it->second.predefined) {
@@ -178,44 +190,63 @@ bool SimTektronixAwg::source(const scpi::Command& c, Reply& out) {
     } else {
       s_.assigned = name;
     }
-  } else if (match("[SOURce#:]FREQuency[:CW]", c.header, &sfx) || match("[SOURce#:]FREQuency:FIXed", c.header, &sfx)) {
-    if (c.query) append(out, num(s_.sample_rate_hz) + "\n");
-    else if (!parse_one(c.params, &v) || v < model_.min_sample_rate_hz || v > model_.max_sample_rate_hz)
+  } else if (match("[SOURce#:]FREQuency[:CW]", c.header, &sfx) ||
+             match("[SOURce#:]FREQuency:FIXed", c.header, &sfx)) {
+    if (c.query)
+      append(out, num(s_.sample_rate_hz) + "\n");
+    else if (!parse_one(c.params, &v) || v < model_.min_sample_rate_hz ||
+             v > model_.max_sample_rate_hz)
       push_error(-222, "Data out of range; sampling frequency");
-    else s_.sample_rate_hz = v;
+    else
+      s_.sample_rate_hz = v;
   } else if (match("[SOURce#:]DAC:RESolution", c.header, &sfx)) {
     if (!channel_ok()) return true;
-    if (c.query) append(out, std::to_string(model_.dac_bits) + "\n");
-    else if (!parse_one(c.params, &v) || v != model_.dac_bits) push_error(-222, "Data out of range; DAC resolution");
+    if (c.query)
+      append(out, std::to_string(model_.dac_bits) + "\n");
+    else if (!parse_one(c.params, &v) || v != model_.dac_bits)
+      push_error(-222, "Data out of range; DAC resolution");
   } else if (match("[SOURce#:]VOLTage[:LEVel][:IMMediate]:OFFSet", c.header, &sfx)) {
     if (!channel_ok()) return true;
-    if (c.query) append(out, num(s_.offset_v) + "\n");
-    else if (!parse_one(c.params, &v) || std::fabs(v) > model_.max_offset_v) push_error(-222, "Data out of range; offset");
-    else s_.offset_v = v;
+    if (c.query)
+      append(out, num(s_.offset_v) + "\n");
+    else if (!parse_one(c.params, &v) || std::fabs(v) > model_.max_offset_v)
+      push_error(-222, "Data out of range; offset");
+    else
+      s_.offset_v = v;
   } else if (match("[SOURce#:]VOLTage[:LEVel][:IMMediate][:AMPLitude]", c.header, &sfx)) {
     if (!channel_ok()) return true;
-    if (c.query) append(out, num(s_.amplitude_vpp) + "\n");
-    else if (!parse_one(c.params, &v) || v < model_.min_amplitude_vpp || v > model_.max_amplitude_vpp)
+    if (c.query)
+      append(out, num(s_.amplitude_vpp) + "\n");
+    else if (!parse_one(c.params, &v) || v < model_.min_amplitude_vpp ||
+             v > model_.max_amplitude_vpp)
       push_error(-222, "Data out of range; amplitude");
-    else s_.amplitude_vpp = v;
+    else
+      s_.amplitude_vpp = v;
   } else if (match("[SOURce#:]MARKer#:VOLTage[:LEVel][:IMMediate]:HIGH", c.header, &sfx) ||
              match("[SOURce#:]MARKer#:VOLTage[:LEVel][:IMMediate]:LOW", c.header, &sfx)) {
     if (!channel_ok()) return true;
     const bool high = upper(c.header).ends_with("HIGH");
     double& level = high ? s_.marker_high_v : s_.marker_low_v;
     const bool marker1 = sfx.size() > 1 && sfx[1] == 1;
-    if (c.query) append(out, num(marker1 ? level : 0.0) + "\n");
-    else if (!parse_one(c.params, &v) || v < kMarkerMinV || v > kMarkerMaxV) push_error(-222, "Data out of range; marker level");
-    else if (marker1) level = v;  // marker 2 is not wired to anything
+    if (c.query)
+      append(out, num(marker1 ? level : 0.0) + "\n");
+    else if (!parse_one(c.params, &v) || v < kMarkerMinV || v > kMarkerMaxV)
+      push_error(-222, "Data out of range; marker level");
+    else if (marker1)
+      level = v;  // marker 2 is not wired to anything
   } else if (match("[SOURce#:]MARKer#:DELay", c.header, &sfx)) {
     // 0..1 ns on the AWG5000: far below a DAQ sample period here; accepted, not modelled.
     if (!channel_ok()) return true;
-    if (c.query) append(out, "0\n");
-    else if (!parse_one(c.params, &v) || v < 0 || v > 1e-9) push_error(-222, "Data out of range; marker delay");
+    if (c.query)
+      append(out, "0\n");
+    else if (!parse_one(c.params, &v) || v < 0 || v > 1e-9)
+      push_error(-222, "Data out of range; marker delay");
   } else if (match("OUTPut#[:STATe]", c.header, &sfx)) {
     if (!channel_ok()) return true;
-    if (c.query) append(out, s_.output_on ? "1\n" : "0\n");
-    else s_.output_on = is_on(c.params);
+    if (c.query)
+      append(out, s_.output_on ? "1\n" : "0\n");
+    else
+      s_.output_on = is_on(c.params);
   } else {
     return false;
   }
@@ -227,13 +258,18 @@ bool SimTektronixAwg::command(const scpi::Command& c, const scpi::ProgramMessage
   std::lock_guard lock(bench_->mutex());
   if (c.header == "*RST") {
     reset();
-  } else if (c.header == "*TRG" || (match("TRIGger[:SEQuence][:IMMediate]", c.header) && !c.query)) {
+  } else if (c.header == "*TRG" ||
+             (match("TRIGger[:SEQuence][:IMMediate]", c.header) && !c.query)) {
     trigger();
   } else if (match("TRIGger[:SEQuence]:SOURce", c.header)) {
-    if (c.query) append(out, s_.external_trigger ? "EXT\n" : "INT\n");
-    else if (c.params.size() == 1 && upper(c.params[0]).starts_with("EXT")) s_.external_trigger = true;
-    else if (c.params.size() == 1 && upper(c.params[0]).starts_with("INT")) s_.external_trigger = false;
-    else push_error(-224, "Illegal parameter value; INTernal|EXTernal");
+    if (c.query)
+      append(out, s_.external_trigger ? "EXT\n" : "INT\n");
+    else if (c.params.size() == 1 && upper(c.params[0]).starts_with("EXT"))
+      s_.external_trigger = true;
+    else if (c.params.size() == 1 && upper(c.params[0]).starts_with("INT"))
+      s_.external_trigger = false;
+    else
+      push_error(-224, "Illegal parameter value; INTernal|EXTernal");
   } else if (match("AWGControl:RMODe", c.header)) {
     if (c.query) {
       append(out, s_.triggered_mode ? "TRIG\n" : "CONT\n");
@@ -247,8 +283,10 @@ bool SimTektronixAwg::command(const scpi::Command& c, const scpi::ProgramMessage
     }
     if (s_.run_state != 0) s_.run_state = s_.triggered_mode ? 1 : 2;
   } else if (match("AWGControl:RUN[:IMMediate]", c.header) && !c.query) {
-    if (s_.assigned.empty()) push_error(-221, "Settings conflict; no waveform assigned to channel 1");
-    else s_.run_state = s_.triggered_mode ? 1 : 2;
+    if (s_.assigned.empty())
+      push_error(-221, "Settings conflict; no waveform assigned to channel 1");
+    else
+      s_.run_state = s_.triggered_mode ? 1 : 2;
   } else if (match("AWGControl:STOP[:IMMediate]", c.header) && !c.query) {
     s_.run_state = 0;
   } else if (match("AWGControl:RSTate", c.header) && c.query) {

@@ -31,7 +31,9 @@ class SimTektronixAwg : public ScpiDevice {
   explicit SimTektronixAwg(std::shared_ptr<SimBench> bench);
 
  protected:
-  std::string idn() const override { return "TEKTRONIX,AWG5014C,SIM0005014,SCPI:99.0 FW:piezobench-sim"; }
+  std::string idn() const override {
+    return "TEKTRONIX,AWG5014C,SIM0005014,SCPI:99.0 FW:piezobench-sim";
+  }
   bool command(const scpi::Command& c, const scpi::ProgramMessage& msg, Reply& out) override;
 
  private:

@@ -68,7 +68,8 @@ int Driver::run_state() {
 bool Driver::waveform_exists(const std::string& name) {
   const double size = scpi_.query_double(std::string(kListSize));
   if (!(size >= 0 && size < 1e6 && size == std::floor(size)))
-    throw InstrumentError(scpi_.address() + ": '" + std::string(kListSize) + "' answered " + num(size));
+    throw InstrumentError(scpi_.address() + ": '" + std::string(kListSize) + "' answered " +
+                          num(size));
   for (long i = 0; i < static_cast<long>(size); ++i)
     if (unquoted(scpi_.query(std::string(kListName) + std::to_string(i))) == name) return true;
   return false;
@@ -83,8 +84,8 @@ void Driver::load(const ArbWaveform& w) {
                                 " allowed on the " + std::string(m.idn_model) + ")");
   if (!(w.sample_rate_hz >= m.min_sample_rate_hz && w.sample_rate_hz <= m.max_sample_rate_hz))
     throw std::invalid_argument(who + "sample rate " + num(w.sample_rate_hz) + " Hz outside [" +
-                                num(m.min_sample_rate_hz) + ", " + num(m.max_sample_rate_hz) + "] on the " +
-                                std::string(m.idn_model));
+                                num(m.min_sample_rate_hz) + ", " + num(m.max_sample_rate_hz) +
+                                "] on the " + std::string(m.idn_model));
   // The amplitude is specified into 50 ohm; the divider's input is high
   // impedance, where the generator's 50-ohm source shows twice that. So a
   // peak of peak_v at the divider is an amplitude of peak_v Vpp.
@@ -95,7 +96,8 @@ void Driver::load(const ArbWaveform& w) {
                                 "] V (amplitude into 50 ohm) on the " + std::string(m.idn_model));
   std::vector<float> values(w.samples.size());
   for (std::size_t i = 0; i < values.size(); ++i) {
-    if (!(std::fabs(w.samples[i]) <= 1.0)) throw std::invalid_argument(who + "samples must lie in [-1, 1]");
+    if (!(std::fabs(w.samples[i]) <= 1.0))
+      throw std::invalid_argument(who + "samples must lie in [-1, 1]");
     values[i] = static_cast<float>(w.samples[i]);
   }
   const std::string name = quoted(kWaveformName);
@@ -131,7 +133,8 @@ void Driver::load(const ArbWaveform& w) {
   // *OPC? is said to answer 1 at once on these instruments (tm_devices'
   // notes), so the run state is polled until it waits for a trigger.
   step("wait for the run state", [&] {
-    const auto deadline = std::chrono::steady_clock::now() + std::chrono::duration<double>(run_timeout_s_);
+    const auto deadline =
+        std::chrono::steady_clock::now() + std::chrono::duration<double>(run_timeout_s_);
     for (;;) {
       const int s = run_state();
       if (s == 1) return;
@@ -143,7 +146,9 @@ void Driver::load(const ArbWaveform& w) {
   });
 }
 
-void Driver::output(bool on) { configure(on ? "output on" : "output off", std::string(on ? kOutputOn : kOutputOff)); }
+void Driver::output(bool on) {
+  configure(on ? "output on" : "output off", std::string(on ? kOutputOn : kOutputOff));
+}
 
 void Driver::trigger() {
   step("trigger (*TRG)", [&] {

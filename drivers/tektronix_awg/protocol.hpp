@@ -41,6 +41,7 @@ struct Model {
 // (50 mV..2 Vpp, ±0.5 V; option 02/06 direct outputs allow 0.5..1 Vpp and no
 // offset, which *IDN? does not reveal). The AWG7000 minimum length (960) is a
 // conservative guess we could not confirm; the waveforms here are thousands of points.
+// clang-format off
 inline constexpr Model kModels[] = {
     // idn    ch  min rate max rate  min pts  max pts    bits sel  min A  max A  |offset|
     {"AWG5002", 2, 10e6, 600e6, 250, 16'200'000, 14, 0, 0.02, 4.5, 2.25},
@@ -63,6 +64,7 @@ inline constexpr Model kModels[] = {
     {"AWG7082C", 2, 10e6, 8e9, 960, 32'400'000, 8, 8, 0.05, 2.0, 0.5},
     {"AWG7122C", 2, 10e6, 12e9, 960, 32'400'000, 8, 8, 0.05, 2.0, 0.5},
 };
+// clang-format on
 
 // "TEKTRONIX,AWG5014C,B051234,SCPI:99.0 FW:4.6.0.7": the row for field 2 when
 // field 1 is Tektronix (any case); nullptr otherwise.
@@ -71,19 +73,24 @@ const Model* find_model(std::string_view idn);
 // Command table (channel 1). Long forms as the manual writes them.
 inline constexpr std::string_view kStop = "AWGControl:STOP";
 inline constexpr std::string_view kRun = "AWGControl:RUN";
-inline constexpr std::string_view kRunState = "AWGControl:RSTate?";  // 0 stopped, 1 waiting for trigger, 2 running
-inline constexpr std::string_view kRunModeTriggered = "AWGControl:RMODe TRIGgered";  // one waveform per trigger
+inline constexpr std::string_view kRunState =
+    "AWGControl:RSTate?";  // 0 stopped, 1 waiting for trigger, 2 running
+inline constexpr std::string_view kRunModeTriggered =
+    "AWGControl:RMODe TRIGgered";  // one waveform per trigger
 // External source: with nothing at TRIGger IN only *TRG starts a burst (the
 // internal source would be the free-running trigger timer).
 inline constexpr std::string_view kTriggerExternal = "TRIGger:SEQuence:SOURce EXTernal";
-inline constexpr std::string_view kTrigger = "*TRG";  // = TRIGger:SEQuence:IMMediate (force trigger)
+inline constexpr std::string_view kTrigger =
+    "*TRG";  // = TRIGger:SEQuence:IMMediate (force trigger)
 inline constexpr std::string_view kListSize = "WLISt:SIZE?";
-inline constexpr std::string_view kListName = "WLISt:NAME? ";             // + index, reply quoted
+inline constexpr std::string_view kListName = "WLISt:NAME? ";  // + index, reply quoted
 inline constexpr std::string_view kWaveformDelete = "WLISt:WAVeform:DELete ";  // + "name"
 inline constexpr std::string_view kWaveformNew = "WLISt:WAVeform:NEW ";  // + "name",<points>,REAL
-inline constexpr std::string_view kWaveformData = "WLISt:WAVeform:DATA ";  // + "name",0,<points>,<block>
+inline constexpr std::string_view kWaveformData =
+    "WLISt:WAVeform:DATA ";                                       // + "name",0,<points>,<block>
 inline constexpr std::string_view kAssign = "SOURce1:WAVeform ";  // + "name"
-inline constexpr std::string_view kSampleRate = "SOURce1:FREQuency ";  // the sampling clock, all channels
+inline constexpr std::string_view kSampleRate =
+    "SOURce1:FREQuency ";  // the sampling clock, all channels
 inline constexpr std::string_view kDacResolution = "SOURce1:DAC:RESolution ";
 inline constexpr std::string_view kAmplitude = "SOURce1:VOLTage:AMPLitude ";  // Vpp into 50 ohm
 inline constexpr std::string_view kOffset = "SOURce1:VOLTage:OFFSet ";

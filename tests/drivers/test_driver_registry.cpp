@@ -19,13 +19,16 @@ using namespace piezo::drivers;
 namespace {
 
 std::shared_ptr<sim::SimBench> bench() {
-  return std::make_shared<sim::SimBench>(std::make_unique<test::RcPhysics>(3140.0, 2.1e-9), sim::DaqImperfections{}, 1);
+  return std::make_shared<sim::SimBench>(std::make_unique<test::RcPhysics>(3140.0, 2.1e-9),
+                                         sim::DaqImperfections{}, 1);
 }
 
 class Stranger : public sim::ScpiDevice {
  protected:
   std::string idn() const override { return "ACME,WAVEMAKER 9000,1,0"; }
-  bool command(const scpi::Command&, const scpi::ProgramMessage&, sim::Reply&) override { return false; }
+  bool command(const scpi::Command&, const scpi::ProgramMessage&, sim::Reply&) override {
+    return false;
+  }
 };
 
 std::unique_ptr<Transport> loop(std::shared_ptr<sim::ScpiDevice> d) {
@@ -52,7 +55,8 @@ TEST(DriverRegistry, TheIdnReplyChoosesTheDriver) {
   EXPECT_NE(dynamic_cast<infiniium::Driver*>(daq.get()), nullptr);
   auto by_key = r.open_awg("tektronix_awg", loop(std::make_shared<sim::SimTektronixAwg>(b)));
   EXPECT_NE(dynamic_cast<tektronix_awg::Driver*>(by_key.get()), nullptr);
-  EXPECT_THROW(r.open_awg("no_such_driver", loop(std::make_shared<sim::SimAwg>(b))), std::invalid_argument);
+  EXPECT_THROW(r.open_awg("no_such_driver", loop(std::make_shared<sim::SimAwg>(b))),
+               std::invalid_argument);
 }
 
 TEST(DriverRegistry, AnUnknownInstrumentIsNamedWithTheKnownDrivers) {
@@ -66,14 +70,16 @@ TEST(DriverRegistry, AnUnknownInstrumentIsNamedWithTheKnownDrivers) {
     EXPECT_NE(m.find("tektronix_awg"), std::string::npos) << m;
   }
   // A DAQ address answering as an AWG: no DAQ driver takes it.
-  EXPECT_THROW(builtin_drivers().open_daq(loop(std::make_shared<sim::SimTektronixAwg>(bench()))), InstrumentError);
+  EXPECT_THROW(builtin_drivers().open_daq(loop(std::make_shared<sim::SimTektronixAwg>(bench()))),
+               InstrumentError);
 }
 
 TEST(DriverRegistry, KeysMustBeUniqueAndEntriesComplete) {
   DriverRegistry r;
   register_builtin_drivers(r);
   EXPECT_THROW(register_builtin_drivers(r), std::invalid_argument);  // every key again
-  EXPECT_THROW(r.add_awg({"", "nameless", [](const std::string&) { return true; }, nullptr}), std::invalid_argument);
+  EXPECT_THROW(r.add_awg({"", "nameless", [](const std::string&) { return true; }, nullptr}),
+               std::invalid_argument);
 }
 
 }  // namespace

@@ -29,7 +29,9 @@ namespace tek = piezo::drivers::tektronix_awg;
 
 namespace {
 
-bool contains(const std::string& s, const std::string& part) { return s.find(part) != std::string::npos; }
+bool contains(const std::string& s, const std::string& part) {
+  return s.find(part) != std::string::npos;
+}
 
 // ------------------------------------------------------------ REAL format
 TEST(TektronixProtocol, RealPointIsFloat32LittleEndianThenAMarkerByte) {
@@ -37,7 +39,8 @@ TEST(TektronixProtocol, RealPointIsFloat32LittleEndianThenAMarkerByte) {
   const std::uint8_t m[] = {tek::kMarker1Bit, tek::kMarker2Bit};
   const auto b = tek::encode_real_points(v, m);
   // 1.0f = 0x3F800000, -0.5f = 0xBF000000, least significant byte first.
-  const std::vector<std::uint8_t> want = {0x00, 0x00, 0x80, 0x3F, 0x40, 0x00, 0x00, 0x00, 0xBF, 0x80};
+  const std::vector<std::uint8_t> want = {0x00, 0x00, 0x80, 0x3F, 0x40,
+                                          0x00, 0x00, 0x00, 0xBF, 0x80};
   EXPECT_EQ(b, want);
 }
 
@@ -78,8 +81,9 @@ TEST(TektronixProtocol, ModelsAreChosenFromTheIdnReply) {
   EXPECT_FALSE(tek::find_model("ACME,AWG5014C,1,1"));
   EXPECT_FALSE(tek::find_model("garbage"));
   for (const auto& m : tek::kModels) {
-    EXPECT_TRUE(m.channels >= 1 && m.min_sample_rate_hz < m.max_sample_rate_hz && m.min_points < m.max_points &&
-                m.min_amplitude_vpp < m.max_amplitude_vpp && m.dac_bits > 0)
+    EXPECT_TRUE(m.channels >= 1 && m.min_sample_rate_hz < m.max_sample_rate_hz &&
+                m.min_points < m.max_points && m.min_amplitude_vpp < m.max_amplitude_vpp &&
+                m.dac_bits > 0)
         << m.idn_model;
   }
 }
@@ -93,17 +97,27 @@ struct Fault {
 
 class FaultyTek : public sim::SimTektronixAwg {
  public:
-  FaultyTek(std::shared_ptr<sim::SimBench> b, Fault f) : SimTektronixAwg(std::move(b)), f_(std::move(f)) {}
+  FaultyTek(std::shared_ptr<sim::SimBench> b, Fault f)
+      : SimTektronixAwg(std::move(b)), f_(std::move(f)) {}
 
  protected:
   bool command(const scpi::Command& c, const scpi::ProgramMessage& msg, sim::Reply& out) override {
     if (f_.kind != Fault::None && scpi::match(f_.header, c.header)) {
       switch (f_.kind) {
-        case Fault::Error: push_error(-222, "Data out of range; simulated fault"); return true;
-        case Fault::Swallow: out.swallow = true; return true;
-        case Fault::Garbage: append(out, f_.garbage + "\n"); return true;
-        case Fault::Close: out.close_connection = true; return true;
-        case Fault::None: break;
+        case Fault::Error:
+          push_error(-222, "Data out of range; simulated fault");
+          return true;
+        case Fault::Swallow:
+          out.swallow = true;
+          return true;
+        case Fault::Garbage:
+          append(out, f_.garbage + "\n");
+          return true;
+        case Fault::Close:
+          out.close_connection = true;
+          return true;
+        case Fault::None:
+          break;
       }
     }
     return SimTektronixAwg::command(c, msg, out);
@@ -117,7 +131,8 @@ constexpr double kR1 = 3140.0, kC = 2.1e-9;
 
 std::shared_ptr<sim::SimBench> bench(std::uint64_t seed) {
   sim::DaqImperfections imp;
-  imp.noise_rel[0] = imp.noise_rel[1] = 0.03;  // seeded noise: equality also checks the RNG stays in step
+  imp.noise_rel[0] = imp.noise_rel[1] =
+      0.03;  // seeded noise: equality also checks the RNG stays in step
   return std::make_shared<sim::SimBench>(std::make_unique<test::RcPhysics>(kR1, kC), imp, seed);
 }
 
@@ -136,7 +151,8 @@ Link connect(const std::string& kind, std::shared_ptr<sim::ScpiDevice> dev) {
     l.server = std::make_unique<sim::TcpServer>(std::move(dev), "127.0.0.1", 0);
     l.server->start();
     // Short: the timeout case waits it out once.
-    l.transport = std::make_unique<TcpTransport>("127.0.0.1", l.server->port(), std::chrono::milliseconds(400));
+    l.transport = std::make_unique<TcpTransport>("127.0.0.1", l.server->port(),
+                                                 std::chrono::milliseconds(400));
   }
   return l;
 }
@@ -183,12 +199,15 @@ TEST_P(TektronixDriver, ShotsEqualTheKeysightPathSampleForSample) {
   infiniium::Driver daq(std::move(dl.transport));
   EXPECT_EQ(awg.model().idn_model, "AWG5014C");
 
-  keysight33500::Driver key_awg(std::make_unique<sim::LoopbackTransport>(std::make_shared<sim::SimAwg>(key_bench), "loop://key"));
-  infiniium::Driver key_daq(std::make_unique<sim::LoopbackTransport>(std::make_shared<sim::SimDaq>(key_bench), "loop://daq"));
+  keysight33500::Driver key_awg(std::make_unique<sim::LoopbackTransport>(
+      std::make_shared<sim::SimAwg>(key_bench), "loop://key"));
+  infiniium::Driver key_daq(std::make_unique<sim::LoopbackTransport>(
+      std::make_shared<sim::SimDaq>(key_bench), "loop://daq"));
 
   const ArbWaveform w = seeded_waveform(5, 2500);
   DaqRecord a;
-  for (int load = 0; load < 2; ++load) {  // the second load replaces the waveform (DELete, then NEW)
+  for (int load = 0; load < 2;
+       ++load) {  // the second load replaces the waveform (DELete, then NEW)
     awg.load(w);
     key_awg.load(w);
     for (int k = 0; k < 2; ++k) {
@@ -264,22 +283,24 @@ std::string load_fails_with(const std::string& kind, const Fault& f) {
 }
 
 TEST_P(TektronixDriver, AnInstrumentErrorNamesTheStepAndCarriesItsText) {
-  const std::string m =
-      load_fails_with<InstrumentError>(GetParam(), {Fault::Error, "[SOURce#:]VOLTage[:LEVel][:IMMediate][:AMPLitude]", ""});
+  const std::string m = load_fails_with<InstrumentError>(
+      GetParam(), {Fault::Error, "[SOURce#:]VOLTage[:LEVel][:IMMediate][:AMPLitude]", ""});
   EXPECT_TRUE(contains(m, "step 'amplitude'")) << m;
   EXPECT_TRUE(contains(m, "SOURce1:VOLTage:AMPLitude 0.8")) << m;
   EXPECT_TRUE(contains(m, "-222,\"Data out of range; simulated fault\"")) << m;
 }
 
 TEST_P(TektronixDriver, AnErrorAfterTheBlockNamesTheUpload) {
-  const std::string m = load_fails_with<InstrumentError>(GetParam(), {Fault::Error, "WLISt:WAVeform:DATA", ""});
+  const std::string m =
+      load_fails_with<InstrumentError>(GetParam(), {Fault::Error, "WLISt:WAVeform:DATA", ""});
   EXPECT_TRUE(contains(m, "step 'upload the waveform (WLISt:WAVeform:DATA)'")) << m;
   EXPECT_TRUE(contains(m, "<block of 5000 bytes>")) << m;  // 1000 points x 5 bytes
   EXPECT_TRUE(contains(m, "-222")) << m;
 }
 
 TEST_P(TektronixDriver, AReplyTimeoutNamesTheStep) {
-  Link l = connect(GetParam(), std::make_shared<FaultyTek>(bench(3), Fault{Fault::Swallow, "AWGControl:RSTate", ""}));
+  Link l = connect(GetParam(), std::make_shared<FaultyTek>(
+                                   bench(3), Fault{Fault::Swallow, "AWGControl:RSTate", ""}));
   tek::Driver awg(std::move(l.transport));
   try {
     awg.load(seeded_waveform(4, 1000));
@@ -293,7 +314,8 @@ TEST_P(TektronixDriver, AReplyTimeoutNamesTheStep) {
 }
 
 TEST_P(TektronixDriver, TheLinkClosingAtTheBlockNamesTheUpload) {
-  Link l = connect(GetParam(), std::make_shared<FaultyTek>(bench(3), Fault{Fault::Close, "WLISt:WAVeform:DATA", ""}));
+  Link l = connect(GetParam(), std::make_shared<FaultyTek>(
+                                   bench(3), Fault{Fault::Close, "WLISt:WAVeform:DATA", ""}));
   tek::Driver awg(std::move(l.transport));
   try {
     awg.load(seeded_waveform(4, 1000));
@@ -306,7 +328,8 @@ TEST_P(TektronixDriver, TheLinkClosingAtTheBlockNamesTheUpload) {
 }
 
 TEST_P(TektronixDriver, AMalformedReplyNamesTheStepAndTheReply) {
-  std::string m = load_fails_with<InstrumentError>(GetParam(), {Fault::Garbage, "AWGControl:RSTate", "BUSY"});
+  std::string m =
+      load_fails_with<InstrumentError>(GetParam(), {Fault::Garbage, "AWGControl:RSTate", "BUSY"});
   EXPECT_TRUE(contains(m, "step 'wait for the run state'")) << m;
   EXPECT_TRUE(contains(m, "answered 'BUSY', expected 0, 1 or 2")) << m;
   m = load_fails_with<InstrumentError>(GetParam(), {Fault::Garbage, "WLISt:SIZE", "many"});
@@ -326,14 +349,19 @@ class CutMidBlock : public Transport {
   explicit CutMidBlock(std::unique_ptr<Transport> inner) : inner_(std::move(inner)) {}
   std::string address() const override { return inner_->address(); }
   void send(std::span<const std::uint8_t> bytes) override {
-    const std::string head(bytes.begin(), bytes.begin() + static_cast<std::ptrdiff_t>(std::min<std::size_t>(bytes.size(), 40)));
+    const std::string head(
+        bytes.begin(),
+        bytes.begin() + static_cast<std::ptrdiff_t>(std::min<std::size_t>(bytes.size(), 40)));
     if (head.starts_with("WLISt:WAVeform:DATA"))
-      throw TransportError(TransportError::Kind::Closed, address() + ": send: connection closed after " +
-                                                             std::to_string(bytes.size() / 3) + " of " +
-                                                             std::to_string(bytes.size()) + " bytes");
+      throw TransportError(TransportError::Kind::Closed,
+                           address() + ": send: connection closed after " +
+                               std::to_string(bytes.size() / 3) + " of " +
+                               std::to_string(bytes.size()) + " bytes");
     inner_->send(bytes);
   }
-  std::size_t receive(std::uint8_t* buf, std::size_t max, bool* eom) override { return inner_->receive(buf, max, eom); }
+  std::size_t receive(std::uint8_t* buf, std::size_t max, bool* eom) override {
+    return inner_->receive(buf, max, eom);
+  }
   void set_timeout(std::chrono::milliseconds t) override { inner_->set_timeout(t); }
   std::chrono::milliseconds timeout() const override { return inner_->timeout(); }
   using Transport::send;
@@ -343,7 +371,8 @@ class CutMidBlock : public Transport {
 };
 
 TEST(TektronixDriverFaults, TheLinkDroppedMidBlockNamesTheUpload) {
-  auto inner = std::make_unique<sim::LoopbackTransport>(std::make_shared<sim::SimTektronixAwg>(bench(3)), "loop://tek");
+  auto inner = std::make_unique<sim::LoopbackTransport>(
+      std::make_shared<sim::SimTektronixAwg>(bench(3)), "loop://tek");
   tek::Driver awg(std::make_unique<CutMidBlock>(std::move(inner)));
   try {
     awg.load(seeded_waveform(4, 1000));
@@ -359,15 +388,17 @@ TEST(TektronixDriverFaults, TheLinkDroppedMidBlockNamesTheUpload) {
 // Marker 1 is the DAQ's trigger: a waveform uploaded without it plays, but the DAQ never fires.
 TEST(TektronixTwin, WithoutMarkerOneTheDaqIsNotTriggered) {
   auto b = bench(8);
-  ScpiClient awg(std::make_unique<sim::LoopbackTransport>(std::make_shared<sim::SimTektronixAwg>(b), "loop://tek"));
-  infiniium::Driver daq(std::make_unique<sim::LoopbackTransport>(std::make_shared<sim::SimDaq>(b), "loop://daq"));
+  ScpiClient awg(std::make_unique<sim::LoopbackTransport>(std::make_shared<sim::SimTektronixAwg>(b),
+                                                          "loop://tek"));
+  infiniium::Driver daq(
+      std::make_unique<sim::LoopbackTransport>(std::make_shared<sim::SimDaq>(b), "loop://daq"));
   std::vector<float> v(1000, 0.5f);
   std::vector<std::uint8_t> no_markers(v.size(), 0);
   awg.configure("WLISt:WAVeform:NEW \"X\",1000,REAL");
   awg.write_block("WLISt:WAVeform:DATA \"X\",0,1000,", tek::encode_real_points(v, no_markers));
   awg.check_errors("WLISt:WAVeform:DATA");
-  for (const char* c : {"SOURce1:WAVeform \"X\"", "SOURce1:FREQuency 1e7", "AWGControl:RMODe TRIGgered",
-                        "OUTPut1:STATe ON", "AWGControl:RUN"})
+  for (const char* c : {"SOURce1:WAVeform \"X\"", "SOURce1:FREQuency 1e7",
+                        "AWGControl:RMODe TRIGgered", "OUTPut1:STATe ON", "AWGControl:RUN"})
     awg.configure(c);
   EXPECT_EQ(awg.query("AWGControl:RSTate?"), "1");
   daq.configure(daq_config());
