@@ -1,8 +1,7 @@
 #include "acquisition/bench.hpp"
 
-#include "drivers/infiniium/driver.hpp"
 #include "drivers/instrument_uri.hpp"
-#include "drivers/keysight33500/driver.hpp"
+#include "drivers/registry.hpp"
 #include "drivers/sim/loopback_transport.hpp"
 #include "drivers/sim/sim_awg.hpp"
 #include "drivers/sim/sim_daq.hpp"
@@ -33,10 +32,8 @@ Bench open_bench(const BenchAddress& addr, std::shared_ptr<sim::SimBench> sim_be
     if (!sim_bench) throw std::invalid_argument("open_bench: the simulated bench needs its physics");
     auto awg_dev = std::make_shared<sim::SimAwg>(sim_bench);
     auto daq_dev = std::make_shared<sim::SimDaq>(sim_bench);
-    b.awg = std::make_unique<keysight33500::Driver>(
-        std::make_unique<sim::LoopbackTransport>(awg_dev, "sim://awg"));
-    b.daq = std::make_unique<infiniium::Driver>(
-        std::make_unique<sim::LoopbackTransport>(daq_dev, "sim://daq"));
+    b.awg = builtin_drivers().open_awg(std::make_unique<sim::LoopbackTransport>(awg_dev, "sim://awg"));
+    b.daq = builtin_drivers().open_daq(std::make_unique<sim::LoopbackTransport>(daq_dev, "sim://daq"));
     b.sim = sim_bench;
     b.description = "embedded simulated bench (" + sim_bench->physics().description() + ")";
     return b;
@@ -50,8 +47,9 @@ Bench open_bench(const BenchAddress& addr, std::shared_ptr<sim::SimBench> sim_be
     throw std::invalid_argument("instrument address '" + addr.awg +
                                 "': a USBTMC bench needs the DAQ's address too (--daq)");
   }
-  b.awg = std::make_unique<keysight33500::Driver>(open_transport(addr.awg));
-  b.daq = std::make_unique<infiniium::Driver>(open_transport(daq_addr));
+  // The driver is chosen from each instrument's *IDN? reply (drivers/registry.hpp).
+  b.awg = builtin_drivers().open_awg(open_transport(addr.awg));
+  b.daq = builtin_drivers().open_daq(open_transport(daq_addr));
   b.description = "AWG " + addr.awg + " [" + b.awg->identity() + "], DAQ " + daq_addr + " [" +
                   b.daq->identity() + "]";
   return b;

@@ -3,6 +3,9 @@
 // simulated bench ("sim"), SCPI over TCP, or USBTMC. The simulated bench is
 // an ordinary pair of drivers: the same keysight33500 / infiniium drivers
 // talk to simulated instruments through an in-process loopback transport.
+// Each driver is chosen from its instrument's *IDN? reply through the
+// driver registry (drivers/registry.hpp), so a Tektronix AWG5000/7000 (or
+// its simulated twin, `sim-instrument --dialect tektronix`) works at any address.
 #include <memory>
 #include <optional>
 #include <string>

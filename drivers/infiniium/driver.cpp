@@ -22,18 +22,25 @@ const char* input_of(Coupling c) {
     default: return "DC";
   }
 }
+// *IDN?: "KEYSIGHT TECHNOLOGIES,DSO9104A,serial,firmware"; the last row whose prefix fits.
+const Model* find_model(const std::string& idn) {
+  auto c1 = idn.find(',');
+  std::string model = c1 == std::string::npos ? "" : idn.substr(c1 + 1, idn.find(',', c1 + 1) - c1 - 1);
+  const Model* found = nullptr;
+  for (const auto& m : kModels)
+    if (model.starts_with(m.idn_prefix)) found = &m;
+  return found;
+}
 }  // namespace
+
+bool Driver::supports(const std::string& idn) { return find_model(idn) != nullptr; }
 
 Driver::Driver(std::unique_ptr<Transport> t) : scpi_(std::move(t)) {
   idn_ = scpi_.identify();
-  // *IDN?: "KEYSIGHT TECHNOLOGIES,DSO9104A,serial,firmware"
-  auto c1 = idn_.find(',');
-  std::string model = c1 == std::string::npos ? "" : idn_.substr(c1 + 1, idn_.find(',', c1 + 1) - c1 - 1);
-  for (const auto& m : kModels)
-    if (model.starts_with(m.idn_prefix)) {
-      max_rate_ = m.max_sample_rate_hz;
-      max_points_ = m.max_points;
-    }
+  if (const Model* m = find_model(idn_)) {
+    max_rate_ = m->max_sample_rate_hz;
+    max_points_ = m->max_points;
+  }
   if (max_points_ == 0)
     throw InstrumentError(scpi_.address() + ": '" + idn_ + "' is not a supported Infiniium oscilloscope");
   scpi_.write("*CLS");

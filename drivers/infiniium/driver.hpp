@@ -10,6 +10,8 @@ namespace piezo::drivers::infiniium {
 class Driver : public Daq {
  public:
   explicit Driver(std::unique_ptr<Transport> t);
+  // Whether an *IDN? reply names a supported model (for the driver registry).
+  static bool supports(const std::string& idn);
   std::string identity() const override { return idn_; }
   void configure(const DaqConfig& c) override;
   void arm() override;

@@ -14,15 +14,21 @@ std::string num(double v) {
   std::snprintf(buf, sizeof buf, "%.10g", v);
   return buf;
 }
+const Model* find_model(const std::string& idn) {
+  const Model* found = nullptr;
+  for (const auto& m : kModels)
+    if (idn.find(m.idn_model) != std::string::npos) found = &m;
+  return found;
+}
 }  // namespace
+
+bool Driver::supports(const std::string& idn) { return find_model(idn) != nullptr; }
 
 Driver::Driver(std::unique_ptr<Transport> t) : scpi_(std::move(t)) {
   idn_ = scpi_.identify();
-  for (const auto& m : kModels) {
-    if (idn_.find(m.idn_model) != std::string::npos) {
-      max_rate_ = m.max_sample_rate_hz;
-      max_points_ = m.max_arb_points;
-    }
+  if (const Model* m = find_model(idn_)) {
+    max_rate_ = m->max_sample_rate_hz;
+    max_points_ = m->max_arb_points;
   }
   if (max_points_ == 0)
     throw InstrumentError(scpi_.address() + ": '" + idn_ +

@@ -11,6 +11,8 @@ class Driver : public Awg {
  public:
   // Connects: *IDN? must name a supported model (the table in protocol.hpp).
   explicit Driver(std::unique_ptr<Transport> t);
+  // Whether an *IDN? reply names a supported model (for the driver registry).
+  static bool supports(const std::string& idn);
   std::string identity() const override { return idn_; }
   void load(const ArbWaveform& w) override;
   void output(bool on) override;

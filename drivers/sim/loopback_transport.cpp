@@ -6,6 +6,9 @@ namespace piezo::drivers::sim {
 
 void LoopbackTransport::send(std::span<const std::uint8_t> bytes) {
   if (closed_) throw TransportError(TransportError::Kind::Closed, name_ + ": instrument closed the connection");
+  // The instrument has dropped the link: the bytes go nowhere (a socket's
+  // first send after its peer closed succeeds too); the next read fails.
+  if (close_pending_) return;
   framer_.feed(bytes);
   while (auto msg = framer_.next()) {
     Reply r = dev_->handle(*msg);

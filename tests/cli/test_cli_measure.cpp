@@ -1,6 +1,8 @@
 // `piezobench measure` on the embedded simulated bench and through
 // `piezobench sim-instrument` over TCP: same SCPI drivers, same simulated
-// instruments, so the two captures must be equal sample for sample.
+// instruments, so the two captures must be equal sample for sample; and
+// over TCP with the AWG in the Tektronix dialect (its own driver, chosen
+// from *IDN?), equal to the embedded bench too.
 #include <gtest/gtest.h>
 #include <netinet/in.h>
 #include <signal.h>
@@ -9,6 +11,7 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <chrono>
 #include <filesystem>
 #include <nlohmann/json.hpp>
@@ -47,7 +50,6 @@ int free_port_pair() {  // two consecutive free ports (AWG, DAQ)
   }
   return 0;
 }
-}  // namespace
 
 TEST(CliMeasure, SeedLabMeasurementOnTheEmbeddedBench) {
   auto out = tmp_dir() / "lab.h5";
@@ -73,15 +75,19 @@ TEST(CliMeasure, BadEffectIsBadInput) {
   EXPECT_NE(r.err.find("bounds"), std::string::npos);
 }
 
-TEST(CliMeasure, SimInstrumentOverTcpEqualsInProcess) {
+// Serves the simulated bench with `sim-instrument` (AWG dialect `dialect`),
+// measures over TCP with the driver the AWG's *IDN? chooses, measures the same
+// plan on the embedded bench (Keysight twin, in-process), and compares.
+// Returns the TCP run's bench description (which names the AWG's *IDN?).
+std::string expect_tcp_equals_in_process(const char* dialect) {
   const int port = free_port_pair();
-  ASSERT_GT(port, 0);
+  EXPECT_GT(port, 0);
   std::string exe = PIEZO_CLI, p = std::to_string(port);
   const char* argv[] = {exe.c_str(), "sim-instrument", "--host", "127.0.0.1", "--port", p.c_str(),
                         "--seconds", "60", "--noise", "0.05", "--seed", "17",
-                        "--effect", "parallel_capacitance=100e-12", nullptr};
+                        "--effect", "parallel_capacitance=100e-12", "--dialect", dialect, nullptr};
   pid_t pid = 0;
-  ASSERT_EQ(posix_spawn(&pid, exe.c_str(), nullptr, nullptr, const_cast<char**>(argv), environ), 0);
+  EXPECT_EQ(posix_spawn(&pid, exe.c_str(), nullptr, nullptr, const_cast<char**>(argv), environ), 0);
   // Wait until both ports accept connections.
   for (int i = 0; i < 200; ++i) {
     int fd = ::socket(AF_INET, SOCK_STREAM, 0);
@@ -94,22 +100,48 @@ TEST(CliMeasure, SimInstrumentOverTcpEqualsInProcess) {
     if (up) break;
     std::this_thread::sleep_for(std::chrono::milliseconds(25));
   }
-  auto dir = tmp_dir();
+  auto dir = tmp_dir() / dialect;
+  fs::create_directories(dir);
   const std::string plan = " --samples 5000 --shots 2 --overwrite --out ";
-  auto tcp = test::run_cli("measure --instrument tcp://127.0.0.1:" + p + plan + (dir / "tcp.h5").string());
+  auto tcp = test::run_cli("measure --json --instrument tcp://127.0.0.1:" + p + plan + (dir / "tcp.h5").string());
   ::kill(pid, SIGTERM);
   int status = 0;
   ::waitpid(pid, &status, 0);
-  ASSERT_EQ(tcp.exit_code, 0) << tcp.err;
+  EXPECT_EQ(tcp.exit_code, 0) << tcp.err;
   auto local = test::run_cli("measure --instrument sim --noise 0.05 --seed 17 --effect parallel_capacitance=100e-12" +
                              plan + (dir / "local.h5").string());
-  ASSERT_EQ(local.exit_code, 0) << local.err;
+  EXPECT_EQ(local.exit_code, 0) << local.err;
+  if (tcp.exit_code != 0 || local.exit_code != 0) return {};
   auto a = acq::read_capture(dir / "tcp.h5");
   auto b = acq::read_capture(dir / "local.h5");
-  ASSERT_EQ(a.shots.size(), 2u);
-  ASSERT_EQ(b.shots.size(), 2u);
-  for (int k = 0; k < 2; ++k) {
-    EXPECT_EQ(a.shots[k].v1, b.shots[k].v1) << "shot " << k;
-    EXPECT_EQ(a.shots[k].v2, b.shots[k].v2) << "shot " << k;
+  EXPECT_EQ(a.shots.size(), 2u);
+  EXPECT_EQ(b.shots.size(), 2u);
+  for (std::size_t k = 0; k < std::min<std::size_t>({2, a.shots.size(), b.shots.size()}); ++k) {
+    EXPECT_EQ(a.shots[k].v1, b.shots[k].v1) << dialect << " shot " << k;
+    EXPECT_EQ(a.shots[k].v2, b.shots[k].v2) << dialect << " shot " << k;
   }
+  return nlohmann::json::parse(tcp.out)["bench"].get<std::string>();
+}
+}  // namespace
+
+TEST(CliMeasure, SimInstrumentOverTcpEqualsInProcess) {
+  const std::string bench = expect_tcp_equals_in_process("keysight");
+  EXPECT_NE(bench.find("33522B"), std::string::npos) << bench;
+}
+
+// Issue 20: the Tektronix AWG5000 driver, end to end over TCP against its
+// twin, records what the embedded (Keysight) bench records, sample for
+// sample: both twins hand the bench the same float32 samples (REAL format
+// and FORMat:BORDer SWAPped blocks alike) and the same EMF (Tektronix:
+// amplitude peak_v Vpp into 50 ohm, doubled at the high-impedance divider;
+// Keysight: 2 peak_v Vpp with OUTPut:LOAD INFinity).
+TEST(CliMeasure, TektronixTwinOverTcpEqualsInProcess) {
+  const std::string bench = expect_tcp_equals_in_process("tektronix");
+  EXPECT_NE(bench.find("TEKTRONIX,AWG5014C"), std::string::npos) << bench;
+}
+
+TEST(CliMeasure, UnknownDialectIsBadInput) {
+  auto r = test::run_cli("sim-instrument --dialect rigol --seconds 1");
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_NE(r.err.find("dialect"), std::string::npos) << r.err;
 }

@@ -1,7 +1,8 @@
 // `piezobench measure`: runs a measurement plan on a bench (embedded simulator,
 // SCPI over TCP, or USBTMC) and writes the capture shot by shot.
 // `piezobench sim-instrument`: serves the simulated AWG and DAQ over TCP
-// (AWG on PORT, DAQ on PORT+1), speaking the same SCPI dialects as the real ones.
+// (AWG on PORT, DAQ on PORT+1), speaking the same SCPI dialects as the real
+// ones; the AWG speaks Keysight 33500 (default) or Tektronix AWG5000 (--dialect).
 #include <csignal>
 #include <iostream>
 #include <thread>
@@ -11,6 +12,7 @@
 #include "acquisition/sim_setup.hpp"
 #include "drivers/sim/sim_awg.hpp"
 #include "drivers/sim/sim_daq.hpp"
+#include "drivers/sim/sim_tektronix_awg.hpp"
 #include "drivers/sim/tcp_server.hpp"
 #include "ui/cli/cli_common.hpp"
 
@@ -204,6 +206,7 @@ void register_measure_commands(CLI::App& app, Context& ctx) {
     int port = 5025;
     double r1 = 3140;
     double seconds = 0;  // 0 = until interrupted
+    std::string dialect = "keysight";
     SimOptions sim;
   };
   auto sa = std::make_shared<SimArgs>();
@@ -211,23 +214,32 @@ void register_measure_commands(CLI::App& app, Context& ctx) {
   s->add_option("--port", sa->port, "AWG port; the DAQ listens on PORT+1")->capture_default_str();
   s->add_option("--r1", sa->r1, "Nominal series resistor of the simulated bench (ohm)")->capture_default_str();
   s->add_option("--seconds", sa->seconds, "Stop after this long (0: until Ctrl-C)")->capture_default_str();
+  s->add_option("--dialect", sa->dialect,
+                "The AWG's SCPI dialect: keysight (33522B) or tektronix (AWG5014C); the DAQ is Infiniium")
+      ->check(CLI::IsMember({"keysight", "tektronix"}))
+      ->capture_default_str();
   add_sim_options(s, sa->sim);
   add_json_flag(s, ctx);
   s->callback([&ctx, sa] {
     ctx.exit_code = run_command(ctx, [&] {
       if (sa->port < 1 || sa->port > 65534) throw InputError("--port must be 1..65534");
       auto bench = acq::make_sim_bench(sim_spec(sa->sim, model::TubeGeometry{}), sa->r1);
-      drivers::sim::TcpServer awg(std::make_shared<drivers::sim::SimAwg>(bench), sa->host,
-                                  static_cast<std::uint16_t>(sa->port));
+      const bool tek = sa->dialect == "tektronix";
+      std::shared_ptr<drivers::sim::ScpiDevice> awg_dev;
+      if (tek) awg_dev = std::make_shared<drivers::sim::SimTektronixAwg>(bench);
+      else awg_dev = std::make_shared<drivers::sim::SimAwg>(bench);
+      const char* awg_name = tek ? "Tektronix AWG5014C" : "Keysight 33522B";
+      drivers::sim::TcpServer awg(awg_dev, sa->host, static_cast<std::uint16_t>(sa->port));
       drivers::sim::TcpServer daq(std::make_shared<drivers::sim::SimDaq>(bench), sa->host,
                                   static_cast<std::uint16_t>(sa->port + 1));
       awg.start();
       daq.start();
       std::signal(SIGINT, on_sigint);
       std::signal(SIGTERM, on_sigint);
-      if (ctx.json) print_json({{"awg_port", awg.port()}, {"daq_port", daq.port()}, {"host", sa->host}});
+      if (ctx.json)
+        print_json({{"awg_port", awg.port()}, {"daq_port", daq.port()}, {"host", sa->host}, {"awg_dialect", sa->dialect}});
       else
-        std::cout << "simulated bench: AWG (Keysight 33522B dialect) on " << sa->host << ":" << awg.port()
+        std::cout << "simulated bench: AWG (" << awg_name << " dialect) on " << sa->host << ":" << awg.port()
                   << ", DAQ (Infiniium dialect) on " << sa->host << ":" << daq.port() << std::endl;
       auto t0 = std::chrono::steady_clock::now();
       while (!g_cancel) {

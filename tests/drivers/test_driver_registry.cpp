@@ -1,0 +1,85 @@
+// The driver registry: register_builtin_drivers() lists the drivers, and the
+// driver for an address is chosen from the instrument's *IDN? reply.
+#include <gtest/gtest.h>
+
+#include "drivers/infiniium/driver.hpp"
+#include "drivers/keysight33500/driver.hpp"
+#include "drivers/registry.hpp"
+#include "drivers/scpi_client.hpp"
+#include "drivers/sim/loopback_transport.hpp"
+#include "drivers/sim/sim_awg.hpp"
+#include "drivers/sim/sim_daq.hpp"
+#include "drivers/sim/sim_tektronix_awg.hpp"
+#include "drivers/tektronix_awg/driver.hpp"
+#include "tests/support/rc_physics.hpp"
+
+using namespace piezo;
+using namespace piezo::drivers;
+
+namespace {
+
+std::shared_ptr<sim::SimBench> bench() {
+  return std::make_shared<sim::SimBench>(std::make_unique<test::RcPhysics>(3140.0, 2.1e-9),
+                                         sim::DaqImperfections{}, 1);
+}
+
+class Stranger : public sim::ScpiDevice {
+ protected:
+  std::string idn() const override { return "ACME,WAVEMAKER 9000,1,0"; }
+  bool command(const scpi::Command&, const scpi::ProgramMessage&, sim::Reply&) override {
+    return false;
+  }
+};
+
+std::unique_ptr<Transport> loop(std::shared_ptr<sim::ScpiDevice> d) {
+  return std::make_unique<sim::LoopbackTransport>(std::move(d), "loop://x");
+}
+
+TEST(DriverRegistry, BuiltinDriversAreListedByKey) {
+  const auto& r = builtin_drivers();
+  ASSERT_EQ(r.awgs().size(), 2u);
+  EXPECT_EQ(r.awgs()[0].key, "keysight33500");
+  EXPECT_EQ(r.awgs()[1].key, "tektronix_awg");
+  ASSERT_EQ(r.daqs().size(), 1u);
+  EXPECT_EQ(r.daqs()[0].key, "infiniium");
+}
+
+TEST(DriverRegistry, TheIdnReplyChoosesTheDriver) {
+  const auto& r = builtin_drivers();
+  auto b = bench();
+  auto tek = r.open_awg(loop(std::make_shared<sim::SimTektronixAwg>(b)));
+  EXPECT_NE(dynamic_cast<tektronix_awg::Driver*>(tek.get()), nullptr);
+  auto key = r.open_awg(loop(std::make_shared<sim::SimAwg>(b)));
+  EXPECT_NE(dynamic_cast<keysight33500::Driver*>(key.get()), nullptr);
+  auto daq = r.open_daq(loop(std::make_shared<sim::SimDaq>(b)));
+  EXPECT_NE(dynamic_cast<infiniium::Driver*>(daq.get()), nullptr);
+  auto by_key = r.open_awg("tektronix_awg", loop(std::make_shared<sim::SimTektronixAwg>(b)));
+  EXPECT_NE(dynamic_cast<tektronix_awg::Driver*>(by_key.get()), nullptr);
+  EXPECT_THROW(r.open_awg("no_such_driver", loop(std::make_shared<sim::SimAwg>(b))),
+               std::invalid_argument);
+}
+
+TEST(DriverRegistry, AnUnknownInstrumentIsNamedWithTheKnownDrivers) {
+  try {
+    builtin_drivers().open_awg(loop(std::make_shared<Stranger>()));
+    FAIL() << "opened a driver for an unknown instrument";
+  } catch (const InstrumentError& e) {
+    const std::string m = e.what();
+    EXPECT_NE(m.find("ACME,WAVEMAKER 9000"), std::string::npos) << m;
+    EXPECT_NE(m.find("keysight33500"), std::string::npos) << m;
+    EXPECT_NE(m.find("tektronix_awg"), std::string::npos) << m;
+  }
+  // A DAQ address answering as an AWG: no DAQ driver takes it.
+  EXPECT_THROW(builtin_drivers().open_daq(loop(std::make_shared<sim::SimTektronixAwg>(bench()))),
+               InstrumentError);
+}
+
+TEST(DriverRegistry, KeysMustBeUniqueAndEntriesComplete) {
+  DriverRegistry r;
+  register_builtin_drivers(r);
+  EXPECT_THROW(register_builtin_drivers(r), std::invalid_argument);  // every key again
+  EXPECT_THROW(r.add_awg({"", "nameless", [](const std::string&) { return true; }, nullptr}),
+               std::invalid_argument);
+}
+
+}  // namespace
