@@ -1,6 +1,5 @@
 #include "model/modal.hpp"
 
-#include <Spectra/MatOp/SparseSymMatProd.h>
 #include <Spectra/SymGEigsShiftSolver.h>
 
 #include <algorithm>
@@ -18,8 +17,8 @@ namespace {
 class CondensedShiftInvert {
  public:
   using Scalar = double;
-  CondensedShiftInvert(const CoupledFactor& f, int n_u, double sigma)
-      : f_(&f), n_u_(n_u), sigma_(sigma), rhs_(Eigen::VectorXd::Zero(f.size())) {}
+  CondensedShiftInvert(const CoupledFactor& f, int n_u, double sigma, std::span<const int> clamped)
+      : f_(&f), n_u_(n_u), sigma_(sigma), clamped_(clamped), rhs_(Eigen::VectorXd::Zero(f.size())) {}
   Eigen::Index rows() const { return n_u_; }
   Eigen::Index cols() const { return n_u_; }
   void set_shift(const Scalar& sigma) {
@@ -28,6 +27,7 @@ class CondensedShiftInvert {
   }
   void perform_op(const Scalar* x_in, Scalar* y_out) const {
     rhs_.head(n_u_) = Eigen::Map<const Eigen::VectorXd>(x_in, n_u_);
+    for (int d : clamped_) rhs_[d] = 0.0;  // the solve returns the rhs at a constrained DOF
     f_->solve(rhs_, sol_);
     Eigen::Map<Eigen::VectorXd>(y_out, n_u_) = sol_.head(n_u_);
   }
@@ -36,7 +36,40 @@ class CondensedShiftInvert {
   const CoupledFactor* f_;
   int n_u_;
   double sigma_;
+  std::span<const int> clamped_;
   mutable Eigen::VectorXd rhs_, sol_;
+};
+
+// B-product x ↦ M x for Spectra with M symmetric and stored with both
+// triangles (SplitSystem's pattern): column j of M is also its row j, so
+// y_j = M(:, j)·x is one gather per column. Spectra's SparseSymMatProd goes
+// through selfadjointView, which scatters into y and was a quarter of a port
+// model's time (perf, single-shot diagnosis bench).
+class SymmetricStoredProd {
+ public:
+  using Scalar = double;
+  explicit SymmetricStoredProd(const SpMat& m) : m_(&m) {}
+  Eigen::Index rows() const { return m_->rows(); }
+  Eigen::Index cols() const { return m_->cols(); }
+  void perform_op(const Scalar* x_in, Scalar* y_out) const {
+    const int* outer = m_->outerIndexPtr();
+    const int* inner = m_->innerIndexPtr();
+    const double* val = m_->valuePtr();
+    for (Eigen::Index j = 0; j < m_->cols(); ++j) {
+      double s = 0.0;
+      for (int p = outer[j]; p < outer[j + 1]; ++p) s += val[p] * x_in[inner[p]];
+      y_out[j] = s;
+    }
+  }
+  Eigen::MatrixXd operator*(const Eigen::Ref<const Eigen::MatrixXd>& x) const {
+    Eigen::MatrixXd y(rows(), x.cols());
+    for (Eigen::Index c = 0; c < x.cols(); ++c) perform_op(x.col(c).data(), y.col(c).data());
+    return y;
+  }
+  Scalar operator()(Eigen::Index i, Eigen::Index j) const { return m_->coeff(i, j); }
+
+ private:
+  const SpMat* m_;
 };
 
 }  // namespace
@@ -109,10 +142,15 @@ double ModalSolver::static_solve(const PiezoMaterialE& material, const SpMat& ma
   // The only zero-energy mode of the free tube is the rigid axial translation;
   // fixing one u_z removes it without loading the tube (the electric load is
   // self-equilibrated), so Q is that of the free tube.
-  const int fix[1] = {model_->dofs().u_z(0)};
+  const int fix_rigid[1] = {model_->dofs().u_z(0)};
+  const bool half = model_->extent() == TubeExtent::upper_half;  // no rigid mode: u_z = 0 at the mid-plane
+  const std::span<const int> fix = half ? std::span<const int>(model_->symmetry_plane_dofs())
+                                        : std::span<const int>(fix_rigid);
   Eigen::VectorXd x;
   const double c = factor_.charge_for_unit_voltage(weights(material), fix, &x);
-  if (u_static) {
+  if (u_static && half) {
+    *u_static = x.head(model_->n_u());
+  } else if (u_static) {
     Eigen::VectorXd u = x.head(model_->n_u());
     Eigen::VectorXd rigid = Eigen::VectorXd::Zero(model_->n_u());
     for (int n = 0; n < model_->mesh().num_nodes(); ++n) rigid[model_->dofs().u_z(n)] = 1.0;
@@ -139,14 +177,15 @@ ModalResult ModalSolver::solve(const PiezoMaterialE& material, Electrodes electr
   res.c_clamped = clamped_capacitance(material, &g);
 
   const double sigma = -std::pow(2.0 * M_PI * opt.shift_hz, 2);
-  if (!factor_.factorize(w, sigma, electrodes, {}, opt.end_mass_fraction)) {
+  const std::vector<int>& plane = model_->symmetry_plane_dofs();  // empty for the whole tube
+  if (!factor_.factorize(w, sigma, electrodes, plane, opt.end_mass_fraction)) {
     res.message = "singular shifted system";
     return res;
   }
-  CondensedShiftInvert op(factor_, nu, sigma);
-  Spectra::SparseSymMatProd<double> bop(m_uu);
+  CondensedShiftInvert op(factor_, nu, sigma, plane);
+  SymmetricStoredProd bop(m_uu);
   const int ncv = std::min<int>(nu, opt.ncv > 0 ? opt.ncv : std::max(2 * opt.n_modes + 1, opt.n_modes + 20));
-  Spectra::SymGEigsShiftSolver<CondensedShiftInvert, Spectra::SparseSymMatProd<double>,
+  Spectra::SymGEigsShiftSolver<CondensedShiftInvert, SymmetricStoredProd,
                                Spectra::GEigsMode::ShiftInvert>
       eigs(op, bop, opt.n_modes, ncv, sigma);
   eigs.init();
@@ -164,8 +203,10 @@ ModalResult ModalSolver::solve(const PiezoMaterialE& material, Electrodes electr
   std::iota(order.begin(), order.end(), 0);
   std::sort(order.begin(), order.end(), [&](int a, int b) { return lambda[a] < lambda[b]; });
 
-  SpMat k_uu = w[0] * model_->split().k_c[0];
-  for (int i = 1; i < 5; ++i) k_uu += w[i] * model_->split().k_c[i];
+  // κ_k = φᵀK_UUφ without assembling K_UU: the factorised matrix's U block is
+  // K_UU − σ·M(f), and φ is M(f)-normalised, so κ = [φ;0]ᵀA[φ;0] + σ.
+  const SpMat& a_shifted = factor_.matrix();
+  Eigen::VectorXd phi_full = Eigen::VectorXd::Zero(a_shifted.rows());
 
   res.shapes.resize(nu, static_cast<Eigen::Index>(order.size()));
   const double rigid_omega = 2.0 * M_PI * 1e-3 * opt.shift_hz;
@@ -181,13 +222,18 @@ ModalResult ModalSolver::solve(const PiezoMaterialE& material, Electrodes electr
     m.eigenvalue = lambda[order[j]];
     m.omega = std::sqrt(std::max(m.eigenvalue, 0.0));
     m.frequency_hz = m.omega / (2.0 * M_PI);
-    const Eigen::VectorXd sym = 0.5 * (phi + model_->mirror(phi));
-    m.symmetric_fraction = sym.dot(m_uu * sym);
+    if (plane.empty()) {
+      const Eigen::VectorXd sym = 0.5 * (phi + model_->mirror(phi));
+      m.symmetric_fraction = sym.dot(m_uu * sym);
+    } else {
+      m.symmetric_fraction = 1.0;  // the half with u_z = 0 on the mid-plane has only symmetric modes
+    }
     m.symmetry = m.symmetric_fraction > 0.99   ? Symmetry::symmetric
                  : m.symmetric_fraction < 0.01 ? Symmetry::antisymmetric
                                                : Symmetry::mixed;
     m.participation = g.dot(phi);
-    m.kappa = phi.dot(k_uu * phi);
+    phi_full.head(nu) = phi;
+    m.kappa = phi_full.dot(a_shifted * phi_full) + sigma;
     if (m.omega > rigid_omega)
       m.coupling = m.participation * m.participation / (m.omega * m.omega * res.c_clamped);
     const double threshold =
@@ -199,8 +245,36 @@ ModalResult ModalSolver::solve(const PiezoMaterialE& material, Electrodes electr
   return res;
 }
 
+ModalPortModel ModalSolver::half_port_model(const PiezoMaterialE& material, const ModalOptions& opt) {
+  ModalOptions ho = opt;
+  ho.n_modes = opt.n_modes / 2 + 1;
+  ho.ncv = opt.ncv > 0 ? std::max(ho.n_modes + 1, opt.ncv / 2) : 0;
+  ModalPortModel p = half_solver_->port_model(material, ho);
+  // Whole tube = two mirrored halves in parallel: every charge doubles, so C0,
+  // C_static and the residual static share double, and a mode normalised on
+  // the whole tube (φᵀMφ = 1 = 2·φ_halfᵀM_halfφ_half) has p² = 2·p_half²;
+  // ω and κ = φᵀK_UUφ/φᵀMφ are the half's.
+  p.c_clamped *= 2.0;
+  p.c_static *= 2.0;
+  p.c_residual *= 2.0;
+  for (auto& m : p.modes) m.participation *= std::sqrt(2.0);
+  return p;
+}
+
 ModalPortModel ModalSolver::port_model(const PiezoMaterialE& material, const ModalOptions& opt,
                                        ModalResult* sc_result) {
+  if (opt.mirror_symmetry && !sc_result && model_->extent() == TubeExtent::whole) {
+    if (!half_tried_) {
+      half_tried_ = true;
+      half_model_ = model_->upper_half();
+      if (half_model_) half_solver_ = std::make_unique<ModalSolver>(*half_model_);
+    }
+    if (half_solver_) {
+      validate(material, "ModalSolver::port_model");
+      opt.validate();
+      return half_port_model(material, opt);
+    }
+  }
   ModalResult sc = solve(material, Electrodes::short_circuit, opt);
   ModalPortModel p;
   p.converged = sc.converged;

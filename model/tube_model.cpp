@@ -7,13 +7,26 @@
 
 namespace piezo::model {
 
-TubeModel::TubeModel(const TubeGeometry& geometry, const MeshOptions& mesh, int gauss_points)
-    : geometry_(geometry) {
+TubeModel::TubeModel(const TubeGeometry& geometry, const MeshOptions& mesh, int gauss_points,
+                     TubeExtent extent)
+    : geometry_(geometry), gauss_points_(gauss_points), extent_(extent) {
   geometry_.validate();
   mesh_ = std::make_unique<TubeMesh>(geometry_, mesh);
   dofs_ = std::make_unique<DofMap>(*mesh_);
   system_ = SplitSystem(*mesh_, *dofs_, geometry_.density_kg_m3, gauss_points);
-  system_.set_end_mass(end_face_mass_triplets(*mesh_, *dofs_, geometry_));
+  auto end_mass = end_face_mass_triplets(*mesh_, *dofs_, geometry_);
+  if (extent_ == TubeExtent::upper_half) {
+    // The whole tube's top-face mass: its areal density ρL/2 per unit f is twice
+    // the half's own ρ(L/2)/2, and the mid-plane (bottom face) carries none.
+    const int top = mesh_->nodes_z() - 1;
+    std::vector<Eigen::Triplet<double>> kept;
+    for (const auto& t : end_mass)
+      if ((t.row() / 2) / mesh_->nodes_r() == top) kept.emplace_back(t.row(), t.col(), 2.0 * t.value());
+    end_mass = std::move(kept);
+    for (int ir = 0; ir < mesh_->nodes_r(); ++ir)
+      symmetry_plane_.push_back(dofs_->u_z(mesh_->node_index(ir, 0)));
+  }
+  system_.set_end_mass(end_mass);
   const int nu = dofs_->n_u(), np = dofs_->n_phi();
   split_.m = system_.mass().topLeftCorner(nu, nu);
   split_.m_end = system_.end_mass().topLeftCorner(nu, nu);
@@ -23,6 +36,18 @@ TubeModel::TubeModel(const TubeGeometry& geometry, const MeshOptions& mesh, int 
     split_.k_e[i] = system_.matrix(static_cast<MaterialParam>(5 + i)).block(0, nu, nu, np);
   for (int i = 0; i < 2; ++i)
     split_.k_eps[i] = system_.matrix(static_cast<MaterialParam>(8 + i)).bottomRightCorner(np, np);
+}
+
+std::unique_ptr<TubeModel> TubeModel::upper_half() const {
+  if (extent_ != TubeExtent::whole)
+    throw std::invalid_argument("TubeModel::upper_half: the model is already a half");
+  const MeshOptions& o = mesh_->options();
+  if (o.n_axial % 2 != 0) return nullptr;
+  MeshOptions half_mesh = o;
+  half_mesh.n_axial = o.n_axial / 2;
+  TubeGeometry half = geometry_;
+  half.length_m = 0.5 * geometry_.length_m;
+  return std::make_unique<TubeModel>(half, half_mesh, gauss_points_, TubeExtent::upper_half);
 }
 
 SpMat TubeModel::mass(double f) const {

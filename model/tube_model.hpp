@@ -8,6 +8,7 @@
 // outer electrode: Q = −(K_ΦU U + K_ΦΦ Φ)_V (eq. 72 with G = −Q on the electrode).
 #include <array>
 #include <memory>
+#include <vector>
 
 #include "model/assembler.hpp"
 #include "model/material.hpp"
@@ -32,10 +33,30 @@ struct AssembledMatrices {
   SpMat m, k_uu, k_uphi, k_phiphi;
 };
 
+// What the mesh covers. A tube symmetric about its mid-plane (geometry,
+// poling, electrodes and end-face masses alike) has its electrically active
+// modes among the symmetric ones (u_z odd in z): its upper half z ∈ [0, L/2]
+// with u_z = 0 on the mid-plane carries them exactly, on half the DOFs.
+//   whole       the tube, z ∈ [−L/2, L/2]
+//   upper_half  z ∈ [0, L/2]: mesh rows = the whole tube's upper rows (n_axial/2
+//               elements of the same size), the bottom face is the mid-plane
+//               (symmetry_plane_dofs(): its u_z, to be constrained by the
+//               solver), and the end-face mass sits on the top face only
+//               with the whole tube's areal density. geometry() is the
+//               half's (length L/2).
+enum class TubeExtent { whole, upper_half };
+
 class TubeModel {
  public:
   explicit TubeModel(const TubeGeometry& geometry, const MeshOptions& mesh = {},
-                     int gauss_points = 3);
+                     int gauss_points = 3, TubeExtent extent = TubeExtent::whole);
+
+  // The upper half of this (whole) tube, or nullptr when its mesh has an odd
+  // number of axial elements (no node row on the mid-plane).
+  std::unique_ptr<TubeModel> upper_half() const;
+  TubeExtent extent() const { return extent_; }
+  // u_z DOFs of the mid-plane (upper_half), empty for the whole tube.
+  const std::vector<int>& symmetry_plane_dofs() const { return symmetry_plane_; }
 
   const TubeGeometry& geometry() const { return geometry_; }
   const TubeMesh& mesh() const { return *mesh_; }
@@ -61,6 +82,9 @@ class TubeModel {
 
  private:
   TubeGeometry geometry_;
+  int gauss_points_ = 3;
+  TubeExtent extent_ = TubeExtent::whole;
+  std::vector<int> symmetry_plane_;
   std::unique_ptr<TubeMesh> mesh_;
   std::unique_ptr<DofMap> dofs_;
   SplitSystem system_;
