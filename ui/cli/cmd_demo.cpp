@@ -24,6 +24,7 @@ void register_demo_command(CLI::App& app, Context& ctx) {
     bool no_diagnose = false;
     std::string calibrate = "open,short,load";
     bool no_calibrate = false;
+    int shots = 16;
   };
   auto a = std::make_shared<Args>();
   demo->add_option("--out", a->out_dir, "Folder for the demo's files")->capture_default_str();
@@ -35,6 +36,11 @@ void register_demo_command(CLI::App& app, Context& ctx) {
                    "Fixture standards measured before the transducer (open,short,load; load 1000 ohm)")
       ->capture_default_str();
   demo->add_flag("--no-calibrate", a->no_calibrate, "No fixture standards (Cp and R1 error are then aliases)");
+  demo->add_option("--shots", a->shots,
+                   "Shots of the drive and of the held-out chirp (1 or 2: the one-shot path, the "
+                   "gap diagnosed in the output-error model as for most recorded captures)")
+      ->capture_default_str()
+      ->check(CLI::Range(1, 256));
   add_json_flag(demo, ctx);
   demo->callback([&ctx, a] {
     ctx.exit_code = run_command(ctx, [&] {
@@ -47,7 +53,7 @@ void register_demo_command(CLI::App& app, Context& ctx) {
       req.plan.setup.material = "apc850";
       req.plan.samples = 20000;
       req.plan.pretrigger_samples = 200;
-      req.plan.shots = 16;
+      req.plan.shots = a->shots;
       // The simulated "real" tube: the seed's Table 4/5 target material in the isotropic class.
       req.sim.material = "apc850";
       req.sim.isotropic = true;
