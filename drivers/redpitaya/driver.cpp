@@ -60,7 +60,8 @@ void Generator::load(const ArbWaveform& w) {
                                 num(b.dac_rate_hz) + "] (the DAC clock)");
   if (!(w.peak_v > 0 && w.peak_v <= b.max_output_v))
     throw std::invalid_argument(who + "peak voltage " + num(w.peak_v) + " V outside (0, " +
-                                num(b.max_output_v) + "] V (the output's range, high-impedance load)");
+                                num(b.max_output_v) +
+                                "] V (the output's range, high-impedance load)");
   std::vector<float> buffer(b.arb_points, 0.0f);  // the tail is the idle level
   for (std::size_t i = 0; i < w.samples.size(); ++i) {
     if (!(std::fabs(w.samples[i]) <= 1.0))
@@ -70,9 +71,9 @@ void Generator::load(const ArbWaveform& w) {
   const double freq = w.sample_rate_hz / static_cast<double>(b.arb_points);
   s_->configure("output off", std::string(kOutputOff));
   s_->configure("arbitrary function", std::string(kFuncArb));
-  s_->configure("upload the waveform (SOUR1:TRAC:DATA:DATA, " + std::to_string(b.arb_points) +
-                    " values)",
-                std::string(kArbData) + encode_arb_list(buffer));
+  s_->configure(
+      "upload the waveform (SOUR1:TRAC:DATA:DATA, " + std::to_string(b.arb_points) + " values)",
+      std::string(kArbData) + encode_arb_list(buffer));
   s_->configure("frequency (one period = the buffer)", std::string(kFrequency) + num(freq));
   s_->configure("amplitude", std::string(kAmplitude) + num(w.peak_v));
   s_->configure("offset", std::string(kOffset));
@@ -114,12 +115,14 @@ void Digitizer::configure(const DaqConfig& c) {
     g[ch] = gain_for_range(c.range_v[ch]);
     if (!g[ch])
       throw std::invalid_argument(who + "input " + std::to_string(ch + 1) + " range ±" +
-                                  num(c.range_v[ch]) + " V: the inputs offer ±1 V (LV) or ±20 V (HV)");
+                                  num(c.range_v[ch]) +
+                                  " V: the inputs offer ±1 V (LV) or ±20 V (HV)");
   }
   if (c.coupling != Coupling::Dc1M)
     throw std::invalid_argument(who + "the inputs are DC-coupled, 1 Mohm, only");
   if (!c.external_trigger)
-    throw std::invalid_argument(who + "the driver triggers on the generator (ACQ:TRig AWG_PE) only");
+    throw std::invalid_argument(who +
+                                "the driver triggers on the generator (ACQ:TRig AWG_PE) only");
 
   s_->configure("acquisition reset", std::string(kAcqReset));  // first: it resets the format too
   s_->configure("decimation " + std::to_string(rate->decimation),
@@ -127,10 +130,9 @@ void Digitizer::configure(const DaqConfig& c) {
   s_->configure("binary data", std::string(kFormatBin));
   s_->configure("data in volts", std::string(kUnitsVolts));
   for (int ch = 0; ch < 2; ++ch)
-    s_->configure("input " + std::to_string(ch + 1) + " gain",
-                  gain_command(ch + 1, g[ch]->name));
-  s_->configure("trigger delay",
-                std::string(kTriggerDelay) + std::to_string(trigger_delay_for(c.pretrigger_samples, b)));
+    s_->configure("input " + std::to_string(ch + 1) + " gain", gain_command(ch + 1, g[ch]->name));
+  s_->configure("trigger delay", std::string(kTriggerDelay) +
+                                     std::to_string(trigger_delay_for(c.pretrigger_samples, b)));
   cfg_ = c;
   rate_ = *rate;
   gain_[0] = g[0];
@@ -169,8 +171,7 @@ std::vector<double> Digitizer::read_input(int input) {
 
 DaqRecord Digitizer::fetch(double timeout_s) {
   if (!configured_) throw std::logic_error(kWho + "Digitizer::fetch: configure() and arm() first");
-  const auto deadline =
-      std::chrono::steady_clock::now() + std::chrono::duration<double>(timeout_s);
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::duration<double>(timeout_s);
   auto poll = [&](const char* what, std::string_view query, std::string_view done) {
     s_->step(what, [&] {
       for (;;) {
@@ -178,7 +179,8 @@ DaqRecord Digitizer::fetch(double timeout_s) {
         if (r == done) return;
         if (std::chrono::steady_clock::now() > deadline)
           throw InstrumentError(s_->scpi().address() + ": " + std::string(query) + " still '" + r +
-                                "' after " + num(timeout_s) + " s (no trigger from the generator?)");
+                                "' after " + num(timeout_s) +
+                                " s (no trigger from the generator?)");
         std::this_thread::sleep_for(std::chrono::milliseconds(2));
       }
     });

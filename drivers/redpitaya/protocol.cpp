@@ -97,7 +97,8 @@ std::vector<std::uint8_t> encode_float_block_payload(std::span<const float> valu
   return out;
 }
 
-std::optional<std::vector<float>> decode_float_block_payload(std::span<const std::uint8_t> payload) {
+std::optional<std::vector<float>> decode_float_block_payload(
+    std::span<const std::uint8_t> payload) {
   if (payload.size() % 4 != 0) return std::nullopt;
   std::vector<float> v(payload.size() / 4);
   for (std::size_t i = 0; i < v.size(); ++i) {

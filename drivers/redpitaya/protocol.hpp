@@ -24,12 +24,12 @@ namespace piezo::drivers::redpitaya {
 // SDRlab 122-16 answers the same and would be scaled as a 125-14.
 struct Board {
   std::string_view name;
-  double adc_rate_hz;         // undecimated ADC clock
+  double adc_rate_hz;          // undecimated ADC clock
   std::size_t buffer_samples;  // acquisition buffer per channel (ACQ:SOURn:DATA? returns all of it)
   int adc_bits;
-  std::size_t arb_points;     // generator buffer (SOUR1:TRAC:DATA:DATA)
-  double dac_rate_hz;         // the generator's clock: at most one buffer point per clock
-  double max_output_v;        // |amplitude| + |offset| into a high-impedance load
+  std::size_t arb_points;  // generator buffer (SOUR1:TRAC:DATA:DATA)
+  double dac_rate_hz;      // the generator's clock: at most one buffer point per clock
+  double max_output_v;     // |amplitude| + |offset| into a high-impedance load
 };
 inline constexpr Board kStemlab125_14 = {"STEMlab 125-14", 125e6, 16384, 14, 16384, 125e6, 1.0};
 
@@ -66,7 +66,6 @@ const Gain* gain_for_range(double range_v);
 long trigger_delay_for(std::size_t pretrigger, const Board& b = kStemlab125_14);
 
 // Command table (generator channel 1, inputs 1 and 2).
-inline constexpr std::string_view kGenReset = "GEN:RST";
 inline constexpr std::string_view kOutputOff = "OUTPUT1:STATE OFF";
 inline constexpr std::string_view kOutputOn = "OUTPUT1:STATE ON";
 inline constexpr std::string_view kFuncArb = "SOUR1:FUNC ARBITRARY";

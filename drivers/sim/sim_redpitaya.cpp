@@ -29,8 +29,9 @@ std::string first(const std::vector<std::string>& p) { return p.empty() ? "" : u
 SimRedPitaya::SimRedPitaya(std::shared_ptr<SimBench> bench) : bench_(std::move(bench)) {
   if (!bench_) throw std::invalid_argument("SimRedPitaya: null bench");
   if (bench_->imperfections().adc_bits != rp::kStemlab125_14.adc_bits)
-    throw std::invalid_argument("SimRedPitaya: the STEMlab 125-14 digitises with 14 bits, the bench with " +
-                                std::to_string(bench_->imperfections().adc_bits));
+    throw std::invalid_argument(
+        "SimRedPitaya: the STEMlab 125-14 digitises with 14 bits, the bench with " +
+        std::to_string(bench_->imperfections().adc_bits));
   std::lock_guard lock(bench_->mutex());
   apply_acquisition_settings();
 }
@@ -110,12 +111,15 @@ bool SimRedPitaya::generator(const scpi::Command& c, Reply& out) {
     gen_ = Gen{};
   } else if (match("OUTPUT#:STATe", c.header, &sfx)) {
     if (!channel_ok()) return true;
-    if (c.query) append(out, gen_.output_on ? "ON\r\n" : "OFF\r\n");
-    else gen_.output_on = first(c.params) == "ON" || first(c.params) == "1";
+    if (c.query)
+      append(out, gen_.output_on ? "ON\r\n" : "OFF\r\n");
+    else
+      gen_.output_on = first(c.params) == "ON" || first(c.params) == "1";
   } else if (match("SOURce#:FUNCtion", c.header, &sfx) && !c.query) {
     if (!channel_ok()) return true;
     gen_.arb_function = first(c.params) == "ARBITRARY";
-    if (!gen_.arb_function) push_error(-224, "Illegal parameter value; the simulator offers ARBITRARY only");
+    if (!gen_.arb_function)
+      push_error(-224, "Illegal parameter value; the simulator offers ARBITRARY only");
   } else if (match("SOURce#:TRACe:DATA:DATA", c.header, &sfx) && !c.query) {
     if (!channel_ok()) return true;
     auto values = rp::decode_arb_list(c.params, rp::kStemlab125_14.arb_points);
@@ -131,33 +135,42 @@ bool SimRedPitaya::generator(const scpi::Command& c, Reply& out) {
     gen_.arb = std::move(*values);
   } else if (match("SOURce#:FREQuency:FIX", c.header, &sfx) && !c.query) {
     if (!channel_ok()) return true;
-    if (!parse_one(c.params, &v) || v <= 0 || v > 62.5e6) push_error(-222, "Data out of range; frequency");
-    else gen_.freq_hz = v;
+    if (!parse_one(c.params, &v) || v <= 0 || v > 62.5e6)
+      push_error(-222, "Data out of range; frequency");
+    else
+      gen_.freq_hz = v;
   } else if (match("SOURce#:VOLTage:OFFSet", c.header, &sfx) && !c.query) {
     if (!channel_ok()) return true;
     if (!parse_one(c.params, &v) || std::fabs(v) + gen_.amplitude_v > 1.0)
       push_error(-222, "Data out of range; |amplitude| + |offset| must stay within 1 V");
-    else gen_.offset_v = v;
+    else
+      gen_.offset_v = v;
   } else if (match("SOURce#:VOLTage", c.header, &sfx) && !c.query) {
     if (!channel_ok()) return true;
     if (!parse_one(c.params, &v) || v < 0 || v + std::fabs(gen_.offset_v) > 1.0)
       push_error(-222, "Data out of range; |amplitude| + |offset| must stay within 1 V");
-    else gen_.amplitude_v = v;
+    else
+      gen_.amplitude_v = v;
   } else if (match("SOURce#:BURSt:STATe", c.header, &sfx) && !c.query) {
     if (!channel_ok()) return true;
     const std::string m = first(c.params);
-    if (m != "BURST" && m != "CONTINUOUS") push_error(-224, "Illegal parameter value; BURST|CONTINUOUS");
-    else gen_.burst = m == "BURST";
+    if (m != "BURST" && m != "CONTINUOUS")
+      push_error(-224, "Illegal parameter value; BURST|CONTINUOUS");
+    else
+      gen_.burst = m == "BURST";
   } else if ((match("SOURce#:BURSt:NCYCles", c.header, &sfx) ||
-              match("SOURce#:BURSt:NORepetitions", c.header, &sfx)) && !c.query) {
+              match("SOURce#:BURSt:NORepetitions", c.header, &sfx)) &&
+             !c.query) {
     if (!channel_ok()) return true;
     const bool ncyc = upper(c.header).find("NCYC") != std::string::npos;
     if (!parse_one(c.params, &v) || v < 1 || v > 50000 || v != std::floor(v))
       push_error(-222, "Data out of range; burst count");
-    else (ncyc ? gen_.cycles : gen_.repetitions) = static_cast<int>(v);
+    else
+      (ncyc ? gen_.cycles : gen_.repetitions) = static_cast<int>(v);
   } else if (match("SOURce#:TRig:SOURce", c.header, &sfx) && !c.query) {
     if (!channel_ok()) return true;
-    if (first(c.params) != "INT") push_error(-224, "Illegal parameter value; the simulator offers INT only");
+    if (first(c.params) != "INT")
+      push_error(-224, "Illegal parameter value; the simulator offers INT only");
   } else if (match("SOURce#:TRig:INT", c.header, &sfx) && !c.query) {
     if (!channel_ok()) return true;
     fire();
@@ -188,26 +201,35 @@ bool SimRedPitaya::acquisition(const scpi::Command& c, Reply& out) {
     bool known = false;
     if (parse_one(c.params, &v))
       for (unsigned d : rp::kDecimations) known = known || v == d;
-    if (!known) push_error(-222, "Data out of range; decimation 1, 8, 64, 1024, 8192 or 65536");
-    else acq_.decimation = static_cast<unsigned>(v);
+    if (!known)
+      push_error(-222, "Data out of range; decimation 1, 8, 64, 1024, 8192 or 65536");
+    else
+      acq_.decimation = static_cast<unsigned>(v);
   } else if (match("ACQ:DATA:FORMAT", c.header) && !c.query) {
     const std::string f = first(c.params);
-    if (f != "BIN" && f != "ASCII") push_error(-224, "Illegal parameter value; BIN|ASCII");
-    else acq_.binary = f == "BIN";
+    if (f != "BIN" && f != "ASCII")
+      push_error(-224, "Illegal parameter value; BIN|ASCII");
+    else
+      acq_.binary = f == "BIN";
   } else if (match("ACQ:DATA:UNITS", c.header) && !c.query) {
     const std::string u = first(c.params);
     if (u != "VOLTS") push_error(-224, "Illegal parameter value; the simulator serves VOLTS only");
   } else if (match("ACQ:SOUR#:GAIN", c.header, &sfx)) {
     if (!input_ok()) return true;
     bool& hv = acq_.high_gain[sfx[0] - 1];
-    if (c.query) append(out, hv ? "HV\r\n" : "LV\r\n");
-    else if (first(c.params) == "LV" || first(c.params) == "HV") hv = first(c.params) == "HV";
-    else push_error(-224, "Illegal parameter value; LV|HV");
+    if (c.query)
+      append(out, hv ? "HV\r\n" : "LV\r\n");
+    else if (first(c.params) == "LV" || first(c.params) == "HV")
+      hv = first(c.params) == "HV";
+    else
+      push_error(-224, "Illegal parameter value; LV|HV");
   } else if (match("ACQ:TRig:DLY", c.header)) {
-    if (c.query) append(out, std::to_string(acq_.delay) + "\r\n");
+    if (c.query)
+      append(out, std::to_string(acq_.delay) + "\r\n");
     else if (!parse_one(c.params, &v) || v != std::floor(v) || std::fabs(v) >= 8192)
       push_error(-222, "Data out of range; trigger delay (samples)");
-    else acq_.delay = static_cast<long>(v);
+    else
+      acq_.delay = static_cast<long>(v);
   } else if (match("ACQ:START", c.header) && !c.query) {
     acq_.started = true;
     acq_.armed = false;

@@ -95,7 +95,7 @@ TEST(RedPitayaProtocol, TheArbitraryListRoundTripsEveryFloat) {
   params.push_back(text.substr(at));
   auto back = rp::decode_arb_list(params, 16384);
   ASSERT_TRUE(back);
-  EXPECT_EQ(*back, v);  // bit-exact
+  EXPECT_EQ(*back, v);                              // bit-exact
   EXPECT_FALSE(rp::decode_arb_list(params, 2999));  // more than the buffer
   EXPECT_FALSE(rp::decode_arb_list(std::vector<std::string>{"0.5", "x"}, 16384));
   EXPECT_FALSE(rp::decode_arb_list(std::vector<std::string>{}, 16384));
@@ -121,7 +121,8 @@ struct Fault {
 
 class FaultyRp : public sim::SimRedPitaya {
  public:
-  FaultyRp(std::shared_ptr<sim::SimBench> b, Fault f) : SimRedPitaya(std::move(b)), f_(std::move(f)) {}
+  FaultyRp(std::shared_ptr<sim::SimBench> b, Fault f)
+      : SimRedPitaya(std::move(b)), f_(std::move(f)) {}
 
  protected:
   bool command(const scpi::Command& c, const scpi::ProgramMessage& msg, sim::Reply& out) override {
@@ -160,7 +161,8 @@ constexpr double kRate = 15.625e6;  // 125 MS/s / 8: a rate both paths sample at
 
 std::shared_ptr<sim::SimBench> bench(std::uint64_t seed, double noise = 0.03) {
   sim::DaqImperfections imp;
-  imp.noise_rel[0] = imp.noise_rel[1] = noise;  // seeded: equality also checks the RNG stays in step
+  imp.noise_rel[0] = imp.noise_rel[1] =
+      noise;  // seeded: equality also checks the RNG stays in step
   return std::make_shared<sim::SimBench>(std::make_unique<test::RcPhysics>(kR1, kC), imp, seed);
 }
 
@@ -340,7 +342,8 @@ TEST_P(RedPitayaDriver, AnInstrumentErrorNamesTheStepAndCarriesItsText) {
     gen.awg->load(seeded_waveform(1, 500));
     FAIL() << "load() survived the instrument's error";
   } catch (const InstrumentError& e) {
-    EXPECT_TRUE(contains(e.what(), "step 'upload the waveform (SOUR1:TRAC:DATA:DATA, 16384 values)'"))
+    EXPECT_TRUE(
+        contains(e.what(), "step 'upload the waveform (SOUR1:TRAC:DATA:DATA, 16384 values)'"))
         << e.what();
   }
 }
