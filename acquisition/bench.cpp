@@ -2,6 +2,7 @@
 
 #include "drivers/instrument_uri.hpp"
 #include "drivers/registry.hpp"
+#include "drivers/scpi_client.hpp"
 #include "drivers/sim/loopback_transport.hpp"
 #include "drivers/sim/sim_awg.hpp"
 #include "drivers/sim/sim_daq.hpp"
@@ -38,17 +39,26 @@ Bench open_bench(const BenchAddress& addr, std::shared_ptr<sim::SimBench> sim_be
     b.description = "embedded simulated bench (" + sim_bench->physics().description() + ")";
     return b;
   }
-  std::string daq_addr;
-  if (addr.daq) {
-    daq_addr = *addr.daq;
-  } else if (awg_uri.kind == InstrumentUri::Kind::Tcp) {
-    daq_addr = "tcp://" + awg_uri.host + ":" + std::to_string(awg_uri.port + 1);
-  } else {
+  // The driver is chosen from each instrument's *IDN? reply (drivers/registry.hpp).
+  // The first address may be an instrument with both roles (a Red Pitaya):
+  // then, without --daq, it is the whole bench.
+  const bool tcp = awg_uri.kind == InstrumentUri::Kind::Tcp;
+  if (!addr.daq && !tcp)
     throw std::invalid_argument("instrument address '" + addr.awg +
                                 "': a USBTMC bench needs the DAQ's address too (--daq)");
+  auto first = builtin_drivers().open_instrument(open_transport(addr.awg));
+  if (!first.awg)
+    throw InstrumentError(addr.awg + ": '" + first.daq->identity() +
+                          "' is a digitizer, not a generator; give the AWG's address to --instrument");
+  b.awg = std::move(first.awg);
+  if (first.daq && !addr.daq) {
+    b.daq = std::move(first.daq);
+    b.description = "AWG and DAQ " + addr.awg + " [" + b.awg->identity() + "] (one instrument, both roles)";
+    return b;
   }
-  // The driver is chosen from each instrument's *IDN? reply (drivers/registry.hpp).
-  b.awg = builtin_drivers().open_awg(open_transport(addr.awg));
+  const std::string daq_addr =
+      addr.daq ? *addr.daq : "tcp://" + awg_uri.host + ":" + std::to_string(awg_uri.port + 1);
+  // An explicit --daq wins over a dual-role instrument's own acquisition.
   b.daq = builtin_drivers().open_daq(open_transport(daq_addr));
   b.description = "AWG " + addr.awg + " [" + b.awg->identity() + "], DAQ " + daq_addr + " [" +
                   b.daq->identity() + "]";

@@ -6,6 +6,9 @@
 // Each driver is chosen from its instrument's *IDN? reply through the
 // driver registry (drivers/registry.hpp), so a Tektronix AWG5000/7000 (or
 // its simulated twin, `sim-instrument --dialect tektronix`) works at any address.
+// An instrument with both roles (a Red Pitaya STEMlab 125-14, or its twin,
+// `sim-instrument --dialect redpitaya`) is the whole bench at one address
+// when no --daq is given.
 #include <memory>
 #include <optional>
 #include <string>
@@ -19,7 +22,9 @@ namespace piezo::acq {
 
 struct BenchAddress {
   std::string awg = "sim";  // sim | tcp://HOST:PORT | usbtmc://VID:PID[/SERIAL]
-  std::optional<std::string> daq;  // default: tcp → PORT+1 on the same host; sim → sim
+  // default: the AWG's own acquisition if it has one (Red Pitaya), else tcp →
+  // PORT+1 on the same host; sim → sim
+  std::optional<std::string> daq;
 };
 
 struct Bench {

@@ -5,14 +5,15 @@
 
 #include "drivers/infiniium/driver.hpp"
 #include "drivers/keysight33500/driver.hpp"
+#include "drivers/redpitaya/driver.hpp"
 #include "drivers/scpi_client.hpp"
 #include "drivers/tektronix_awg/driver.hpp"
 
 namespace piezo::drivers {
 
 namespace {
-template <class Role>
-void add_entry(std::vector<DriverEntry<Role>>& v, DriverEntry<Role> e) {
+template <class Entry>
+void add_entry(std::vector<Entry>& v, Entry e) {
   if (e.key.empty() || !e.accepts || !e.open)
     throw std::invalid_argument("DriverRegistry: an entry needs a key, accepts() and open()");
   for (const auto& x : v)
@@ -21,34 +22,78 @@ void add_entry(std::vector<DriverEntry<Role>>& v, DriverEntry<Role> e) {
   v.push_back(std::move(e));
 }
 
-template <class Role>
-std::unique_ptr<Role> open_by_idn(const std::vector<DriverEntry<Role>>& v,
-                                  std::unique_ptr<Transport> t, const char* role) {
-  if (!t) throw std::invalid_argument("DriverRegistry: null transport");
-  const std::string idn = query_idn(*t);
-  for (const auto& e : v)
-    if (e.accepts(idn)) return e.open(std::move(t));
-  std::string known;
+template <class Entry>
+void list_keys(const std::vector<Entry>& v, std::string& known) {
   for (const auto& e : v) known += (known.empty() ? "" : ", ") + e.key + " (" + e.description + ")";
-  throw InstrumentError(t->address() + ": no " + role + " driver for '" + idn +
-                        "'; known: " + known);
 }
 }  // namespace
 
-void DriverRegistry::add_awg(DriverEntry<Awg> e) { add_entry(awgs_, std::move(e)); }
-void DriverRegistry::add_daq(DriverEntry<Daq> e) { add_entry(daqs_, std::move(e)); }
+void DriverRegistry::add_awg(DriverEntry<Awg> e) {
+  for (const auto& d : duals_)
+    if (d.key == e.key) throw std::invalid_argument("DriverRegistry: duplicate driver key '" + e.key + "'");
+  add_entry(awgs_, std::move(e));
+}
+void DriverRegistry::add_daq(DriverEntry<Daq> e) {
+  for (const auto& d : duals_)
+    if (d.key == e.key) throw std::invalid_argument("DriverRegistry: duplicate driver key '" + e.key + "'");
+  add_entry(daqs_, std::move(e));
+}
+void DriverRegistry::add_dual(DualRoleEntry e) {
+  for (const auto& a : awgs_)
+    if (a.key == e.key) throw std::invalid_argument("DriverRegistry: duplicate driver key '" + e.key + "'");
+  for (const auto& a : daqs_)
+    if (a.key == e.key) throw std::invalid_argument("DriverRegistry: duplicate driver key '" + e.key + "'");
+  add_entry(duals_, std::move(e));
+}
+
+InstrumentRoles DriverRegistry::open_instrument(std::unique_ptr<Transport> t) const {
+  if (!t) throw std::invalid_argument("DriverRegistry: null transport");
+  const std::string idn = query_idn(*t);
+  for (const auto& e : duals_)
+    if (e.accepts(idn)) return e.open(std::move(t));
+  for (const auto& e : awgs_)
+    if (e.accepts(idn)) return InstrumentRoles{e.open(std::move(t)), nullptr};
+  for (const auto& e : daqs_)
+    if (e.accepts(idn)) return InstrumentRoles{nullptr, e.open(std::move(t))};
+  std::string known;
+  list_keys(duals_, known);
+  list_keys(awgs_, known);
+  list_keys(daqs_, known);
+  throw InstrumentError(t->address() + ": no driver for '" + idn + "'; known: " + known);
+}
 
 std::unique_ptr<Awg> DriverRegistry::open_awg(std::unique_ptr<Transport> t) const {
-  return open_by_idn(awgs_, std::move(t), "AWG");
+  if (!t) throw std::invalid_argument("DriverRegistry: null transport");
+  const std::string idn = query_idn(*t);
+  for (const auto& e : awgs_)
+    if (e.accepts(idn)) return e.open(std::move(t));
+  for (const auto& e : duals_)
+    if (e.accepts(idn)) return e.open(std::move(t)).awg;
+  std::string known;
+  list_keys(awgs_, known);
+  list_keys(duals_, known);
+  throw InstrumentError(t->address() + ": no AWG driver for '" + idn + "'; known: " + known);
 }
+
 std::unique_ptr<Daq> DriverRegistry::open_daq(std::unique_ptr<Transport> t) const {
-  return open_by_idn(daqs_, std::move(t), "DAQ");
+  if (!t) throw std::invalid_argument("DriverRegistry: null transport");
+  const std::string idn = query_idn(*t);
+  for (const auto& e : daqs_)
+    if (e.accepts(idn)) return e.open(std::move(t));
+  for (const auto& e : duals_)
+    if (e.accepts(idn)) return e.open(std::move(t)).daq;
+  std::string known;
+  list_keys(daqs_, known);
+  list_keys(duals_, known);
+  throw InstrumentError(t->address() + ": no DAQ driver for '" + idn + "'; known: " + known);
 }
 
 std::unique_ptr<Awg> DriverRegistry::open_awg(const std::string& key,
                                               std::unique_ptr<Transport> t) const {
   for (const auto& e : awgs_)
     if (e.key == key) return e.open(std::move(t));
+  for (const auto& e : duals_)
+    if (e.key == key) return e.open(std::move(t)).awg;
   throw std::invalid_argument("DriverRegistry: no AWG driver '" + key + "'");
 }
 
@@ -67,6 +112,11 @@ void register_builtin_drivers(DriverRegistry& r) {
              [](std::unique_ptr<Transport> t) -> std::unique_ptr<Daq> {
                return std::make_unique<infiniium::Driver>(std::move(t));
              }});
+  r.add_dual({"redpitaya", "Red Pitaya STEMlab 125-14 (generator and acquisition, one address)",
+              redpitaya::supports, [](std::unique_ptr<Transport> t) {
+                auto roles = redpitaya::open(std::move(t));
+                return InstrumentRoles{std::move(roles.awg), std::move(roles.daq)};
+              }});
 }
 
 const DriverRegistry& builtin_drivers() {

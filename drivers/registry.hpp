@@ -3,7 +3,9 @@
 // per role. register_builtin_drivers() is the one place that lists the
 // drivers compiled in; open_awg()/open_daq() ask the instrument's *IDN? and
 // open the driver whose model table accepts the reply, so one address works
-// whatever the make of the instrument behind it.
+// whatever the make of the instrument behind it. An instrument that is both
+// the AWG and the DAQ (the Red Pitaya) has a dual-role entry: one address,
+// one connection, both roles.
 #include <functional>
 #include <memory>
 #include <string>
@@ -23,18 +25,38 @@ struct DriverEntry {
   std::function<std::unique_ptr<Role>(std::unique_ptr<Transport>)> open;
 };
 
+// Both roles of one instrument (one connection shared by the two).
+struct InstrumentRoles {
+  std::unique_ptr<Awg> awg;  // null if the instrument is not a generator
+  std::unique_ptr<Daq> daq;  // null if it is not a digitizer
+};
+
+struct DualRoleEntry {
+  std::string key;          // "redpitaya"
+  std::string description;  // "Red Pitaya STEMlab 125-14 (generator and acquisition)"
+  std::function<bool(const std::string& idn)> accepts;
+  std::function<InstrumentRoles(std::unique_ptr<Transport>)> open;  // both set
+};
+
 class DriverRegistry {
  public:
   // Throws std::invalid_argument on an empty or duplicate key, or a missing function.
   void add_awg(DriverEntry<Awg> e);
   void add_daq(DriverEntry<Daq> e);
+  void add_dual(DualRoleEntry e);
   const std::vector<DriverEntry<Awg>>& awgs() const { return awgs_; }
   const std::vector<DriverEntry<Daq>>& daqs() const { return daqs_; }
+  const std::vector<DualRoleEntry>& duals() const { return duals_; }
 
-  // Asks *IDN? and opens the first driver that accepts the reply; throws
-  // InstrumentError naming the reply and the known drivers if none does.
+  // Asks *IDN? and opens the first driver that accepts the reply (the
+  // role's own entries first, then the dual-role ones, of which only that
+  // role is kept); throws InstrumentError naming the reply and the known
+  // drivers if none does.
   std::unique_ptr<Awg> open_awg(std::unique_ptr<Transport> t) const;
   std::unique_ptr<Daq> open_daq(std::unique_ptr<Transport> t) const;
+  // Asks *IDN? once and opens whatever the instrument is: both roles for a
+  // dual-role entry, else the AWG, else the DAQ that accepts the reply.
+  InstrumentRoles open_instrument(std::unique_ptr<Transport> t) const;
   // The driver of that key (no *IDN? match needed); throws std::invalid_argument for an unknown
   // key.
   std::unique_ptr<Awg> open_awg(const std::string& key, std::unique_ptr<Transport> t) const;
@@ -42,9 +64,10 @@ class DriverRegistry {
  private:
   std::vector<DriverEntry<Awg>> awgs_;
   std::vector<DriverEntry<Daq>> daqs_;
+  std::vector<DualRoleEntry> duals_;
 };
 
-// AWGs: keysight33500, tektronix_awg. DAQs: infiniium.
+// AWGs: keysight33500, tektronix_awg. DAQs: infiniium. Both: redpitaya.
 void register_builtin_drivers(DriverRegistry& r);
 
 // The registry filled by register_builtin_drivers() (built once, never changed).

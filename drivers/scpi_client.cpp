@@ -112,15 +112,24 @@ std::vector<std::uint8_t> ScpiClient::query_block(const std::string& cmd) {
                                        "a partial read of " + std::to_string(h->payload_len) +
                                        " bytes expected)");
   }
-  // Consume the message terminator that follows the block, if it is there already.
-  if (!pending_.empty() && pending_.front() == '\n') pending_.erase(pending_.begin());
-  else if (pending_.empty() && !pending_eom_) {
+  // Consume the message terminator that follows the block: "\n", or "\r\n"
+  // (Red Pitaya's server ends every reply so).
+  auto take = [&](std::uint8_t want) {
+    if (!pending_.empty()) {
+      if (pending_.front() != want) return false;
+      pending_.erase(pending_.begin());
+      return true;
+    }
+    if (pending_eom_) return false;
     // Byte stream: the terminator is still on its way; read it.
     std::uint8_t c = 0;
     bool eom = false;
     std::size_t n = read_some(&c, 1, &eom);
-    if (n == 1 && c != '\n') pending_.insert(pending_.begin(), c);
-  }
+    if (n == 1 && c != want) pending_.insert(pending_.begin(), c);
+    return n == 1 && c == want;
+  };
+  if (take('\r')) take('\n');
+  else take('\n');
   return payload;
 }
 

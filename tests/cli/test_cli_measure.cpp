@@ -2,7 +2,8 @@
 // `piezobench sim-instrument` over TCP: same SCPI drivers, same simulated
 // instruments, so the two captures must be equal sample for sample; and
 // over TCP with the AWG in the Tektronix dialect (its own driver, chosen
-// from *IDN?), equal to the embedded bench too.
+// from *IDN?), equal to the embedded bench too; and a Red Pitaya twin at
+// one address (both roles, no --daq), equal for a plan it can follow.
 #include <gtest/gtest.h>
 #include <netinet/in.h>
 #include <signal.h>
@@ -79,7 +80,11 @@ TEST(CliMeasure, BadEffectIsBadInput) {
 // measures over TCP with the driver the AWG's *IDN? chooses, measures the same
 // plan on the embedded bench (Keysight twin, in-process), and compares.
 // Returns the TCP run's bench description (which names the AWG's *IDN?).
-std::string expect_tcp_equals_in_process(const char* dialect) {
+// `plan` is the measurement plan's options; the instrument is up when `up_port`
+// (PORT + up_offset: the DAQ's port, or the one port of a Red Pitaya) accepts.
+std::string expect_tcp_equals_in_process(const char* dialect,
+                                         const std::string& plan = " --samples 5000 --shots 2",
+                                         int up_offset = 1) {
   const int port = free_port_pair();
   EXPECT_GT(port, 0);
   std::string exe = PIEZO_CLI, p = std::to_string(port);
@@ -94,7 +99,7 @@ std::string expect_tcp_equals_in_process(const char* dialect) {
     sockaddr_in a{};
     a.sin_family = AF_INET;
     a.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
-    a.sin_port = htons(static_cast<uint16_t>(port + 1));
+    a.sin_port = htons(static_cast<uint16_t>(port + up_offset));
     bool up = ::connect(fd, reinterpret_cast<sockaddr*>(&a), sizeof a) == 0;
     ::close(fd);
     if (up) break;
@@ -102,14 +107,14 @@ std::string expect_tcp_equals_in_process(const char* dialect) {
   }
   auto dir = tmp_dir() / dialect;
   fs::create_directories(dir);
-  const std::string plan = " --samples 5000 --shots 2 --overwrite --out ";
-  auto tcp = test::run_cli("measure --json --instrument tcp://127.0.0.1:" + p + plan + (dir / "tcp.h5").string());
+  const std::string out = plan + " --overwrite --out ";
+  auto tcp = test::run_cli("measure --json --instrument tcp://127.0.0.1:" + p + out + (dir / "tcp.h5").string());
   ::kill(pid, SIGTERM);
   int status = 0;
   ::waitpid(pid, &status, 0);
   EXPECT_EQ(tcp.exit_code, 0) << tcp.err;
   auto local = test::run_cli("measure --instrument sim --noise 0.05 --seed 17 --effect parallel_capacitance=100e-12" +
-                             plan + (dir / "local.h5").string());
+                             out + (dir / "local.h5").string());
   EXPECT_EQ(local.exit_code, 0) << local.err;
   if (tcp.exit_code != 0 || local.exit_code != 0) return {};
   auto a = acq::read_capture(dir / "tcp.h5");
@@ -117,6 +122,8 @@ std::string expect_tcp_equals_in_process(const char* dialect) {
   EXPECT_EQ(a.shots.size(), 2u);
   EXPECT_EQ(b.shots.size(), 2u);
   for (std::size_t k = 0; k < std::min<std::size_t>({2, a.shots.size(), b.shots.size()}); ++k) {
+    EXPECT_EQ(a.shots[k].sample_rate_hz, b.shots[k].sample_rate_hz) << dialect << " shot " << k;
+    EXPECT_EQ(a.shots[k].v1.size(), b.shots[k].v1.size()) << dialect << " shot " << k;
     EXPECT_EQ(a.shots[k].v1, b.shots[k].v1) << dialect << " shot " << k;
     EXPECT_EQ(a.shots[k].v2, b.shots[k].v2) << dialect << " shot " << k;
   }
@@ -138,6 +145,56 @@ TEST(CliMeasure, SimInstrumentOverTcpEqualsInProcess) {
 TEST(CliMeasure, TektronixTwinOverTcpEqualsInProcess) {
   const std::string bench = expect_tcp_equals_in_process("tektronix");
   EXPECT_NE(bench.find("TEKTRONIX,AWG5014C"), std::string::npos) << bench;
+}
+
+// Issue 20: the Red Pitaya STEMlab 125-14 twin at ONE address: `measure
+// --instrument tcp://127.0.0.1:PORT` with no --daq runs the redpitaya driver
+// for both roles. The plan is one both benches follow exactly: the whole
+// 16384-sample buffer (the twin always records all of it; a shorter record
+// is its start, but the simulator scales its noise by the whole record's
+// std, so only whole-buffer shots draw the same noise), 15.625 MS/s (125
+// MS/s / 8, so no rate is rounded up) and a ±1 V range (LV: 2^-13 V steps
+// in 14 bits, the embedded Infiniium's step at 2 V full scale; float32 volts
+// carry them exactly). Then the captures are equal sample for sample.
+TEST(CliMeasure, RedPitayaTwinAtOneAddressEqualsInProcess) {
+  const std::string bench = expect_tcp_equals_in_process(
+      "redpitaya", " --samples 16384 --pretrigger 200 --rate 15.625e6 --range 1 --amplitude 0.8 --shots 2",
+      0);
+  EXPECT_NE(bench.find("REDPITAYA,INSTR2020"), std::string::npos) << bench;
+  EXPECT_NE(bench.find("one instrument, both roles"), std::string::npos) << bench;
+}
+
+// The default plan's 20000 samples exceed the board's buffers: clear errors naming the limit.
+TEST(CliMeasure, RedPitayaRefusesMoreSamplesThanItsBuffer) {
+  const int port = free_port_pair();
+  ASSERT_GT(port, 0);
+  std::string exe = PIEZO_CLI, p = std::to_string(port);
+  const char* argv[] = {exe.c_str(), "sim-instrument", "--host", "127.0.0.1", "--port", p.c_str(),
+                        "--seconds", "60", "--dialect", "redpitaya", nullptr};
+  pid_t pid = 0;
+  ASSERT_EQ(posix_spawn(&pid, exe.c_str(), nullptr, nullptr, const_cast<char**>(argv), environ), 0);
+  test::CliResult r;
+  for (int i = 0; i < 200; ++i) {  // until the port accepts
+    r = test::run_cli("measure --instrument tcp://127.0.0.1:" + p + " --amplitude 0.5 --overwrite --out " +
+                      (tmp_dir() / "rp-too-long.h5").string());
+    if (r.err.find("connect") == std::string::npos) break;
+    std::this_thread::sleep_for(std::chrono::milliseconds(25));
+  }
+  // The runner loads the generator first: its 19800 points (after the
+  // pretrigger) exceed the generator's buffer of the same size.
+  EXPECT_NE(r.exit_code, 0);
+  EXPECT_NE(r.err.find("19800 points (1..16384: the STEMlab 125-14's generator buffer)"), std::string::npos)
+      << r.err;
+  // A waveform that fits, a record that does not: the acquisition's limit.
+  r = test::run_cli("measure --instrument tcp://127.0.0.1:" + p +
+                    " --amplitude 0.5 --pretrigger 10000 --overwrite --out " + (tmp_dir() / "rp-too-long.h5").string());
+  ::kill(pid, SIGTERM);
+  int status = 0;
+  ::waitpid(pid, &status, 0);
+  EXPECT_NE(r.exit_code, 0);
+  EXPECT_NE(r.err.find("record length 20000 samples: the STEMlab 125-14 holds at most 16384 samples per channel"),
+            std::string::npos)
+      << r.err;
 }
 
 TEST(CliMeasure, UnknownDialectIsBadInput) {

@@ -4,11 +4,13 @@
 
 #include "drivers/infiniium/driver.hpp"
 #include "drivers/keysight33500/driver.hpp"
+#include "drivers/redpitaya/driver.hpp"
 #include "drivers/registry.hpp"
 #include "drivers/scpi_client.hpp"
 #include "drivers/sim/loopback_transport.hpp"
 #include "drivers/sim/sim_awg.hpp"
 #include "drivers/sim/sim_daq.hpp"
+#include "drivers/sim/sim_redpitaya.hpp"
 #include "drivers/sim/sim_tektronix_awg.hpp"
 #include "drivers/tektronix_awg/driver.hpp"
 #include "tests/support/rc_physics.hpp"
@@ -42,6 +44,39 @@ TEST(DriverRegistry, BuiltinDriversAreListedByKey) {
   EXPECT_EQ(r.awgs()[1].key, "tektronix_awg");
   ASSERT_EQ(r.daqs().size(), 1u);
   EXPECT_EQ(r.daqs()[0].key, "infiniium");
+  ASSERT_EQ(r.duals().size(), 1u);
+  EXPECT_EQ(r.duals()[0].key, "redpitaya");
+}
+
+// Issue 20: one address, both roles. open_instrument() asks *IDN? once and
+// hands back both roles of a Red Pitaya over the one connection; an AWG-only
+// or DAQ-only instrument fills its own role alone (the Keysight + Infiniium
+// pairing is unchanged); open_awg()/open_daq() take one role of a dual.
+TEST(DriverRegistry, ADualRoleInstrumentOpensAsBothRoles) {
+  const auto& r = builtin_drivers();
+  auto b = bench();
+  auto both = r.open_instrument(loop(std::make_shared<sim::SimRedPitaya>(b)));
+  EXPECT_NE(dynamic_cast<redpitaya::Generator*>(both.awg.get()), nullptr);
+  EXPECT_NE(dynamic_cast<redpitaya::Digitizer*>(both.daq.get()), nullptr);
+  EXPECT_EQ(both.awg->identity(), both.daq->identity());
+  auto awg_only = r.open_instrument(loop(std::make_shared<sim::SimAwg>(b)));
+  EXPECT_NE(dynamic_cast<keysight33500::Driver*>(awg_only.awg.get()), nullptr);
+  EXPECT_EQ(awg_only.daq, nullptr);
+  auto daq_only = r.open_instrument(loop(std::make_shared<sim::SimDaq>(b)));
+  EXPECT_EQ(daq_only.awg, nullptr);
+  EXPECT_NE(dynamic_cast<infiniium::Driver*>(daq_only.daq.get()), nullptr);
+  EXPECT_NE(dynamic_cast<redpitaya::Generator*>(
+                r.open_awg(loop(std::make_shared<sim::SimRedPitaya>(b))).get()),
+            nullptr);
+  EXPECT_NE(dynamic_cast<redpitaya::Digitizer*>(
+                r.open_daq(loop(std::make_shared<sim::SimRedPitaya>(b))).get()),
+            nullptr);
+  try {
+    r.open_instrument(loop(std::make_shared<Stranger>()));
+    FAIL() << "opened an unknown instrument";
+  } catch (const InstrumentError& e) {
+    EXPECT_NE(std::string(e.what()).find("redpitaya"), std::string::npos) << e.what();
+  }
 }
 
 TEST(DriverRegistry, TheIdnReplyChoosesTheDriver) {
@@ -79,6 +114,10 @@ TEST(DriverRegistry, KeysMustBeUniqueAndEntriesComplete) {
   register_builtin_drivers(r);
   EXPECT_THROW(register_builtin_drivers(r), std::invalid_argument);  // every key again
   EXPECT_THROW(r.add_awg({"", "nameless", [](const std::string&) { return true; }, nullptr}),
+               std::invalid_argument);
+  // A dual-role key is unique across the roles too.
+  EXPECT_THROW(r.add_awg({"redpitaya", "again", [](const std::string&) { return true; },
+                          [](std::unique_ptr<Transport>) -> std::unique_ptr<Awg> { return nullptr; }}),
                std::invalid_argument);
 }
 

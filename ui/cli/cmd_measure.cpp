@@ -2,16 +2,21 @@
 // SCPI over TCP, or USBTMC) and writes the capture shot by shot.
 // `piezobench sim-instrument`: serves the simulated AWG and DAQ over TCP
 // (AWG on PORT, DAQ on PORT+1), speaking the same SCPI dialects as the real
-// ones; the AWG speaks Keysight 33500 (default) or Tektronix AWG5000 (--dialect).
+// ones; the AWG speaks Keysight 33500 (default) or Tektronix AWG5000 (--dialect);
+// --dialect redpitaya serves one Red Pitaya STEMlab 125-14 on PORT alone
+// (generator and acquisition on one SCPI server, as on the board's port 5000).
 #include <csignal>
 #include <iostream>
+#include <memory>
 #include <thread>
+#include <vector>
 
 #include "acquisition/calibration_plan.hpp"
 #include "acquisition/runner.hpp"
 #include "acquisition/sim_setup.hpp"
 #include "drivers/sim/sim_awg.hpp"
 #include "drivers/sim/sim_daq.hpp"
+#include "drivers/sim/sim_redpitaya.hpp"
 #include "drivers/sim/sim_tektronix_awg.hpp"
 #include "drivers/sim/tcp_server.hpp"
 #include "ui/cli/cli_common.hpp"
@@ -91,7 +96,9 @@ void register_measure_commands(CLI::App& app, Context& ctx) {
   auto a = std::make_shared<MeasureArgs>();
   m->add_option("--instrument", a->instrument, "sim | tcp://HOST:PORT | usbtmc://VID:PID[/SERIAL] (the AWG)")
       ->capture_default_str();
-  m->add_option("--daq", a->daq, "DAQ address (default: tcp PORT+1 on the same host)");
+  m->add_option("--daq", a->daq,
+                "DAQ address (default: the instrument itself if it has both roles, e.g. a Red Pitaya; "
+                "else tcp PORT+1 on the same host)");
   auto* plan_opt = m->add_option("--plan", a->plan_file, "TOML measurement plan");
   m->add_option("--excitation", a->excitation, "exp_decay | sine | chirp | noise")->capture_default_str();
   m->add_option("--amplitude", a->amplitude, "Peak drive (V)")->capture_default_str();
@@ -200,7 +207,7 @@ void register_measure_commands(CLI::App& app, Context& ctx) {
 
   // --------------------------------------------------------- sim-instrument
   auto* s = app.add_subcommand("sim-instrument",
-                               "Serve the simulated AWG (PORT) and DAQ (PORT+1) over TCP (SCPI; the simulator-only SIM:DUT TUBE|OPEN|SHORT|LOAD,<ohm>[,<F>] on the AWG port swaps the device for calibration standards)");
+                               "Serve the simulated AWG (PORT) and DAQ (PORT+1) over TCP, or with --dialect redpitaya one instrument with both roles on PORT (SCPI; the simulator-only SIM:DUT TUBE|OPEN|SHORT|LOAD,<ohm>[,<F>] on the AWG port swaps the device for calibration standards)");
   struct SimArgs {
     std::string host = "127.0.0.1";
     int port = 5025;
@@ -215,8 +222,9 @@ void register_measure_commands(CLI::App& app, Context& ctx) {
   s->add_option("--r1", sa->r1, "Nominal series resistor of the simulated bench (ohm)")->capture_default_str();
   s->add_option("--seconds", sa->seconds, "Stop after this long (0: until Ctrl-C)")->capture_default_str();
   s->add_option("--dialect", sa->dialect,
-                "The AWG's SCPI dialect: keysight (33522B) or tektronix (AWG5014C); the DAQ is Infiniium")
-      ->check(CLI::IsMember({"keysight", "tektronix"}))
+                "The AWG's SCPI dialect: keysight (33522B) or tektronix (AWG5014C), the DAQ being Infiniium "
+                "on PORT+1; or redpitaya (STEMlab 125-14: both roles on PORT alone)")
+      ->check(CLI::IsMember({"keysight", "tektronix", "redpitaya"}))
       ->capture_default_str();
   add_sim_options(s, sa->sim);
   add_json_flag(s, ctx);
@@ -224,23 +232,43 @@ void register_measure_commands(CLI::App& app, Context& ctx) {
     ctx.exit_code = run_command(ctx, [&] {
       if (sa->port < 1 || sa->port > 65534) throw InputError("--port must be 1..65534");
       auto bench = acq::make_sim_bench(sim_spec(sa->sim, model::TubeGeometry{}), sa->r1);
-      const bool tek = sa->dialect == "tektronix";
-      std::shared_ptr<drivers::sim::ScpiDevice> awg_dev;
-      if (tek) awg_dev = std::make_shared<drivers::sim::SimTektronixAwg>(bench);
-      else awg_dev = std::make_shared<drivers::sim::SimAwg>(bench);
-      const char* awg_name = tek ? "Tektronix AWG5014C" : "Keysight 33522B";
-      drivers::sim::TcpServer awg(awg_dev, sa->host, static_cast<std::uint16_t>(sa->port));
-      drivers::sim::TcpServer daq(std::make_shared<drivers::sim::SimDaq>(bench), sa->host,
-                                  static_cast<std::uint16_t>(sa->port + 1));
-      awg.start();
-      daq.start();
       std::signal(SIGINT, on_sigint);
       std::signal(SIGTERM, on_sigint);
-      if (ctx.json)
-        print_json({{"awg_port", awg.port()}, {"daq_port", daq.port()}, {"host", sa->host}, {"awg_dialect", sa->dialect}});
-      else
-        std::cout << "simulated bench: AWG (" << awg_name << " dialect) on " << sa->host << ":" << awg.port()
-                  << ", DAQ (Infiniium dialect) on " << sa->host << ":" << daq.port() << std::endl;
+      const auto port = static_cast<std::uint16_t>(sa->port);
+      std::vector<std::unique_ptr<drivers::sim::TcpServer>> servers;
+      if (sa->dialect == "redpitaya") {  // one instrument, both roles, one port
+        std::shared_ptr<drivers::sim::ScpiDevice> dev;
+        try {
+          dev = std::make_shared<drivers::sim::SimRedPitaya>(bench);
+        } catch (const std::invalid_argument& e) {
+          throw InputError(std::string(e.what()) + " (--adc-bits)");
+        }
+        servers.push_back(std::make_unique<drivers::sim::TcpServer>(dev, sa->host, port));
+        servers.back()->start();
+        if (ctx.json)
+          print_json({{"port", servers[0]->port()}, {"awg_port", servers[0]->port()},
+                      {"daq_port", servers[0]->port()}, {"host", sa->host}, {"awg_dialect", sa->dialect}});
+        else
+          std::cout << "simulated bench: Red Pitaya STEMlab 125-14 (generator and acquisition) on "
+                    << sa->host << ":" << servers[0]->port() << std::endl;
+      } else {
+        const bool tek = sa->dialect == "tektronix";
+        std::shared_ptr<drivers::sim::ScpiDevice> awg_dev;
+        if (tek) awg_dev = std::make_shared<drivers::sim::SimTektronixAwg>(bench);
+        else awg_dev = std::make_shared<drivers::sim::SimAwg>(bench);
+        const char* awg_name = tek ? "Tektronix AWG5014C" : "Keysight 33522B";
+        servers.push_back(std::make_unique<drivers::sim::TcpServer>(awg_dev, sa->host, port));
+        servers.push_back(std::make_unique<drivers::sim::TcpServer>(
+            std::make_shared<drivers::sim::SimDaq>(bench), sa->host, static_cast<std::uint16_t>(port + 1)));
+        for (auto& srv : servers) srv->start();
+        if (ctx.json)
+          print_json({{"awg_port", servers[0]->port()}, {"daq_port", servers[1]->port()}, {"host", sa->host},
+                      {"awg_dialect", sa->dialect}});
+        else
+          std::cout << "simulated bench: AWG (" << awg_name << " dialect) on " << sa->host << ":"
+                    << servers[0]->port() << ", DAQ (Infiniium dialect) on " << sa->host << ":"
+                    << servers[1]->port() << std::endl;
+      }
       auto t0 = std::chrono::steady_clock::now();
       while (!g_cancel) {
         std::this_thread::sleep_for(std::chrono::milliseconds(50));
