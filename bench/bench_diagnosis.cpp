@@ -1,7 +1,8 @@
 // The one-shot gap diagnosis (issue 18; target: under 1 s): the output-error
 // fit of one exp_decay shot with the catalogue's effects scanned, and the
 // held-out check on its one-shot chirp — refsim corpus captures (another
-// simulator's files), a control and one with a channel skew.
+// simulator's files), a control and one with a channel skew; an end mass and a
+// dielectric loss, the slowest kinds.
 #include <benchmark/benchmark.h>
 
 #include <filesystem>
@@ -52,5 +53,9 @@ BENCHMARK_CAPTURE(BM_OneShotDiagnosis, control_12, std::string("12"), false)->Un
 BENCHMARK_CAPTURE(BM_OneShotDiagnosis, control_12_heldout, std::string("12"), true)->Unit(benchmark::kMillisecond)->Iterations(1);
 BENCHMARK_CAPTURE(BM_OneShotDiagnosis, skew_06, std::string("06"), false)->Unit(benchmark::kMillisecond)->Iterations(1);
 BENCHMARK_CAPTURE(BM_OneShotDiagnosis, skew_06_heldout, std::string("06"), true)->Unit(benchmark::kMillisecond)->Iterations(1);
+// The slow kinds: an end mass (extra starts where the capture shows a misfit)
+// and a dielectric loss (both loss laws, lack of fit left in the fit).
+BENCHMARK_CAPTURE(BM_OneShotDiagnosis, mass_02_heldout, std::string("02"), true)->Unit(benchmark::kMillisecond)->Iterations(1);
+BENCHMARK_CAPTURE(BM_OneShotDiagnosis, dielectric_14_heldout, std::string("14"), true)->Unit(benchmark::kMillisecond)->Iterations(1);
 
 }  // namespace

@@ -17,7 +17,8 @@ Prints a summary and exits non-zero on any violation.
   /usr/bin/python3 scripts/mutation-soak.py --cli build/ui/piezobench \
       --capture CAP.h5 --count 10000 --batch 100 --jobs 2 --work /tmp/soak [--resume]
 Each batch is checked whole (replay, resume, capture info) and marked
-batchNNNN.done; --resume goes on from the first batch not marked.
+batchNNNN.done; --resume goes on from the first batch not marked; --first-batch K
+starts a run (on another machine, say) at batch K with the same mutants as a run from 0.
 """
 import argparse
 import json
@@ -122,6 +123,10 @@ def main():
     ap.add_argument("--metadata-share", type=float, default=0.9)
     ap.add_argument("--skip-replay", action="store_true")
     ap.add_argument("--skip-info", action="store_true")
+    ap.add_argument("--first-batch", type=int, default=0,
+                    help="start at this batch: the earlier mutants are drawn (so the later ones are the "
+                         "same as in a run from 0) but neither written nor replayed — to go on with "
+                         "the same series on another machine")
     ap.add_argument("--resume", action="store_true",
                     help="keep WORK and the batches already checked (batchNNNN.done); "
                          "the mutants are the same for the same --seed, --count and --batch")
@@ -136,19 +141,23 @@ def main():
     os.makedirs(a.work, exist_ok=True)
     batches = []
     for b in range(0, a.count, a.batch):
+        keep = b // a.batch >= a.first_batch
         d = os.path.join(a.work, "batch%04d" % (b // a.batch))
-        os.makedirs(d, exist_ok=True)
+        if keep:
+            os.makedirs(d, exist_ok=True)
         for k in range(b, min(a.count, b + a.batch)):
             m = bytearray(data)
             for _ in range(rng.randint(1, 8)):
                 pos = rng.choice(meta) if meta and rng.random() < a.metadata_share else rng.randrange(len(m))
                 m[pos] = rng.randrange(256)
             f = os.path.join(d, "m%05d.h5" % k)
-            if not os.path.exists(f):
+            if keep and not os.path.exists(f):
                 open(f, "wb").write(m)
-        batches.append(d)
-    print("soak: %d mutants of %s (%d bytes, %d of metadata) in %d batches"
-          % (a.count, a.capture, len(data), len(meta), len(batches)), flush=True)
+        if keep:
+            batches.append(d)
+    print("soak: mutants %d..%d of %d of %s (%d bytes, %d of metadata) in %d batches"
+          % (a.first_batch * a.batch, a.count - 1, a.count, a.capture, len(data), len(meta), len(batches)),
+          flush=True)
 
     bad = []
     counts = {"ok": 0, "failed": 0, "crashed": 0, "hung": 0}
