@@ -112,6 +112,14 @@ void fit_slot(const Eigen::VectorXd& f, const Eigen::VectorXcd& z, const Eigen::
   try {
     m.fit = fit_bvd(f, z, zs, yb, m.lo, m.hi, *m.p, opt.fit);
     m.p = m.fit.p;
+    // A branch that resonates outside its own window fitted something else
+    // (a grid coarser than the resonance, a mode too weak): no figures.
+    const double fs_fit = fs_of(*m.p);
+    if (!(fs_fit >= f[m.lo] && fs_fit <= f[m.hi]) || !std::isfinite(fp_of(*m.p))) {
+      m.notes.push_back("the BVD fit left its window (grid too coarse for the resonance?)");
+      m.p.reset();
+      m.fit = BvdFit{};
+    }
   } catch (const std::invalid_argument& e) {
     m.notes.push_back(std::string("BVD fit: ") + e.what());
   }
@@ -136,6 +144,9 @@ ModeFigures figures_of(const Slot& m, const Eigen::VectorXd& f, const Eigen::Vec
   out.window_lo_hz = f[m.lo];
   out.window_hi_hz = f[m.hi];
   if (!m.fit.converged) out.notes.push_back("BVD fit: " + m.fit.message);
+  const Eigen::Index is = std::clamp<Eigen::Index>(first_at_or_above(f, fs_of(p)), 1, f.size() - 1);
+  if (f[is] - f[is - 1] > 0.5 * fs_of(p) / qm_of(p))
+    out.notes.push_back("grid step above half the resonance bandwidth: R1, L1 and Qm are poorly resolved");
   out.r1_ohm = {p.r1_ohm, m.fit.sigma.r1_ohm};
   out.l1_h = {p.l1_h, m.fit.sigma.l1_h};
   out.c1_f = {p.c1_f, m.fit.sigma.c1_f};
@@ -152,7 +163,11 @@ ModeFigures figures_of(const Slot& m, const Eigen::VectorXd& f, const Eigen::Vec
   // The bandwidth method on the measured conductance (other modes' branches
   // removed), from the window's low edge to half-way to fp.
   const Eigen::Index hi = std::min(m.hi, last_at_or_below(f, 0.5 * (fs + fp)));
-  out.conductance = conductance_peak(f, y_adj.real(), g_sigma, m.lo, hi);
+  if (hi - m.lo >= 2) {
+    out.conductance = conductance_peak(f, y_adj.real(), g_sigma, m.lo, hi);
+  } else {
+    out.conductance.message = "fewer than 3 grid points between the window's edge and (fs + fp)/2";
+  }
   if (out.conductance.ok) {
     out.qm_bandwidth = {out.conductance.qm, out.conductance.qm_sigma};
     const double s = std::hypot(out.qm_bandwidth.sigma, out.qm_branch.sigma);
