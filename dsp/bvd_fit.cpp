@@ -78,7 +78,8 @@ BvdParams bvd_start_from_circle(const Eigen::VectorXd& f, const Eigen::VectorXcd
   const double ws = 1.0 / std::sqrt(p.l1_h * p.c1_f);
   p.c0_f = circle.centre.imag() / ws;
   if (!(p.l1_h > 0) || !(p.c1_f > 0) || !(p.c0_f > 0) || !std::isfinite(p.r1_ohm))
-    throw std::invalid_argument("bvd_start_from_circle: the points do not trace a resonance circle");
+    throw std::invalid_argument(
+        "bvd_start_from_circle: the points do not trace a resonance circle");
   return p;
 }
 

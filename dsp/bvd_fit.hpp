@@ -49,7 +49,7 @@ struct BvdFitOptions {
 
 struct BvdFit {
   BvdParams p;
-  BvdParams sigma;                 // 1σ of each parameter
+  BvdParams sigma;                                           // 1σ of each parameter
   Eigen::Matrix4d cov_ln = Eigen::Matrix4d::Constant(kNaN);  // of (ln R1, ln L1, ln C1, ln C0)
   bool weighted = false;           // per-point σ of Z used (else residual-scaled)
   double chi2_per_dof = kNaN;      // with weights: Σ|r/σ|²/(2n − 4); else NaN

@@ -116,8 +116,8 @@ ConductancePeak conductance_peak(const Eigen::VectorXd& f, const Eigen::VectorXd
     // with the σ of the nearest grid point (first order; independent points).
     const double d1 = std::abs(left.dg_df(out.f1_hz)), d2 = std::abs(right.dg_df(out.f2_hz));
     const double s1 = g_sigma[j1], s2 = g_sigma[j2], sm = g_sigma[i];
-    const double var = s2 * s2 / (d2 * d2) + s1 * s1 / (d1 * d1) +
-                       std::pow(0.5 * sm * (1 / d1 + 1 / d2), 2);
+    const double var =
+        s2 * s2 / (d2 * d2) + s1 * s1 / (d1 * d1) + std::pow(0.5 * sm * (1 / d1 + 1 / d2), 2);
     out.qm_sigma = out.qm * std::sqrt(var) / (out.f2_hz - out.f1_hz);
   }
   return out;

@@ -19,12 +19,12 @@ namespace piezo::dsp {
 
 struct ConductancePeak {
   bool ok = false;
-  std::string message;     // why not, when !ok
-  double fs_hz = kNaN;     // maximum of G
+  std::string message;  // why not, when !ok
+  double fs_hz = kNaN;  // maximum of G
   double g_max_s = kNaN;
   double f1_hz = kNaN, f2_hz = kNaN;  // G = G_max/2 below and above fs
-  double qm = kNaN;        // fs/(f2 − f1)
-  double qm_sigma = kNaN;  // first order from g_sigma (NaN without it)
+  double qm = kNaN;                   // fs/(f2 − f1)
+  double qm_sigma = kNaN;             // first order from g_sigma (NaN without it)
 };
 
 // g: conductance per grid point (the caller removes other modes' conductance),

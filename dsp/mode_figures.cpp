@@ -23,7 +23,8 @@ Eigen::Index first_at_or_above(const Eigen::VectorXd& f, double x) {
   return static_cast<Eigen::Index>(std::lower_bound(f.data(), f.data() + f.size(), x) - f.data());
 }
 Eigen::Index last_at_or_below(const Eigen::VectorXd& f, double x) {
-  return static_cast<Eigen::Index>(std::upper_bound(f.data(), f.data() + f.size(), x) - f.data()) - 1;
+  return static_cast<Eigen::Index>(std::upper_bound(f.data(), f.data() + f.size(), x) - f.data()) -
+         1;
 }
 
 double fs_of(const BvdParams& p) { return 1.0 / (kTwoPi * std::sqrt(p.l1_h * p.c1_f)); }
@@ -50,7 +51,8 @@ struct Slot {
 };
 
 // Motional admittance of every fitted mode but `skip`, on the grid.
-Eigen::VectorXcd background(const Eigen::VectorXd& f, const std::vector<Slot>& s, std::size_t skip) {
+Eigen::VectorXcd background(const Eigen::VectorXd& f, const std::vector<Slot>& s,
+                            std::size_t skip) {
   Eigen::VectorXcd yb = Eigen::VectorXcd::Zero(f.size());
   for (std::size_t j = 0; j < s.size(); ++j)
     if (j != skip && s[j].p)
@@ -60,7 +62,8 @@ Eigen::VectorXcd background(const Eigen::VectorXd& f, const std::vector<Slot>& s
 
 // Start values: the circle through the conductance peak's points (G ≥ G_max/4, at least 5).
 std::optional<BvdParams> start_values(const Eigen::VectorXd& f, const Eigen::VectorXcd& y,
-                                      Eigen::Index lo, Eigen::Index hi, std::vector<std::string>& notes) {
+                                      Eigen::Index lo, Eigen::Index hi,
+                                      std::vector<std::string>& notes) {
   if (hi - lo < 4) {
     notes.push_back("too few grid points around the resonance for a circle fit");
     return std::nullopt;
@@ -146,7 +149,8 @@ ModeFigures figures_of(const Slot& m, const Eigen::VectorXd& f, const Eigen::Vec
   if (!m.fit.converged) out.notes.push_back("BVD fit: " + m.fit.message);
   const Eigen::Index is = std::clamp<Eigen::Index>(first_at_or_above(f, fs_of(p)), 1, f.size() - 1);
   if (f[is] - f[is - 1] > 0.5 * fs_of(p) / qm_of(p))
-    out.notes.push_back("grid step above half the resonance bandwidth: R1, L1 and Qm are poorly resolved");
+    out.notes.push_back(
+        "grid step above half the resonance bandwidth: R1, L1 and Qm are poorly resolved");
   out.r1_ohm = {p.r1_ohm, m.fit.sigma.r1_ohm};
   out.l1_h = {p.l1_h, m.fit.sigma.l1_h};
   out.c1_f = {p.c1_f, m.fit.sigma.c1_f};
@@ -235,10 +239,12 @@ ModeFiguresResult mode_figures(const Eigen::VectorXd& f, const Eigen::VectorXcd&
   double fr = opt.reference_hz;
   if (fr < f[0] || fr > f[f.size() - 1]) {
     fr = f[0];
-    res.notes.push_back(fmt("C^T and tan delta at %.6g Hz, the grid's lowest frequency (not %.6g Hz)",
-                            fr, opt.reference_hz));
+    res.notes.push_back(
+        fmt("C^T and tan delta at %.6g Hz, the grid's lowest frequency (not %.6g Hz)", fr,
+            opt.reference_hz));
   }
-  const Eigen::Index i1 = std::min<Eigen::Index>(f.size() - 1, std::max<Eigen::Index>(1, first_at_or_above(f, fr)));
+  const Eigen::Index i1 =
+      std::min<Eigen::Index>(f.size() - 1, std::max<Eigen::Index>(1, first_at_or_above(f, fr)));
   const double t = (fr - f[i1 - 1]) / (f[i1] - f[i1 - 1]);
   const cd yr = (1 - t) * y[i1 - 1] + t * y[i1];
   const double w = kTwoPi * fr;
@@ -251,8 +257,9 @@ ModeFiguresResult mode_figures(const Eigen::VectorXd& f, const Eigen::VectorXcd&
     res.tan_delta.sigma = std::hypot(sy, res.tan_delta.value * sy) / std::abs(yr.imag());
   }
   if (!res.modes.empty() && res.modes.front().fs_hz.value < 3.0 * fr)
-    res.notes.push_back("the reference frequency is within a factor 3 of the first resonance: "
-                        "C^T is not the free (low-frequency) capacitance");
+    res.notes.push_back(
+        "the reference frequency is within a factor 3 of the first resonance: "
+        "C^T is not the free (low-frequency) capacitance");
 
   // Hoop mode: given, or the most strongly coupled one.
   int hoop = opt.hoop_mode;

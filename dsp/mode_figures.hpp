@@ -52,13 +52,13 @@ struct ModeFigures {
   Uncertain fm_hz, fn_hz;
   // Motional branch (IEEE 176): fs = 1/(2π√(L1C1)), fp = fs·√(1 + C1/C0).
   Uncertain fs_hz, fp_hz;
-  Uncertain k_eff2, k_eff;  // k_eff² = (fp² − fs²)/fp² = C1/(C0 + C1) (EN 50324-2)
-  Uncertain qm_branch;      // Qm = 1/(2π·fs·R1·C1)
-  Uncertain qm_bandwidth;   // Qm = fs/(f2 − f1), conductance half-power points
+  Uncertain k_eff2, k_eff;      // k_eff² = (fp² − fs²)/fp² = C1/(C0 + C1) (EN 50324-2)
+  Uncertain qm_branch;          // Qm = 1/(2π·fs·R1·C1)
+  Uncertain qm_bandwidth;       // Qm = fs/(f2 − f1), conductance half-power points
   ConductancePeak conductance;  // fs at max G, f1, f2 (the bandwidth method's data)
   Uncertain r1_ohm, l1_h, c1_f, c0_f;
   Uncertain frequency_constant_hz_m;  // fs·D_mean (NaN without a diameter)
-  BvdFit fit;                 // the fit's diagnostics (window points, residual, converged)
+  BvdFit fit;                         // the fit's diagnostics (window points, residual, converged)
   double window_lo_hz = kNaN, window_hi_hz = kNaN;
   std::vector<std::string> notes;
 };
@@ -68,7 +68,7 @@ struct ModeFiguresResult {
   Uncertain free_capacitance_f;    // C^T = Im Y/ω at reference_used_hz
   Uncertain tan_delta;             // Re Y/Im Y there
   double reference_used_hz = kNaN;
-  int hoop_mode = -1;              // index into modes, −1 when none
+  int hoop_mode = -1;                 // index into modes, −1 when none
   Uncertain frequency_constant_hz_m;  // of the hoop mode
   int sweeps = 0;
   std::vector<std::string> notes;

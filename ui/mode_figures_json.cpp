@@ -84,9 +84,9 @@ nlohmann::json mode_summary_json(const dsp::ModeFiguresResult& r, double d_mean,
 
 void print_mode_figures(std::FILE* out, const nlohmann::json& modes, const nlohmann::json& s) {
   std::fprintf(out, "  mode figures (IEEE 176 / EN 50324-2; BVD fit per mode, ±1σ)\n");
-  std::fprintf(out, "  %-3s %-20s %-20s %-12s %-14s %-14s %-16s %-18s %-18s %-18s\n", "#", "fs [Hz]",
-               "fp [Hz]", "k_eff", "Qm (R1 C1)", "Qm (fs/df)", "R1 [ohm]", "L1 [mH]", "C1 [pF]",
-               "C0 [pF]");
+  std::fprintf(out, "  %-3s %-20s %-20s %-12s %-14s %-14s %-16s %-18s %-18s %-18s\n", "#",
+               "fs [Hz]", "fp [Hz]", "k_eff", "Qm (R1 C1)", "Qm (fs/df)", "R1 [ohm]", "L1 [mH]",
+               "C1 [pF]", "C0 [pF]");
   for (std::size_t k = 0; k < modes.size(); ++k) {
     const auto& m = modes[k];
     std::fprintf(out, "  %-3zu %-20s %-20s %-12s %-14s %-14s %-16s %-18s %-18s %-18s\n", k + 1,
@@ -99,23 +99,27 @@ void print_mode_figures(std::FILE* out, const nlohmann::json& modes, const nlohm
                  vs(m, "l1_h", "l1_sigma_h", 1e3, "%.4g").c_str(),
                  vs(m, "c1_f", "c1_sigma_f", 1e12, "%.4g").c_str(),
                  vs(m, "c0_f", "c0_sigma_f", 1e12, "%.4g").c_str());
-    std::fprintf(out, "      fm %s Hz, fn %s Hz, N = fs*D_mean %s Hz*m\n",
-                 vs(m, "fm_hz", "fm_sigma_hz", 1, "%.2f").c_str(),
-                 vs(m, "fn_hz", "fn_sigma_hz", 1, "%.2f").c_str(),
-                 vs(m, "frequency_constant_hz_m", "frequency_constant_sigma_hz_m", 1, "%.1f").c_str());
-    for (const auto& n : m["notes"]) std::fprintf(out, "      note: %s\n", n.get<std::string>().c_str());
+    std::fprintf(
+        out, "      fm %s Hz, fn %s Hz, N = fs*D_mean %s Hz*m\n",
+        vs(m, "fm_hz", "fm_sigma_hz", 1, "%.2f").c_str(),
+        vs(m, "fn_hz", "fn_sigma_hz", 1, "%.2f").c_str(),
+        vs(m, "frequency_constant_hz_m", "frequency_constant_sigma_hz_m", 1, "%.1f").c_str());
+    for (const auto& n : m["notes"])
+      std::fprintf(out, "      note: %s\n", n.get<std::string>().c_str());
   }
   if (s.contains("reference_hz"))
     std::fprintf(out, "  C^T %s pF, tan delta %s at %.6g Hz\n",
-               vs(s, "free_capacitance_f", "free_capacitance_sigma_f", 1e12, "%.5g").c_str(),
-               vs(s, "tan_delta", "tan_delta_sigma", 1, "%.3g").c_str(), num(s, "reference_hz"));
+                 vs(s, "free_capacitance_f", "free_capacitance_sigma_f", 1e12, "%.5g").c_str(),
+                 vs(s, "tan_delta", "tan_delta_sigma", 1, "%.3g").c_str(), num(s, "reference_hz"));
   if (s.contains("hoop_mode") && s["hoop_mode"].get<int>() >= 0)
-    std::fprintf(out, "  hoop mode %d (most strongly coupled): N = %s Hz*m (D_mean %.5g m, %s)\n",
-                 s["hoop_mode"].get<int>() + 1,
-                 vs(s, "frequency_constant_hz_m", "frequency_constant_sigma_hz_m", 1, "%.1f").c_str(),
-                 num(s, "mean_diameter_m"), s["mean_diameter_source"].get<std::string>().c_str());
+    std::fprintf(
+        out, "  hoop mode %d (most strongly coupled): N = %s Hz*m (D_mean %.5g m, %s)\n",
+        s["hoop_mode"].get<int>() + 1,
+        vs(s, "frequency_constant_hz_m", "frequency_constant_sigma_hz_m", 1, "%.1f").c_str(),
+        num(s, "mean_diameter_m"), s["mean_diameter_source"].get<std::string>().c_str());
   if (s.contains("notes"))
-    for (const auto& n : s["notes"]) std::fprintf(out, "  note: %s\n", n.get<std::string>().c_str());
+    for (const auto& n : s["notes"])
+      std::fprintf(out, "  note: %s\n", n.get<std::string>().c_str());
 }
 
 }  // namespace piezo::ui

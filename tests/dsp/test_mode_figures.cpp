@@ -48,12 +48,12 @@ void expect_branches(const dsp::ModeFiguresResult& r, const bvd::Bvd& m, double 
     const double fs = 1 / (kTwoPi * std::sqrt(b.L * b.C));
     const double q = 1 / (kTwoPi * fs * b.R * b.C);
     const double fp = fs * std::sqrt(1 + b.C / m.c0);
-    std::printf("mode %zu: R1 %.6f / %.6f ohm, L1 %.8g / %.8g H, C1 %.8g / %.8g F, C0 %.8g / %.8g F\n"
-                "        fs %.6f / %.6f Hz, fp %.6f / %.6f Hz, Qm branch %.6f, bandwidth %.6f / %.6f, "
-                "sweeps %d\n",
-                k, x.r1_ohm.value, b.R, x.l1_h.value, b.L, x.c1_f.value, b.C, x.c0_f.value, m.c0,
-                x.fs_hz.value, fs, x.fp_hz.value, fp, x.qm_branch.value, x.qm_bandwidth.value, q,
-                r.sweeps);
+    std::printf(
+        "mode %zu: R1 %.6f / %.6f ohm, L1 %.8g / %.8g H, C1 %.8g / %.8g F, C0 %.8g / %.8g F\n"
+        "        fs %.6f / %.6f Hz, fp %.6f / %.6f Hz, Qm branch %.6f, bandwidth %.6f / %.6f, "
+        "sweeps %d\n",
+        k, x.r1_ohm.value, b.R, x.l1_h.value, b.L, x.c1_f.value, b.C, x.c0_f.value, m.c0,
+        x.fs_hz.value, fs, x.fp_hz.value, fp, x.qm_branch.value, x.qm_bandwidth.value, q, r.sweeps);
     EXPECT_LT(rel(x.r1_ohm.value, b.R), tol);
     EXPECT_LT(rel(x.l1_h.value, b.L), tol);
     EXPECT_LT(rel(x.c1_f.value, b.C), tol);
@@ -103,8 +103,8 @@ TEST(ModeFigures, ThreeBranchTubeNetworkNoiseFree) {
   const auto ri = dsp::mode_figures(g.f, g.z, {}, iso);
   ASSERT_EQ(ri.modes.size(), 3u);
   const double fs0 = 1 / (kTwoPi * std::sqrt(m.branches[0].L * m.branches[0].C));
-  std::printf("isolated fits: mode 1 fs %+.2e, C0 %+.2e relative\n", ri.modes[0].fs_hz.value / fs0 - 1,
-              ri.modes[0].c0_f.value / m.c0 - 1);
+  std::printf("isolated fits: mode 1 fs %+.2e, C0 %+.2e relative\n",
+              ri.modes[0].fs_hz.value / fs0 - 1, ri.modes[0].c0_f.value / m.c0 - 1);
   EXPECT_GT(std::abs(ri.modes[0].c0_f.value / m.c0 - 1), 1e-3);
 }
 
@@ -148,8 +148,9 @@ TEST(ModeFigures, SeededNoiseWithinThreeSigmaAndSigmasCalibrated) {
     for (std::size_t k = 0; k < 3; ++k) {
       const auto& b = m.branches[k];
       const auto& x = r.modes[k];
-      const double e[4] = {(x.r1_ohm.value - b.R) / x.r1_ohm.sigma, (x.l1_h.value - b.L) / x.l1_h.sigma,
-                           (x.c1_f.value - b.C) / x.c1_f.sigma, (x.c0_f.value - m.c0) / x.c0_f.sigma};
+      const double e[4] = {(x.r1_ohm.value - b.R) / x.r1_ohm.sigma,
+                           (x.l1_h.value - b.L) / x.l1_h.sigma, (x.c1_f.value - b.C) / x.c1_f.sigma,
+                           (x.c0_f.value - m.c0) / x.c0_f.sigma};
       for (double v : e) {
         s2 += v * v;
         ++n;
@@ -159,11 +160,13 @@ TEST(ModeFigures, SeededNoiseWithinThreeSigmaAndSigmasCalibrated) {
         }
       }
       if (seed == 1) {
-        std::printf("seed 1 mode %zu: R1 %.4f ± %.4f (true %.4f), L1 %.6g ± %.2g (%.6g), C1 %.6g ± %.2g (%.6g), "
-                    "C0 %.6g ± %.2g (%.6g), Qm %.2f ± %.2f / bandwidth %.2f ± %.2f, chi2/dof %.3f\n",
-                    k, x.r1_ohm.value, x.r1_ohm.sigma, b.R, x.l1_h.value, x.l1_h.sigma, b.L, x.c1_f.value,
-                    x.c1_f.sigma, b.C, x.c0_f.value, x.c0_f.sigma, m.c0, x.qm_branch.value,
-                    x.qm_branch.sigma, x.qm_bandwidth.value, x.qm_bandwidth.sigma, x.fit.chi2_per_dof);
+        std::printf(
+            "seed 1 mode %zu: R1 %.4f ± %.4f (true %.4f), L1 %.6g ± %.2g (%.6g), C1 %.6g ± %.2g "
+            "(%.6g), "
+            "C0 %.6g ± %.2g (%.6g), Qm %.2f ± %.2f / bandwidth %.2f ± %.2f, chi2/dof %.3f\n",
+            k, x.r1_ohm.value, x.r1_ohm.sigma, b.R, x.l1_h.value, x.l1_h.sigma, b.L, x.c1_f.value,
+            x.c1_f.sigma, b.C, x.c0_f.value, x.c0_f.sigma, m.c0, x.qm_branch.value,
+            x.qm_branch.sigma, x.qm_bandwidth.value, x.qm_bandwidth.sigma, x.fit.chi2_per_dof);
         // Qm both ways agree within 3 combined σ (they share data, so this is loose).
         EXPECT_LT(std::abs(x.qm_bandwidth.value - x.qm_branch.value),
                   3 * std::hypot(x.qm_bandwidth.sigma, x.qm_branch.sigma));
@@ -276,16 +279,17 @@ void fe_case(double beta, FeTol tol) {
     };
     const double cs = c_bg(f_modal), cp = c_bg(x.fp_hz.value);
     const double k2s = c1 / (cs + c1), k2p = c1 / (cp + c1);
-    std::printf("beta %.0e mode %zu: fs %.3f Hz (modal %.3f, %+.2e), fm %.3f, fp %.3f, fn %.3f\n"
-                "   C1 %+.2e, L1 %+.2e, R1 %+.2e relative to p^2/w^2, 1/p^2, c/p^2; C0 fit %.5g F "
-                "(C_bg at fs %.5g, at fp %.5g; C0 clamped %.5g)\n"
-                "   k_eff^2 %.6f: C1/(C_bg+C1) %.6f..%.6f; modal coupling p^2/(w^2 C0) %.6f -> "
-                "km2/(1+km2) %.6f; Qm %.2f / bandwidth %.2f (c/p^2 branch: %.2f); N %.2f Hz m\n",
-                beta, k, x.fs_hz.value, f_modal, x.fs_hz.value / f_modal - 1, x.fm_hz.value,
-                x.fp_hz.value, x.fn_hz.value, x.c1_f.value / c1 - 1, x.l1_h.value / l1 - 1,
-                x.r1_ohm.value / r1 - 1, x.c0_f.value, cs, cp, port.c_clamped, x.k_eff2.value,
-                std::min(k2s, k2p), std::max(k2s, k2p), km2, km2 / (1 + km2), x.qm_branch.value,
-                x.qm_bandwidth.value, 1 / (m.omega * r1 * c1), x.frequency_constant_hz_m.value);
+    std::printf(
+        "beta %.0e mode %zu: fs %.3f Hz (modal %.3f, %+.2e), fm %.3f, fp %.3f, fn %.3f\n"
+        "   C1 %+.2e, L1 %+.2e, R1 %+.2e relative to p^2/w^2, 1/p^2, c/p^2; C0 fit %.5g F "
+        "(C_bg at fs %.5g, at fp %.5g; C0 clamped %.5g)\n"
+        "   k_eff^2 %.6f: C1/(C_bg+C1) %.6f..%.6f; modal coupling p^2/(w^2 C0) %.6f -> "
+        "km2/(1+km2) %.6f; Qm %.2f / bandwidth %.2f (c/p^2 branch: %.2f); N %.2f Hz m\n",
+        beta, k, x.fs_hz.value, f_modal, x.fs_hz.value / f_modal - 1, x.fm_hz.value, x.fp_hz.value,
+        x.fn_hz.value, x.c1_f.value / c1 - 1, x.l1_h.value / l1 - 1, x.r1_ohm.value / r1 - 1,
+        x.c0_f.value, cs, cp, port.c_clamped, x.k_eff2.value, std::min(k2s, k2p),
+        std::max(k2s, k2p), km2, km2 / (1 + km2), x.qm_branch.value, x.qm_bandwidth.value,
+        1 / (m.omega * r1 * c1), x.frequency_constant_hz_m.value);
     // fs is the series resonance of the mode's branch — the modal frequency by construction
     // (X1 = ωL1 − 1/(ωC1) = 0 at ω_k, for any damping). What the one-branch fit cannot
     // represent moves it: the symmetric mode at 83.9 kHz (coupling 2e-4, no |Z| extremum,
