@@ -5,6 +5,8 @@
 // Prony, FFT and cross spectra go through acq::assess_impedance: fixture
 // compensation and deskew from the capture's calibration shots, uncertainty
 // band, Kramers-Kronig check, shot validity and the stabilization chart.
+// Per-mode figures (dsp/mode_figures.hpp): key "modes" in --json always, the
+// table after the impedance with --figures.
 #include <iomanip>
 #include <cstdio>
 #include <fstream>
@@ -19,12 +21,14 @@
 #include "dsp/cross_spectra.hpp"
 #include "dsp/fft_ratio.hpp"
 #include "dsp/impedance_io.hpp"
+#include "dsp/mode_figures.hpp"
 #include "dsp/prony_impedance.hpp"
 #include "dsp/rayleigh.hpp"
 #include "dsp/stepped_sine.hpp"
 #include "ui/assessment_json.hpp"
 #include "ui/cli/cli_common.hpp"
 #include "ui/json_text.hpp"
+#include "ui/mode_figures_json.hpp"
 
 namespace piezo::cli {
 
@@ -35,7 +39,7 @@ struct ImpedanceArgs {
   std::optional<std::size_t> shot, samples, order, segment;
   double fmin = 0, fmax = 0, step = 0, overlap = 0.5;
   std::size_t bootstrap = 20;
-  bool csv = false, s1p = false;
+  bool csv = false, s1p = false, figures = false;
   // Trust (issue 10): compensation, deskew, uncertainty, validity, KK, stabilization.
   std::string compensation = "auto", uncertainty = "auto", stabilization = "2:30:2";
   std::optional<double> skew_ns;
@@ -213,6 +217,25 @@ void print_text(const nlohmann::json& j) {
     std::printf("  capacitance     %.5g F\n", f["capacitance_f"].get<double>());
 }
 
+// The figures of every mode on the estimate's grid, with the estimator's σ per point
+// when it has one; D_mean from the capture's geometry (or the project's default tube).
+void add_mode_figures(nlohmann::json& j, const dsp::ImpedanceResult& r, const acq::Capture& cap) {
+  const auto g = cap.setup.geometry();
+  const bool given = cap.setup.inner_diameter_m && cap.setup.outer_diameter_m;
+  dsp::ModeFigureOptions o;
+  o.mean_diameter_m = 0.5 * (g.inner_diameter_m + g.outer_diameter_m);
+  const Eigen::VectorXd sigma = r.z_sigma_ohm.size() == r.f_hz.size() ? r.z_sigma_ohm : Eigen::VectorXd();
+  try {
+    const auto m = dsp::mode_figures(r.f_hz, r.z_ohm, sigma, o);
+    j["modes"] = ui::modes_json(m);
+    j["mode_summary"] = ui::mode_summary_json(
+        m, o.mean_diameter_m, given ? "capture /setup" : "the project's default tube (not in the capture)");
+  } catch (const std::invalid_argument& e) {  // a grid too short for figures: the impedance stands
+    j["modes"] = nlohmann::json::array();
+    j["mode_summary"] = {{"notes", {std::string("no mode figures: ") + e.what()}}};
+  }
+}
+
 void run(const ImpedanceArgs& a, Context& ctx) {
   if (int(a.csv) + int(a.s1p) + int(ctx.json) > 1) throw InputError("choose one of --json, --csv, --s1p");
   const auto cap = acq::read_capture_contained(a.file);  // a crash of libhdf5 costs the file only
@@ -324,12 +347,14 @@ void run(const ImpedanceArgs& a, Context& ctx) {
         j["uncertainty"] = {{"source", band->source}, {"coverage_factor", band->coverage_factor},
                             {"abs_sigma_ohm", std::vector<double>(band->abs_sigma_ohm.data(), band->abs_sigma_ohm.data() + band->size())}};
     }
+    if (ctx.json || a.figures) add_mode_figures(j, r, cap);
     if (ctx.json) {
       ui::write_json(*os, j);  // streamed, no serialised copy
       *os << std::endl;
     } else {
       print_text(j);
       print_trust(j);
+      if (a.figures) ui::print_mode_figures(stdout, j["modes"], j["mode_summary"]);
     }
   }
 }
@@ -366,6 +391,9 @@ void register_impedance_command(CLI::App& app, Context& ctx) {
   cmd->add_flag("--no-validity", a->no_validity, "Skip the per-shot validity flags");
   cmd->add_option("--stabilization", a->stabilization, "Prony stabilization chart orders MIN:MAX[:STEP]")->capture_default_str();
   cmd->add_flag("--no-stabilization", a->no_stabilization, "Skip the stabilization chart");
+  cmd->add_flag("--figures", a->figures,
+                "Per-mode figures after the impedance: fs, fp, k_eff, Qm two ways, BVD R1 L1 C1 C0 "
+                "(always under \"modes\" in --json)");
   cmd->add_flag("--s1p", a->s1p, "Touchstone 1-port output (Z, RI, normalised to 50 ohm)");
   cmd->add_option("-o,--output", a->output, "Write the output to this file instead of stdout");
   add_json_flag(cmd, ctx);
