@@ -50,13 +50,16 @@ struct Slot {
   }
 };
 
-// Motional admittance of every fitted mode but `skip`, on the grid.
+// Motional admittance of the fitted modes within `neighbours` of `skip` (not
+// `skip` itself), on the grid points lo..hi (zero elsewhere: no reader looks there).
 Eigen::VectorXcd background(const Eigen::VectorXd& f, const std::vector<Slot>& s,
-                            std::size_t skip) {
+                            std::size_t skip, Eigen::Index lo, Eigen::Index hi, int neighbours) {
   Eigen::VectorXcd yb = Eigen::VectorXcd::Zero(f.size());
-  for (std::size_t j = 0; j < s.size(); ++j)
+  const std::size_t n = static_cast<std::size_t>(std::max(neighbours, 0));
+  const std::size_t first = skip > n ? skip - n : 0, last = std::min(s.size() - 1, skip + n);
+  for (std::size_t j = first; j <= last; ++j)
     if (j != skip && s[j].p)
-      for (Eigen::Index k = 0; k < f.size(); ++k) yb[k] += s[j].p->motional_admittance(f[k]);
+      for (Eigen::Index k = lo; k <= hi; ++k) yb[k] += s[j].p->motional_admittance(f[k]);
   return yb;
 }
 
@@ -91,11 +94,14 @@ void fit_slot(const Eigen::VectorXd& f, const Eigen::VectorXcd& z, const Eigen::
               const Eigen::VectorXcd& y, std::vector<Slot>& s, std::size_t k,
               const ModeFigureOptions& opt) {
   Slot& m = s[k];
-  const Eigen::VectorXcd yb =
-      opt.subtract_other_modes ? background(f, s, k) : Eigen::VectorXcd::Zero(f.size());
   // Neighbour bounds: half-way to fp of the mode below and fs of the mode above.
   const double lo_bound = k > 0 ? 0.5 * (s[k - 1].fp() + m.fs()) : f[0];
   const double hi_bound = k + 1 < s.size() ? 0.5 * (m.fp() + s[k + 1].fs()) : f[f.size() - 1];
+  const Eigen::VectorXcd yb =
+      opt.subtract_other_modes
+          ? background(f, s, k, first_at_or_above(f, lo_bound), last_at_or_below(f, hi_bound),
+                       opt.background_neighbours)
+          : Eigen::VectorXcd::Zero(f.size());
   if (!m.p) {
     m.notes.clear();
     const double up = std::isfinite(m.fn.f_hz) ? 0.5 * (m.fm.f_hz + m.fn.f_hz) : hi_bound;
@@ -215,6 +221,13 @@ ModeFiguresResult mode_figures(const Eigen::VectorXd& f, const Eigen::VectorXcd&
     s.push_back(m);
   }
   if (s.empty()) res.notes.push_back("no resonance (|Z| minimum) found on the grid");
+  if (opt.max_modes >= 0 && s.size() > static_cast<std::size_t>(opt.max_modes)) {
+    char buf[160];
+    std::snprintf(buf, sizeof buf, "%zu |Z| minima on the grid: the lowest %d fitted, none from %.6g Hz up",
+                  s.size(), opt.max_modes, s[static_cast<std::size_t>(opt.max_modes)].fm.f_hz);
+    res.notes.push_back(buf);
+    s.resize(static_cast<std::size_t>(opt.max_modes));
+  }
 
   // Gauss–Seidel sweeps: each mode fitted with the others' latest branches as background.
   const int sweeps = opt.subtract_other_modes ? std::max(1, opt.max_sweeps) : 1;
@@ -229,8 +242,11 @@ ModeFiguresResult mode_figures(const Eigen::VectorXd& f, const Eigen::VectorXcd&
   }
   res.sweeps = std::min(res.sweeps, sweeps);
   for (std::size_t k = 0; k < s.size(); ++k) {
+    // figures_of reads the window m.lo..m.hi only.
     const Eigen::VectorXcd yb =
-        opt.subtract_other_modes ? background(f, s, k) : Eigen::VectorXcd::Zero(f.size());
+        opt.subtract_other_modes && s[k].hi >= s[k].lo
+            ? background(f, s, k, s[k].lo, s[k].hi, opt.background_neighbours)
+            : Eigen::VectorXcd::Zero(f.size());
     res.modes.push_back(figures_of(s[k], f, y - yb, g_sigma, opt));
   }
 

@@ -35,6 +35,13 @@ struct ModeFigureOptions {
   // less than sweep_tolerance (relative) or after max_sweeps.
   bool subtract_other_modes = true;
   int max_sweeps = 8;
+  // Work proportional to the grid: at most max_modes minima are fitted (the
+  // lowest in frequency; a long noisy record's FFT has thousands of spurious
+  // ones up high, said in a note), and a mode's background holds only its
+  // `background_neighbours` nearest fitted branches on each side (farther ones
+  // are nearly capacitive there and go into its C0), over its own stretch of grid.
+  int max_modes = 32;
+  int background_neighbours = 3;
   double sweep_tolerance = 1e-9;
   BvdFitOptions fit;
   // Free capacitance and tan δ at this frequency (EN 50324-2 measures C^T at
