@@ -8,6 +8,16 @@
 
 namespace piezo::drivers {
 
+void with_step_prefix(const std::string& prefix, const std::function<void()>& f) {
+  try {
+    f();
+  } catch (const InstrumentError& e) {
+    throw InstrumentError(prefix + e.what());
+  } catch (const TransportError& e) {
+    throw TransportError(e.kind(), prefix + e.what());
+  }
+}
+
 ScpiClient::ScpiClient(std::unique_ptr<Transport> t) : t_(std::move(t)) {
   if (!t_) throw std::invalid_argument("ScpiClient: null transport");
   address_ = t_->address();

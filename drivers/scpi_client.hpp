@@ -2,6 +2,7 @@
 // SCPI over any Transport: commands, queries, IEEE 488.2 binary blocks, and the
 // configuration discipline of the drivers: every configuration step is
 // followed by *OPC? and SYST:ERR? (IEEE 488.2 / SCPI-99 error queue).
+#include <functional>
 #include <memory>
 #include <string>
 #include <vector>
@@ -15,6 +16,11 @@ class InstrumentError : public std::runtime_error {
  public:
   using std::runtime_error::runtime_error;
 };
+
+// Runs f; an InstrumentError or TransportError from it is rethrown, of the same
+// kind, with `prefix` before its message — the drivers name the configuration
+// step that failed ("Tektronix AWG, step 'amplitude': …").
+void with_step_prefix(const std::string& prefix, const std::function<void()>& f);
 
 class ScpiClient {
  public:

@@ -25,14 +25,7 @@ Session::Session(std::unique_ptr<Transport> t) : scpi_(std::move(t)) {
 }
 
 void Session::step(const std::string& name, const std::function<void()>& f) {
-  const std::string head = "Red Pitaya, step '" + name + "': ";
-  try {
-    f();
-  } catch (const InstrumentError& e) {
-    throw InstrumentError(head + e.what());
-  } catch (const TransportError& e) {
-    throw TransportError(e.kind(), head + e.what());
-  }
+  with_step_prefix("Red Pitaya, step '" + name + "': ", f);
 }
 
 void Session::configure(const std::string& name, const std::string& cmd) {

@@ -6,33 +6,15 @@
 #include <cstdlib>
 #include <cstring>
 
+#include "drivers/idn.hpp"
+
 namespace piezo::drivers::redpitaya {
 
-namespace {
-std::string_view trim(std::string_view s) {
-  while (!s.empty() && std::isspace(static_cast<unsigned char>(s.front()))) s.remove_prefix(1);
-  while (!s.empty() && std::isspace(static_cast<unsigned char>(s.back()))) s.remove_suffix(1);
-  return s;
-}
-bool iequals(std::string_view a, std::string_view b) {
-  if (a.size() != b.size()) return false;
-  for (std::size_t i = 0; i < a.size(); ++i)
-    if (std::toupper(static_cast<unsigned char>(a[i])) !=
-        std::toupper(static_cast<unsigned char>(b[i])))
-      return false;
-  return true;
-}
-}  // namespace
-
 bool accepts_idn(std::string_view idn) {
-  const auto c1 = idn.find(',');
-  if (c1 == std::string_view::npos) return false;
-  const auto c2 = idn.find(',', c1 + 1);
-  const auto model =
-      trim(idn.substr(c1 + 1, c2 == std::string_view::npos ? std::string_view::npos : c2 - c1 - 1));
-  if (!iequals(trim(idn.substr(0, c1)), "REDPITAYA")) return false;
+  const auto f = split_idn(idn);
+  if (!f || !iequals(f->maker, "REDPITAYA")) return false;
   for (auto m : kIdnModels)
-    if (iequals(model, m)) return true;
+    if (iequals(f->model, m)) return true;
   return false;
 }
 

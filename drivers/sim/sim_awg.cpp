@@ -5,20 +5,12 @@
 #include <cstdlib>
 #include <cstring>
 
+#include "drivers/sim/scpi_args.hpp"
+
 namespace piezo::drivers::sim {
 
 namespace {
-bool parse_num(const std::vector<std::string>& p, double* v) {
-  if (p.size() != 1) return false;
-  char* end = nullptr;
-  *v = std::strtod(p[0].c_str(), &end);
-  return end != p[0].c_str() && std::isfinite(*v);
-}
 bool is_on(const std::vector<std::string>& p) { return !p.empty() && (p[0] == "ON" || p[0] == "1"); }
-std::string upper(std::string s) {
-  for (auto& ch : s) ch = static_cast<char>(std::toupper(static_cast<unsigned char>(ch)));
-  return s;
-}
 }  // namespace
 
 // SIMulation:DUT TUBE | OPEN | SHORT | LOAD,<ohm>[,<farad>]   (simulator only)
@@ -57,13 +49,13 @@ void SimAwg::sim_dut(const scpi::Command& c, Reply& out) {
   }
   if (d.kind == K::Load) {
     double v = 0;
-    if (!parse_num({c.params[1]}, &v)) {
+    if (!parse_one({c.params[1]}, &v)) {
       push_error(-104, "Data type error; load resistance");
       return;
     }
     d.load_ohm = v;
     if (c.params.size() == 3) {
-      if (!parse_num({c.params[2]}, &v)) {
+      if (!parse_one({c.params[2]}, &v)) {
         push_error(-104, "Data type error; load capacitance");
         return;
       }
@@ -109,7 +101,7 @@ bool SimAwg::command(const scpi::Command& c, const scpi::ProgramMessage& msg, Re
     while (!name.empty() && (name.back() == '#' || name.back() == ' ')) name.pop_back();
     volatile_[name] = std::move(s);
   } else if (match("[SOURce#:]FUNCtion:ARBitrary:SRATe", c.header) && !c.query) {
-    if (!parse_num(c.params, &v) || v <= 0 || v > 250e6) push_error(-222, "Data out of range");
+    if (!parse_one(c.params, &v) || v <= 0 || v > 250e6) push_error(-222, "Data out of range");
     else a.arb_rate_hz = v;
   } else if (match("[SOURce#:]FUNCtion:ARBitrary", c.header) && !c.query) {
     auto it = c.params.empty() ? volatile_.end() : volatile_.find(upper(c.params[0]));
@@ -119,10 +111,10 @@ bool SimAwg::command(const scpi::Command& c, const scpi::ProgramMessage& msg, Re
     if (c.params.empty() || !upper(c.params[0]).starts_with("ARB"))
       push_error(-224, "Illegal parameter value; the simulator offers ARB only");
   } else if (match("[SOURce#:]VOLTage:OFFSet", c.header) && !c.query) {
-    if (!parse_num(c.params, &v)) push_error(-104, "Data type error");
+    if (!parse_one(c.params, &v)) push_error(-104, "Data type error");
     else a.offset_v = v;
   } else if (match("[SOURce#:]VOLTage[:AMPLitude]", c.header) && !c.query) {
-    if (!parse_num(c.params, &v) || v <= 0 || v > 20) push_error(-222, "Data out of range");
+    if (!parse_one(c.params, &v) || v <= 0 || v > 20) push_error(-222, "Data out of range");
     else a.vpp = v;
   } else if (match("OUTPut#:LOAD", c.header) || match("OUTPut:SYNC", c.header) ||
              match("[SOURce#:]BURSt:MODE", c.header) || match("[SOURce#:]BURSt:NCYCles", c.header)) {

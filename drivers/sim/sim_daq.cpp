@@ -5,20 +5,11 @@
 #include <cstring>
 
 #include "drivers/ieee488_block.hpp"
+#include "drivers/sim/scpi_args.hpp"
 
 namespace piezo::drivers::sim {
 
 namespace {
-bool parse_num(const std::vector<std::string>& p, double* v) {
-  if (p.size() != 1) return false;
-  char* end = nullptr;
-  *v = std::strtod(p[0].c_str(), &end);
-  return end != p[0].c_str() && std::isfinite(*v);
-}
-std::string upper(std::string s) {
-  for (auto& ch : s) ch = static_cast<char>(std::toupper(static_cast<unsigned char>(ch)));
-  return s;
-}
 std::string num(double v) {
   char buf[40];
   std::snprintf(buf, sizeof buf, "%.17g", v);
@@ -77,21 +68,21 @@ bool SimDaq::command(const scpi::Command& c, const scpi::ProgramMessage&, Reply&
     // accepted
   } else if (match("ACQuire:SRATe[:ANALog]", c.header)) {
     if (c.query) append(out, num(d.sample_rate_hz) + "\n");
-    else if (!parse_num(c.params, &v) || v <= 0 || v > 20e9) push_error(-222, "Data out of range");
+    else if (!parse_one(c.params, &v) || v <= 0 || v > 20e9) push_error(-222, "Data out of range");
     else d.sample_rate_hz = v;
   } else if (match("ACQuire:POINts[:ANALog]", c.header)) {
     if (c.query) append(out, std::to_string(d.points) + "\n");
-    else if (!parse_num(c.params, &v) || v < 16 || v > 10e6) push_error(-222, "Data out of range");
+    else if (!parse_one(c.params, &v) || v < 16 || v > 10e6) push_error(-222, "Data out of range");
     else d.points = static_cast<std::size_t>(v);
   } else if (match("CHANnel#:RANGe", c.header, &sfx)) {
     int ch = sfx.empty() ? 1 : sfx[0];
     if (ch < 1 || ch > 2) push_error(-114, "Header suffix out of range");
     else if (c.query) append(out, num(d.full_scale_v[ch - 1]) + "\n");
-    else if (!parse_num(c.params, &v) || v <= 0 || v > 40) push_error(-222, "Data out of range");
+    else if (!parse_one(c.params, &v) || v <= 0 || v > 40) push_error(-222, "Data out of range");
     else d.full_scale_v[ch - 1] = v;
   } else if (match("TIMebase:POSition", c.header)) {
     if (c.query) append(out, num(d.position_s) + "\n");
-    else if (!parse_num(c.params, &v)) push_error(-104, "Data type error");
+    else if (!parse_one(c.params, &v)) push_error(-104, "Data type error");
     else d.position_s = v;
   } else if (match("TRIGger:EDGE:SOURce", c.header) && !c.query) {
     d.aux_trigger = !c.params.empty() && upper(c.params[0]) == "AUX";

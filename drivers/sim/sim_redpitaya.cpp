@@ -7,22 +7,13 @@
 
 #include "drivers/ieee488_block.hpp"
 #include "drivers/redpitaya/protocol.hpp"
+#include "drivers/sim/scpi_args.hpp"
 
 namespace piezo::drivers::sim {
 
 namespace rp = piezo::drivers::redpitaya;
 
 namespace {
-bool parse_one(const std::vector<std::string>& p, double* v) {
-  if (p.size() != 1) return false;
-  char* end = nullptr;
-  *v = std::strtod(p[0].c_str(), &end);
-  return end != p[0].c_str() && std::isfinite(*v);
-}
-std::string upper(std::string s) {
-  for (auto& ch : s) ch = static_cast<char>(std::toupper(static_cast<unsigned char>(ch)));
-  return s;
-}
 std::string first(const std::vector<std::string>& p) { return p.empty() ? "" : upper(p[0]); }
 }  // namespace
 

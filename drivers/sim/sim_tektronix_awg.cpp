@@ -4,23 +4,13 @@
 #include <cstdlib>
 #include <stdexcept>
 
+#include "drivers/sim/scpi_args.hpp"
+
 namespace piezo::drivers::sim {
 
 namespace tek = piezo::drivers::tektronix_awg;
 
 namespace {
-bool parse_num(const std::string& p, double* v) {
-  char* end = nullptr;
-  *v = std::strtod(p.c_str(), &end);
-  return end != p.c_str() && std::isfinite(*v);
-}
-bool parse_one(const std::vector<std::string>& p, double* v) {
-  return p.size() == 1 && parse_num(p[0], v);
-}
-std::string upper(std::string s) {
-  for (auto& ch : s) ch = static_cast<char>(std::toupper(static_cast<unsigned char>(ch)));
-  return s;
-}
 bool is_on(const std::vector<std::string>& p) {
   return !p.empty() && (upper(p[0]) == "ON" || p[0] == "1");
 }
@@ -101,7 +91,7 @@ bool SimTektronixAwg::waveform_list(const scpi::Command& c, const scpi::ProgramM
       append(out, "\"" + order_[static_cast<std::size_t>(v)] + "\"\n");
     }
   } else if (match("WLISt:WAVeform:NEW", c.header) && !c.query) {
-    if (p.size() != 3 || !unquote(p[0], &name) || !parse_num(p[1], &v)) {
+    if (p.size() != 3 || !unquote(p[0], &name) || !parse_number(p[1], &v)) {
       push_error(-109, "Missing parameter; WLIST:WAVEFORM:NEW \"name\",<size>,REAL");
     } else if (list_.count(name)) {
       push_error(-224, "Illegal parameter value; waveform \"" + name + "\" already exists");
@@ -127,8 +117,8 @@ bool SimTektronixAwg::waveform_list(const scpi::Command& c, const scpi::ProgramM
     }
     auto pts = tek::decode_real_points(msg.block);
     double start = 0, size = pts ? static_cast<double>(pts->values.size()) : 0;
-    if (!pts || (p.size() >= 2 && !parse_num(p[1], &start)) ||
-        (p.size() == 3 && !parse_num(p[2], &size))) {
+    if (!pts || (p.size() >= 2 && !parse_number(p[1], &start)) ||
+        (p.size() == 3 && !parse_number(p[2], &size))) {
       push_error(-104, "Data type error; REAL data is 5 bytes per point");
       return true;
     }

@@ -38,14 +38,7 @@ Driver::Driver(std::unique_ptr<Transport> t) : scpi_(std::move(t)) {
 }
 
 void Driver::step(const std::string& name, const std::function<void()>& f) {
-  const std::string head = "Tektronix AWG, step '" + name + "': ";
-  try {
-    f();
-  } catch (const InstrumentError& e) {
-    throw InstrumentError(head + e.what());
-  } catch (const TransportError& e) {
-    throw TransportError(e.kind(), head + e.what());
-  }
+  with_step_prefix("Tektronix AWG, step '" + name + "': ", f);
 }
 
 void Driver::configure(const std::string& name, const std::string& cmd) {

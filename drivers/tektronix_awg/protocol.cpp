@@ -4,32 +4,15 @@
 #include <cctype>
 #include <cstring>
 
+#include "drivers/idn.hpp"
+
 namespace piezo::drivers::tektronix_awg {
 
-namespace {
-std::string_view trim(std::string_view s) {
-  while (!s.empty() && std::isspace(static_cast<unsigned char>(s.front()))) s.remove_prefix(1);
-  while (!s.empty() && std::isspace(static_cast<unsigned char>(s.back()))) s.remove_suffix(1);
-  return s;
-}
-bool iequals(std::string_view a, std::string_view b) {
-  return a.size() == b.size() && std::equal(a.begin(), a.end(), b.begin(), [](char x, char y) {
-           return std::toupper(static_cast<unsigned char>(x)) ==
-                  std::toupper(static_cast<unsigned char>(y));
-         });
-}
-}  // namespace
-
 const Model* find_model(std::string_view idn) {
-  const auto c1 = idn.find(',');
-  if (c1 == std::string_view::npos) return nullptr;
-  const auto c2 = idn.find(',', c1 + 1);
-  const std::string_view maker = trim(idn.substr(0, c1));
-  const std::string_view model =
-      trim(idn.substr(c1 + 1, c2 == std::string_view::npos ? std::string_view::npos : c2 - c1 - 1));
-  if (!iequals(maker, "TEKTRONIX")) return nullptr;
+  const auto f = split_idn(idn);
+  if (!f || !iequals(f->maker, "TEKTRONIX")) return nullptr;
   for (const auto& m : kModels)
-    if (m.idn_model == model) return &m;
+    if (m.idn_model == f->model) return &m;
   return nullptr;
 }
 

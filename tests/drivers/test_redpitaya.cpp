@@ -22,6 +22,7 @@
 #include "drivers/sim/tcp_server.hpp"
 #include "drivers/tcp_transport.hpp"
 #include "tests/support/rc_physics.hpp"
+#include "tests/support/scpi_link.hpp"
 
 using namespace piezo;
 using namespace piezo::drivers;
@@ -160,41 +161,16 @@ constexpr double kR1 = 3140.0, kC = 2.1e-9;
 constexpr double kRate = 15.625e6;  // 125 MS/s / 8: a rate both paths sample at
 
 std::shared_ptr<sim::SimBench> bench(std::uint64_t seed, double noise = 0.03) {
-  sim::DaqImperfections imp;
-  imp.noise_rel[0] = imp.noise_rel[1] =
-      noise;  // seeded: equality also checks the RNG stays in step
-  return std::make_shared<sim::SimBench>(std::make_unique<test::RcPhysics>(kR1, kC), imp, seed);
+  return test::rc_bench(seed, noise, kR1, kC);
 }
 
-struct Link {
-  std::unique_ptr<sim::TcpServer> server;
-  std::unique_ptr<Transport> transport;
-};
-
+using Link = test::ScpiLink;
 Link connect(const std::string& kind, std::shared_ptr<sim::ScpiDevice> dev) {
-  Link l;
-  if (kind == "loopback") {
-    l.transport = std::make_unique<sim::LoopbackTransport>(std::move(dev), "loop://rp");
-  } else {
-    l.server = std::make_unique<sim::TcpServer>(std::move(dev), "127.0.0.1", 0);
-    l.server->start();
-    l.transport = std::make_unique<TcpTransport>("127.0.0.1", l.server->port(),
-                                                 std::chrono::milliseconds(400));
-  }
-  return l;
+  return test::connect_link(kind, std::move(dev), "loop://rp");
 }
 
 ArbWaveform seeded_waveform(std::uint64_t seed, std::size_t n) {
-  std::mt19937_64 rng(seed);
-  std::normal_distribution<double> g(0.0, 1.0);
-  ArbWaveform w;
-  w.samples.resize(n);
-  double peak = 0;
-  for (auto& x : w.samples) peak = std::max(peak, std::fabs(x = g(rng)));
-  for (auto& x : w.samples) x /= peak;
-  w.sample_rate_hz = kRate;
-  w.peak_v = 0.7;
-  return w;
+  return test::seeded_waveform(seed, n, kRate, 0.7);
 }
 
 DaqConfig daq_config(std::size_t n, double rate = kRate) {

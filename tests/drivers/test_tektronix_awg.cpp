@@ -22,6 +22,7 @@
 #include "drivers/tcp_transport.hpp"
 #include "drivers/tektronix_awg/driver.hpp"
 #include "tests/support/rc_physics.hpp"
+#include "tests/support/scpi_link.hpp"
 
 using namespace piezo;
 using namespace piezo::drivers;
@@ -129,46 +130,15 @@ class FaultyTek : public sim::SimTektronixAwg {
 
 constexpr double kR1 = 3140.0, kC = 2.1e-9;
 
-std::shared_ptr<sim::SimBench> bench(std::uint64_t seed) {
-  sim::DaqImperfections imp;
-  imp.noise_rel[0] = imp.noise_rel[1] =
-      0.03;  // seeded noise: equality also checks the RNG stays in step
-  return std::make_shared<sim::SimBench>(std::make_unique<test::RcPhysics>(kR1, kC), imp, seed);
-}
+std::shared_ptr<sim::SimBench> bench(std::uint64_t seed) { return test::rc_bench(seed, 0.03, kR1, kC); }
 
-// One instrument behind a transport of the kind under test. The server (TCP)
-// outlives the transport, which the driver owns.
-struct Link {
-  std::unique_ptr<sim::TcpServer> server;
-  std::unique_ptr<Transport> transport;
-};
-
+using Link = test::ScpiLink;
 Link connect(const std::string& kind, std::shared_ptr<sim::ScpiDevice> dev) {
-  Link l;
-  if (kind == "loopback") {
-    l.transport = std::make_unique<sim::LoopbackTransport>(std::move(dev), "loop://tek");
-  } else {
-    l.server = std::make_unique<sim::TcpServer>(std::move(dev), "127.0.0.1", 0);
-    l.server->start();
-    // Short: the timeout case waits it out once.
-    l.transport = std::make_unique<TcpTransport>("127.0.0.1", l.server->port(),
-                                                 std::chrono::milliseconds(400));
-  }
-  return l;
+  return test::connect_link(kind, std::move(dev), "loop://tek");
 }
 
-// A seeded drive: a noise burst normalised to peak 1 (every float32 bit pattern matters).
 ArbWaveform seeded_waveform(std::uint64_t seed, std::size_t n) {
-  std::mt19937_64 rng(seed);
-  std::normal_distribution<double> g(0.0, 1.0);
-  ArbWaveform w;
-  w.samples.resize(n);
-  double peak = 0;
-  for (auto& x : w.samples) peak = std::max(peak, std::fabs(x = g(rng)));
-  for (auto& x : w.samples) x /= peak;
-  w.sample_rate_hz = 1e7;
-  w.peak_v = 0.8;
-  return w;
+  return test::seeded_waveform(seed, n, 1e7, 0.8);
 }
 
 DaqConfig daq_config() {
