@@ -4,6 +4,7 @@
 #include <poll.h>
 #include <signal.h>
 #include <sys/prctl.h>
+#include <sys/resource.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -12,6 +13,7 @@
 #include <chrono>
 #include <cstdio>
 #include <cstring>
+#include <fstream>
 #include <mutex>
 #include <string>
 
@@ -67,6 +69,31 @@ std::string describe_signal(int sig) {
   return s;
 }
 
+#if defined(__SANITIZE_ADDRESS__)
+#define PIEZO_UNDER_ASAN 1
+#elif defined(__has_feature)
+#if __has_feature(address_sanitizer)
+#define PIEZO_UNDER_ASAN 1
+#endif
+#endif
+
+void limit_memory_for_capture(std::uintmax_t file_bytes) {
+#ifdef PIEZO_UNDER_ASAN
+  (void)file_bytes;
+#else
+  std::uintmax_t pages = 0;  // the process's present virtual size (first field of statm)
+  if (std::ifstream statm("/proc/self/statm"); !(statm >> pages)) return;
+  const std::uintmax_t page = static_cast<std::uintmax_t>(::sysconf(_SC_PAGESIZE));
+  const std::uintmax_t kBase = std::uintmax_t{2} << 30, kMax = std::uintmax_t{1} << 46;
+  const std::uintmax_t per_file = file_bytes > kMax / 4400 ? kMax : 4400 * file_bytes;
+  const std::uintmax_t cap = std::min(kMax, pages * page + kBase + per_file);
+  rlimit r{};
+  if (::getrlimit(RLIMIT_AS, &r) != 0) return;
+  r.rlim_cur = r.rlim_max == RLIM_INFINITY ? cap : std::min<rlim_t>(cap, r.rlim_max);
+  ::setrlimit(RLIMIT_AS, &r);
+#endif
+}
+
 void probe_capture(const std::filesystem::path& path, const ContainedReadOptions& opt) {
   const std::string file = path.string();
   int fds[2];
@@ -82,6 +109,9 @@ void probe_capture(const std::filesystem::path& path, const ContainedReadOptions
       ::prctl(PR_SET_PDEATHSIG, SIGKILL);  // dies with its parent
       h5::renew_h5_mutex_in_forked_child();
       ::close(fds[0]);
+      std::error_code ec;
+      const auto size = std::filesystem::file_size(path, ec);
+      limit_memory_for_capture(ec ? 0 : size);
       child_read(path, opt.read, fds[1]);
     }
   }

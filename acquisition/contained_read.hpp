@@ -17,6 +17,7 @@
 // the library is consistent; the child renews its copy of the lock (which names
 // the parent's thread) before it reads, and ends with _exit (no atexit
 // handlers: it never flushes or closes anything the parent has open).
+#include <cstdint>
 #include <filesystem>
 
 #include "acquisition/capture.hpp"
@@ -38,6 +39,20 @@ void probe_capture(const std::filesystem::path& file, const ContainedReadOptions
 // probe_capture, then read_capture in this process.
 Capture read_capture_contained(const std::filesystem::path& file,
                                const ContainedReadOptions& opt = {});
+
+// Caps this process's address space (RLIMIT_AS, soft limit) at its present
+// size plus what reading and processing a capture file of `file_bytes` can
+// legitimately need: 2 GiB for the work itself, plus 4400 × the file (samples
+// stored down to 1/1100 when compressed, the reader's own bound, as doubles
+// beside their float32 copy). For the processes that contain a read (the probe
+// child, the replay workers): a damaged variable-length string whose stored
+// length says gigabytes made libhdf5 allocate and clear 22 GB for a 67 kB file
+// (90 s, the machine nearly out of memory); under the cap the allocation fails
+// at once and the file is refused with libhdf5's "memory allocation failed".
+// The hard limit is not touched, so a later, larger file raises the cap again.
+// No-op under AddressSanitizer, whose shadow memory reserves terabytes of
+// address space.
+void limit_memory_for_capture(std::uintmax_t file_bytes);
 
 // Turns a child's end (waitpid status) into words: "SIGSEGV (segmentation fault)".
 std::string describe_signal(int signal_number);

@@ -374,6 +374,11 @@ class WorkerPool {
           const std::string f = frame('S', std::string(what) + '\0' + sha);
           write_all(result_fd, f.data(), f.size());
         };
+        // A damaged file must not take the machine's memory (contained_read.hpp);
+        // twice its size for a held-out partner beside it.
+        std::error_code ec;
+        const auto size = std::filesystem::file_size(files_[i], ec);
+        acq::limit_memory_for_capture(ec ? 0 : 2 * size);
         const Outcome o = replay_capture(files_[i], opt_, sink_, cancel_, stage);
         const std::string f = frame('O', encode_outcome(o));
         write_all(result_fd, f.data(), f.size());
