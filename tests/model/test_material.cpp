@@ -2,6 +2,7 @@
 // §6.4.3 against the numbers printed in seed ch. 7, presets, validation.
 #include <gtest/gtest.h>
 
+#include <Eigen/LU>
 #include <cmath>
 
 #include "model/material.hpp"
@@ -136,4 +137,51 @@ TEST(Material, PreconditionsThrowWithFunctionName) {
   MaterialLosses l;
   l.qm = -1;
   EXPECT_THROW(l.validate(), std::invalid_argument);
+}
+
+// Seed eqs 106-110: the axisymmetric element's e-form from the REDUCED d-form
+// (strains S1, S2, S3, S5 and fields E1, E3 only; S4 = S6 = E2 = 0, eqs 97-101)
+// by A = P⁻¹Q (eq. 109). Its cE block (eq. 110) equals the 3-D cE of the full
+// 6×6 inversion (eq. 8), and so do e and εS: for the 4mm class the dropped set
+// {S4, E2} (coupled by d24 = d15) and {S6} are decoupled from the kept one in
+// sE, d and εT, so the partial inversion acts block by block. The seed's remark
+// after eq. 110 ("the cij of the 2D formulation differ from the 3D ones") does
+// not hold for this reduction; it would for a plane-stress or plane-strain
+// reduction (see model/README.md). Tolerance 1e-12: two 6×6 solves, condition ~10.
+TEST(Material, AxisymmetricReducedEFormEqualsThe3dOne) {
+  for (const auto& p : material_presets()) {
+    const auto& d = p.material;
+    Eigen::Matrix<double, 6, 6> pm, qm;  // eq. 107: P·[T1 T2 T3 T5 D1 D3] = Q·[S1 S2 S3 S5 E1 E3]
+    pm << d.s_e11, d.s_e12, d.s_e13, 0, 0, 0,  //
+        d.s_e12, d.s_e11, d.s_e13, 0, 0, 0,    //
+        d.s_e13, d.s_e13, d.s_e33, 0, 0, 0,    //
+        0, 0, 0, d.s_e44, 0, 0,                //
+        0, 0, 0, -d.d15, 1, 0,                 //
+        -d.d31, -d.d31, -d.d33, 0, 0, 1;
+    qm << 1, 0, 0, 0, 0, -d.d31,  //
+        0, 1, 0, 0, 0, -d.d31,    //
+        0, 0, 1, 0, 0, -d.d33,    //
+        0, 0, 0, 1, -d.d15, 0,    //
+        0, 0, 0, 0, d.eps_t11, 0, //
+        0, 0, 0, 0, 0, d.eps_t33;
+    const Eigen::Matrix<double, 6, 6> a = pm.partialPivLu().solve(qm);  // eq. 109
+    const auto e = to_e_form(d);
+    // T = cE S − eᵀE, D = e S + εS E (eqs 1-2) in the order (1, 2, 3, 5 | 1, 3).
+    EXPECT_LT(rel(a(0, 0), e.c_e11), 1e-12) << p.name;
+    EXPECT_LT(rel(a(1, 1), e.c_e11), 1e-12) << p.name;
+    EXPECT_LT(rel(a(0, 1), e.c_e12), 1e-12) << p.name;
+    EXPECT_LT(rel(a(0, 2), e.c_e13), 1e-12) << p.name;
+    EXPECT_LT(rel(a(2, 2), e.c_e33), 1e-12) << p.name;
+    EXPECT_LT(rel(a(3, 3), e.c_e44), 1e-12) << p.name;
+    EXPECT_LT(rel(a(5, 0), e.e31), 1e-12) << p.name;
+    EXPECT_LT(rel(-a(0, 5), e.e31), 1e-12) << p.name;
+    EXPECT_LT(rel(a(5, 2), e.e33), 1e-12) << p.name;
+    EXPECT_LT(rel(a(5, 5), e.eps_s33), 1e-12) << p.name;
+    if (d.d15 != 0) {
+      EXPECT_LT(rel(a(4, 3), e.e15), 1e-12) << p.name;
+      EXPECT_LT(rel(a(4, 4), e.eps_s11), 1e-12) << p.name;
+    }
+    // No coupling between the shear and the normal block (the 0s of eq. 110).
+    EXPECT_LT(std::abs(a(0, 3)) + std::abs(a(2, 3)), 1e-12 * e.c_e11) << p.name;
+  }
 }
