@@ -298,14 +298,29 @@ dsp::ImpedanceResult estimate(const acq::Capture& cap, bool refine_features, Pip
   return prony;
 }
 
+// κ/ω² of the port model's symmetric mode nearest f (1 without a model): the
+// modal damping is α + βκ, not α + βω² (update/rayleigh.hpp).
+double kappa_ratio_near(const model::ModalPortModel* port, double f_hz) {
+  if (!port) return 1.0;
+  const model::PortMode* best = nullptr;
+  for (const auto& m : port->modes)
+    if (m.symmetric && !m.residual &&
+        (!best || std::abs(m.omega - 2 * M_PI * f_hz) < std::abs(best->omega - 2 * M_PI * f_hz)))
+      best = &m;
+  return best && best->omega > 0 ? best->kappa / (best->omega * best->omega) : 1.0;
+}
+
 // Rayleigh damping of the model curves from the damping ratios of the zeros of
-// Z(s) at the first two resonances (the short-circuit modes; eqs 168-169); the
-// seed's β = 1e-7 s when that fails.
-model::RayleighDamping damping_from_features(const dsp::ImpedanceResult& z, PipelineResult& out) {
+// Z(s) at the first two resonances (the short-circuit modes; eqs 168-169 with
+// the model's κ/ω² of those modes); the seed's β = 1e-7 s when that fails.
+model::RayleighDamping damping_from_features(const dsp::ImpedanceResult& z, PipelineResult& out,
+                                             const model::ModalPortModel* port) {
   model::RayleighDamping d{0.0, 1e-7};
   const auto& r = z.features.resonances;
   if (r.size() < 2 || !std::isfinite(r[0].damping_ratio) || !std::isfinite(r[1].damping_ratio)) return d;
-  auto fit = update::rayleigh_from_damping(r[0].f_hz, r[0].damping_ratio, r[1].f_hz, r[1].damping_ratio);
+  auto fit = update::rayleigh_from_damping(r[0].f_hz, r[0].damping_ratio, r[1].f_hz, r[1].damping_ratio,
+                                           kappa_ratio_near(port, r[0].f_hz),
+                                           kappa_ratio_near(port, r[1].f_hz));
   if (!fit.ok) {
     out.warnings.push_back("Rayleigh damping from the resonances refused (" + fit.message +
                            "); model curves use beta = 1e-7 s");
@@ -812,7 +827,10 @@ PipelineResult run_pipeline(const PipelineRequest& req, const std::function<void
     else u.first_resonance_hz = first_active_mode_hz(*cm.solver, cm.cls.e_form(oe->updated));
   } else if (seed.chosen.ok) {
     u = seed.chosen;
-    u.damping = damping_from_features(*z, out);
+    model::ModalOptions mo;
+    mo.n_modes = 16;
+    const auto port = cm.solver->port_model(cm.cls.e_form(u.updated), mo);
+    u.damping = damping_from_features(*z, out, &port);
     out.warnings.push_back(std::string("the output-error fit did not converge: the seed's chain (") +
                            (u.method == "cmcm" ? "extended CMCM" : "least squares on features") +
                            ") is used, without sigma");

@@ -15,7 +15,9 @@
 // piezoelectric stiffening, so κ_k = ω_k²·(1 − share): κ_k/ω_k² = 0.99969 and 0.99100
 // for the first two APC850 modes. Eqs 168-169 on the EXACT modal ξ_k then
 // return α = +777 1/s and β = 9.22e-8 s (−7.8 %), not (0, 1e-7): two modes
-// 6 % apart amplify mode 2's −0.9 % by 2ω/Δω ≈ 33. That test fails on purpose.
+// 6 % apart amplify mode 2's −0.9 % by 2ω/Δω ≈ 33. rayleigh_from_damping now
+// takes the model's κ_k/ω_k² (2ω_kξ_k = α + βκ_k), and the pipeline passes
+// them; the test checks both: the seed's form misses, the model's form is exact.
 //
 // Tolerances. Eqs 168-169 amplify errors of the damping ratios:
 // δβ = 2(ω2δξ2 − ω1δξ1)/(ω2² − ω1²), δα = 2ω1ω2(ω2δξ1 − ω1δξ2)/(ω2² − ω1²);
@@ -127,7 +129,7 @@ TEST(SimRayleighDamping, PronyDampingOfTheResonancesAndTheRayleighPair) {
 // The inversion itself, with no estimation: the port model's exact (ω_k, ξ_k)
 // of the first two active modes through eqs 168-169 must give back the
 // bench's α = 0, β = 1e-7 s (rounding only: 1e-9 relative on β, and |α| below
-// 1e-9·βω² ≈ 1e-2 1/s). FAILS: see the header (κ_k ≠ ω_k²).
+// 1e-9·βω² ≈ 1e-2 1/s) once κ_k/ω_k² is given; without it, the header's miss.
 TEST(SimRayleighDamping, EqsOneSixEightNineOnExactModalDampingGiveTheBenchsPair) {
   acq::SimSpec spec;
   const auto port = test::sim_port(spec);
@@ -138,7 +140,16 @@ TEST(SimRayleighDamping, EqsOneSixEightNineOnExactModalDampingGiveTheBenchsPair)
       std::printf("mode %.2f Hz: kappa/omega^2 = %.5f, xi = %.6f, beta*omega/2 = %.6f\n", m.omega / kTwoPi,
                   m.kappa / (m.omega * m.omega), (spec.damping.beta * m.kappa) / (2 * m.omega),
                   spec.damping.beta * m.omega / 2);
-  const auto fit = update::rayleigh_from_damping(m1.omega / kTwoPi, m1.xi, m2.omega / kTwoPi, m2.xi);
+  double r1 = 1, r2 = 1;
+  for (const auto& m : port.modes) {
+    if (std::abs(m.omega - m1.omega) < 1) r1 = m.kappa / (m.omega * m.omega);
+    if (std::abs(m.omega - m2.omega) < 1) r2 = m.kappa / (m.omega * m.omega);
+  }
+  const auto seed_form = update::rayleigh_from_damping(m1.omega / kTwoPi, m1.xi, m2.omega / kTwoPi, m2.xi);
+  std::printf("seed's eq. 167 (kappa = omega^2): alpha %.4g 1/s, beta %.5g s (%+.3e relative)\n",
+              seed_form.damping.alpha, seed_form.damping.beta, seed_form.damping.beta / spec.damping.beta - 1.0);
+  EXPECT_GT(std::abs(seed_form.damping.beta / spec.damping.beta - 1.0), 0.01);  // the miss is real
+  const auto fit = update::rayleigh_from_damping(m1.omega / kTwoPi, m1.xi, m2.omega / kTwoPi, m2.xi, r1, r2);
   std::printf("measured: alpha %.4g 1/s, beta %.5g s (%+.3e relative)\n", fit.damping.alpha, fit.damping.beta,
               fit.damping.beta / spec.damping.beta - 1.0);
   EXPECT_NEAR(fit.damping.beta, spec.damping.beta, 1e-9 * spec.damping.beta);
