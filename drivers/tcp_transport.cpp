@@ -78,9 +78,12 @@ void TcpTransport::send(std::span<const std::uint8_t> bytes) {
     ssize_t n = ::send(fd_, bytes.data() + off, bytes.size() - off, MSG_NOSIGNAL);
     if (n < 0) {
       if (errno == EAGAIN || errno == EINTR) continue;
-      auto kind = (errno == EPIPE || errno == ECONNRESET) ? TransportError::Kind::Closed
-                                                          : TransportError::Kind::Io;
-      throw TransportError(kind, address() + ": send: " + errno_text());
+      // A peer that closed with our bytes unread answers with a reset (EPIPE or
+      // ECONNRESET, which of them depends on timing): the same event as a clean close.
+      if (errno == EPIPE || errno == ECONNRESET)
+        throw TransportError(TransportError::Kind::Closed,
+                             address() + ": instrument closed the connection (send: " + errno_text() + ")");
+      throw TransportError(TransportError::Kind::Io, address() + ": send: " + errno_text());
     }
     off += static_cast<std::size_t>(n);
   }
@@ -103,8 +106,12 @@ std::size_t TcpTransport::receive(std::uint8_t* buf, std::size_t max, bool* eom)
       throw TransportError(TransportError::Kind::Closed, address() + ": instrument closed the connection");
     if (n < 0) {
       if (errno == EAGAIN || errno == EINTR) continue;
-      auto kind = errno == ECONNRESET ? TransportError::Kind::Closed : TransportError::Kind::Io;
-      throw TransportError(kind, address() + ": recv: " + errno_text());
+      // A close with unread data in the peer's buffer arrives as a reset rather
+      // than EOF (timing decides): the same event, the same words.
+      if (errno == ECONNRESET)
+        throw TransportError(TransportError::Kind::Closed,
+                             address() + ": instrument closed the connection (recv: " + errno_text() + ")");
+      throw TransportError(TransportError::Kind::Io, address() + ": recv: " + errno_text());
     }
     return static_cast<std::size_t>(n);
   }
