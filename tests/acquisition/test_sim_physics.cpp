@@ -13,22 +13,13 @@
 #include "model/modal.hpp"
 #include "model/transient.hpp"
 #include "model/tube_model.hpp"
+#include "tests/support/apc850_port.hpp"
 
 using namespace piezo;
 using cd = std::complex<double>;
 
 namespace {
-const model::ModalPortModel& apc850_port() {
-  static const model::ModalPortModel port = [] {
-    model::TubeGeometry g;
-    model::TubeModel tube(g);
-    model::ModalSolver solver(tube);
-    model::ModalOptions mo;
-    mo.n_modes = 24;
-    return solver.port_model(model::to_e_form(model::find_preset("apc850").material), mo);
-  }();
-  return port;
-}
+using test::apc850_port;
 model::RayleighDamping beta7() { return {0.0, 1e-7}; }
 
 cd tube_z(double w) {  // Z = V/I = 1/(jω·Q/V)

@@ -15,6 +15,7 @@
 #include "model/material_presets.hpp"
 #include "model/modal.hpp"
 #include "model/tube_model.hpp"
+#include "tests/support/apc850_port.hpp"
 
 namespace {
 using namespace piezo;
@@ -244,17 +245,7 @@ struct FePort {
   model::RayleighDamping damping;
 };
 
-const model::ModalPortModel& apc850_port() {
-  static const model::ModalPortModel port = [] {
-    model::TubeGeometry g;
-    model::TubeModel tube(g);
-    model::ModalSolver solver(tube);
-    model::ModalOptions mo;
-    mo.n_modes = 24;
-    return solver.port_model(model::to_e_form(model::find_preset("apc850").material), mo);
-  }();
-  return port;
-}
+using test::apc850_port;
 
 struct FeTol {
   double fs, k2, c1;
