@@ -47,6 +47,8 @@ void BM_OneShotDiagnosis(benchmark::State& state, const std::string& which, bool
     }
     benchmark::DoNotOptimize(d);
     state.counters["fe_models_fit"] = fit.evaluations;
+    for (const auto& e : fit.effects)
+      if (e.fe_models > 0) state.counters["fe_" + e.name] = e.fe_models;
   }
 }
 BENCHMARK_CAPTURE(BM_OneShotDiagnosis, control_12, std::string("12"), false)->Unit(benchmark::kMillisecond)->Iterations(1);

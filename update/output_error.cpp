@@ -926,7 +926,7 @@ OeResult fit_output_error(model::ModalSolver& solver, const MaterialClass& cls,
         break;
       }
       strict = false;
-      if (lead && lead->jtj.rows() == kParams) {
+      if (lead && lead->jtj.rows() == x.size() && lead->x.size() == x.size()) {
         const Eigen::VectorXd dx = x - lead->x;
         const double gap = cost - lead->cost;
         if (gap >= 0 && dx.dot(lead->jtj * dx) < 9.0) {
@@ -1238,6 +1238,7 @@ OeResult fit_output_error(model::ModalSolver& solver, const MaterialClass& cls,
     const auto& apply = coord->apply;
     const auto& value = coord->value;
     OeEffect e;
+    const int models_before = prob.evaluations();
     e.name = name;
     e.typical = name == "daq_input_resistance" ? 1.0 / typical : typical;
     e.unit = info->unit;
@@ -1307,13 +1308,20 @@ OeResult fit_output_error(model::ModalSolver& solver, const MaterialClass& cls,
       LmOutcome exact = levenberg_marquardt(run.x, nullptr);
       if (exact.converged || exact.cost < run.cost) run = std::move(exact);
     }
-    if (name == "mass_loading" && out.lack_of_fit)
+    if (name == "mass_loading" && out.lack_of_fit) {
+      // The later starts stop once inside the best one's optimum or stalled
+      // far above it (levenberg_marquardt's lead test, on the six).
+      finish(run);
       for (double start : {2.0, 4.0}) {
         Eigen::VectorXd xs = x0;
         xs[kParams] = start;
-        LmOutcome other = levenberg_marquardt(xs, nullptr);
-        if (other.cost < run.cost) run = std::move(other);
+        LmOutcome other = levenberg_marquardt(xs, &run);
+        if (other.cost < run.cost) {
+          run = std::move(other);
+          finish(run);
+        }
       }
+    }
     // Dielectric loss: the FE convention (a constant complex εT33) and the
     // causal constant-phase law differ by ε' falling ~1.5·tanδ per decade —
     // at 1 % noise a misfit of its own; the capture chooses.
@@ -1338,6 +1346,7 @@ OeResult fit_output_error(model::ModalSolver& solver, const MaterialClass& cls,
         fx.dielectric_constant_phase = true;
       };
     fill(e, rf);
+    e.fe_models = prob.evaluations() - models_before;
     out.effects.push_back(e);
     refits.push_back(std::move(rf));
   }
@@ -1356,6 +1365,7 @@ OeResult fit_output_error(model::ModalSolver& solver, const MaterialClass& cls,
     if (order.size() > 2) order.resize(2);
     for (Refit* rf : order) {
       prob.free_effect(rf->apply);
+      const int models_before = prob.evaluations();
       Eigen::VectorXd xg_best;
       double cg_best = INFINITY;
       for (int a = -1; a <= 1; ++a)
@@ -1370,11 +1380,13 @@ OeResult fit_output_error(model::ModalSolver& solver, const MaterialClass& cls,
           if (cg < cg_best) cg_best = cg, xg_best = xg;
         }
       if (!std::isfinite(cg_best)) continue;
-      LmOutcome other = levenberg_marquardt(xg_best, nullptr);
+      // (fill() has finished the run: it leads, as the first start leads the five's later ones.)
+      LmOutcome other = levenberg_marquardt(xg_best, &rf->run);
       if (other.cost < rf->run.cost) {
         rf->run = std::move(other);
         fill(out.effects[rf->index], *rf);
       }
+      out.effects[rf->index].fe_models += prob.evaluations() - models_before;
     }
   }
   prob.free_effect({});

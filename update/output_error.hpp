@@ -149,6 +149,7 @@ struct OeEffect {
   // "frequency-independent" (εT33·(1 − j·tanδ), the FE convention) or
   // "constant-phase" (causal, ε' falling with frequency).
   std::string law;
+  int fe_models = 0;  // FE port models its scan built (the refit, both laws, the extra starts)
 };
 
 struct OeParameter {
