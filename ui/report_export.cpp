@@ -124,10 +124,21 @@ nlohmann::json diagnosis_json(const update::GapDiagnosis& d) {
   j["material_base"] = {{"YE11", d.material_base.y_e11}, {"nu12", d.material_base.nu12}, {"d31", d.material_base.d31},
                         {"epsT33_rel", d.material_base.eps_t33 / model::kEps0}};
   j["regions"] = nlohmann::json::array();
-  for (const auto& g : d.regions)
-    j["regions"].push_back({{"name", g.name}, {"f_lo_hz", g.f_lo_hz}, {"f_hi_hz", g.f_hi_hz}, {"points", g.points},
-                            {"chi2", g.chi2}, {"share", g.share}, {"kind", g.kind}, {"shift_pct", g.shift_pct},
-                            {"width_pct", g.width_pct}, {"level_db", g.level_db}, {"phase_deg", g.phase_deg}});
+  for (const auto& g : d.regions) {
+    nlohmann::json rj = {{"name", g.name}, {"f_lo_hz", g.f_lo_hz}, {"f_hi_hz", g.f_hi_hz}, {"points", g.points},
+                         {"chi2", g.chi2}, {"share", g.share}, {"kind", g.kind}, {"shift_pct", g.shift_pct},
+                         {"width_pct", g.width_pct}, {"level_db", g.level_db}, {"phase_deg", g.phase_deg}};
+    if (!g.description.empty()) {  // the output-error diagnosis's regions
+      rj["description"] = g.description;
+      rj["log10_p"] = g.log10_p;
+      rj["delay_s"] = g.delay_s;
+      rj["resonance"] = nullptr;
+      if (g.resonance)
+        rj["resonance"] = {{"f_hz", g.resonance->f_hz}, {"q", g.resonance->q}, {"k_eff", g.resonance->k_eff},
+                           {"c_f", g.resonance->c_f}, {"delta_chi2", g.resonance->delta_chi2}};
+    }
+    j["regions"].push_back(rj);
+  }
   auto eff = [&](const update::EffectReport& e) {
     nlohmann::json r = {{"name", e.name}, {"unit", e.unit}, {"alias", e.alias}, {"alias_residual", e.alias_residual},
                         {"detectability", e.detectability}, {"typical", e.typical},

@@ -49,6 +49,26 @@ GapDiagnosis build(const OeResult& r, const std::string& fit_description, const 
   d.fit_description = fit_description + "; output-error residual, noise from " + r.noise_source;
   d.material_base = r.updated;
   d.damping_base = r.damping;
+  // Where the residual stands above the noise (a lack of fit only).
+  for (std::size_t i = 0; i < r.regions.size(); ++i) {
+    const ResidualRegion& g = r.regions[i];
+    GapRegion rg;
+    rg.name = "residual region " + std::to_string(i + 1);
+    rg.f_lo_hz = g.f_lo_hz;
+    rg.f_hi_hz = g.f_hi_hz;
+    rg.points = g.bins;
+    rg.chi2 = g.chi2;
+    rg.share = g.share;
+    rg.excess = g.chi2 - 2.0 * g.bins;
+    rg.kind = g.kind;
+    rg.level_db = 20.0 * std::log10(std::max(1e-6, 1.0 + g.level_pct / 100.0));
+    rg.phase_deg = g.phase_deg;
+    rg.log10_p = g.log10_p;
+    rg.delay_s = g.delay_s;
+    rg.resonance = g.resonance;
+    rg.description = g.description;
+    d.regions.push_back(rg);
+  }
   // g = √max(0, χ²/N − 1): the excess over the noise.
   const double g_before = std::sqrt(std::max(0.0, r.chi2_per_dof - 1.0));
   const OeEffect* top = nullptr;
@@ -233,7 +253,17 @@ GapDiagnosis build(const OeResult& r, const std::string& fit_description, const 
                     "Unexplained gap in %.3g-%.3g kHz (residual %.3g times the noise there, chance 1e%.1f): no effect "
                     "of the catalogue explains it.",
                     r.band_lo_hz / 1e3, r.band_hi_hz / 1e3, r.band_excess, r.band_log10_p);
-    d.verdict = buf + near + heldout_note;
+    std::string where;
+    for (std::size_t i = 0; i < d.regions.size(); ++i)
+      where += (i == 0 ? " The residual stands above the noise in " : "; and in ") + d.regions[i].description;
+    if (!where.empty()) where += ".";
+    for (const auto& g : d.regions)
+      if (g.resonance) {
+        where += " An extra resonance is a pole pair the model lacks: a mounting or fixture resonance, or a mode an "
+                 "electrode defect makes electrically active.";
+        break;
+      }
+    d.verdict = buf + where + near + heldout_note;
   }
   std::vector<std::string> aliases;
   for (const auto& e : r.effects)

@@ -8,10 +8,12 @@
 // squares decomposition of the residual ln(Z_meas/Z_model) on four shapes:
 // a frequency shift (−∂lnZ/∂ln f), a change of the damping (peak width and
 // height), a level (real constant) and a phase (imaginary constant).
+#include <optional>
 #include <string>
 #include <vector>
 
 #include "update/gap_fit.hpp"
+#include "update/residual_regions.hpp"
 
 namespace piezo::update {
 
@@ -24,6 +26,12 @@ struct GapRegion {
   double excess = 0;     // χ² − 2·points (what the noise does not explain)
   std::string kind;      // dominant: "frequency shift", "peak width/height", "level", "phase", or "noise"
   double shift_pct = 0, width_pct = 0, level_db = 0, phase_deg = 0;
+  // The output-error diagnosis's regions (update/residual_regions.hpp): the
+  // window's chance under noise, the phase slope's delay, the extra resonance
+  // when that is the kind, and the one phrase every view shows.
+  double log10_p = 0, delay_s = 0;
+  std::optional<ExtraResonance> resonance;
+  std::string description;
 };
 
 // Regions of the misfit of model `m` at `x` against `d`.

@@ -335,6 +335,40 @@ class Problem {
   }
   double residual_bin_hz() const { return fs_ / double(decim_) / double(idx_.size()); }
 
+  // The residual in frequency at x (update/residual_regions.hpp): every r-th
+  // bin of the padded transform (r = nfft/n: bins about 1/T_record apart,
+  // nearly independent) in the low-pass's passband, above the lowest two
+  // (the offsets), with its variance n·|L|²(σ1²|T|² + σ2²) under white noise
+  // σ1 on v1 and σ2 on v2, the model's admittance and ∂T/∂Y.
+  std::optional<ResidualSpectrum> residual_spectrum(const Eigen::VectorXd& x, double s1, double s2) {
+    const model::EffectSet fx = effects_at(x);
+    const model::ModalPortModel* pp = port_of(x, fx.mass_loading);
+    if (!pp) return std::nullopt;
+    const model::RayleighDamping damp{0.0, co_.beta(x)};
+    const std::size_t r = std::max<std::size_t>(1, static_cast<std::size_t>(std::lround(double(nfft_) / double(n_))));
+    double lmax = 0;
+    for (std::size_t k = 0; k <= kmax_; ++k) lmax = std::max(lmax, std::abs(l_[k]));
+    ResidualSpectrum s;
+    for (std::size_t k = 2 * r; k <= kmax_; k += r) {
+      if (std::abs(l_[k]) < 0.5 * lmax) continue;
+      const double w = kTwoPi * fs_ * double(k) / double(nfft_);
+      const cd y = model::tube_admittance(*pp, damp, fx, w);
+      const cd t = model::recorded_transfer(y, fx, r1_, w);
+      const cd dy = 1e-6 * std::abs(y);
+      const cd dt = (model::recorded_transfer(y + dy, fx, r1_, w) - t) / dy;
+      const double var = double(n_) * std::norm(l_[k]) * (s1 * s1 * std::norm(t) + s2 * s2);
+      if (!(var > 0) || !std::isfinite(var)) continue;
+      s.f_hz.push_back(w / kTwoPi);
+      s.e.push_back(t * lv1_[k] - ly_[k]);
+      s.lv1.push_back(lv1_[k]);
+      s.t.push_back(t);
+      s.dt_dy.push_back(dt);
+      s.y_tube.push_back(y);
+      s.var.push_back(var);
+    }
+    return s;
+  }
+
   // σ of the filtered error for white noise σ1 on v1 and σ2 on v2 (Parseval).
   double propagated_sigma(const std::vector<cd>& t, double s1, double s2) const {
     double a1 = 0, a2 = 0;
@@ -557,19 +591,6 @@ double third_active_mode_hz(model::ModalSolver& solver, const MaterialClass& cls
 
 // log Q(w, x): the upper regularised incomplete gamma function for integer w,
 // the chance that a sum of w unit exponentials exceeds x.
-double log_gamma_q(int w, double x) {
-  // e^{-x} Σ_{k<w} x^k/k!, in logs
-  double best = -INFINITY;
-  std::vector<double> t(static_cast<std::size_t>(w));
-  for (int k = 0; k < w; ++k) {
-    t[static_cast<std::size_t>(k)] = (k == 0 ? 0.0 : k * std::log(std::max(x, 1e-300))) - std::lgamma(k + 1.0);
-    best = std::max(best, t[static_cast<std::size_t>(k)]);
-  }
-  double sum = 0;
-  for (double v : t) sum += std::exp(v - best);
-  return -x + best + std::log(sum);
-}
-
 struct SpectralTest {
   double log10_p = 0;  // Bonferroni-corrected, of the most significant window
   double f_lo = 0, f_hi = 0, excess = 1;
@@ -608,7 +629,7 @@ SpectralTest spectral_lack_of_fit(const Eigen::VectorXd& r, const Eigen::VectorX
       double sum = 0;
       for (int i = 0; i < w; ++i) sum += z[s0 + static_cast<std::size_t>(i)];
       ++out.windows;
-      const double lq = log_gamma_q(w, sum);
+      const double lq = log_gamma_tail(w, sum);
       if (lq < best) {
         best = lq;
         out.f_lo = double(bin[s0]) * bin_hz;
@@ -1081,7 +1102,10 @@ OeResult fit_output_error(model::ModalSolver& solver, const MaterialClass& cls,
     out.band_hi_hz = st.f_hi;
     out.band_windows = st.windows;
     out.lack_of_fit = out.lack_of_fit || st.log10_p < std::log10(opt.lack_of_fit_p);
-  }  out.correlation = Eigen::MatrixXd::Identity(kParams, kParams);
+  }
+  if (out.lack_of_fit && t_best)
+    if (const auto rs = prob.residual_spectrum(best.x, ch1, ch2)) out.regions = residual_regions(*rs, 2, opt.lack_of_fit_p);
+  out.correlation = Eigen::MatrixXd::Identity(kParams, kParams);
   for (int a = 0; a < kParams; ++a)
     for (int b = 0; b < kParams; ++b)
       if (a != b) out.correlation(a, b) = cov(a, b) / (sx[a] * sx[b]);

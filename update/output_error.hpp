@@ -44,6 +44,7 @@
 #include "model/effects.hpp"
 #include "model/modal.hpp"
 #include "model/transient.hpp"
+#include "update/residual_regions.hpp"
 #include "update/cmcm.hpp"
 #include "update/parametrization.hpp"
 
@@ -185,6 +186,9 @@ struct OeResult {
   double band_excess = 1;                   // residual power / expected noise power in it
   double band_lo_hz = 0, band_hi_hz = 0;    // where it lies
   int band_windows = 0;
+  // Under a lack of fit: where the residual stands above the noise and what
+  // it looks like there (update/residual_regions.hpp), most significant first.
+  std::vector<ResidualRegion> regions;
   int residual_samples = 0;
   int starts = 0, iterations = 0, evaluations = 0;
   std::vector<OeEffect> effects;             // OeOptions::scan_effects, largest Δχ² first

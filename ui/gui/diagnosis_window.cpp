@@ -83,7 +83,8 @@ void regions_table(const update::GapDiagnosis& d, DiagnosisShown& shown) {
     ImGui::ColorButton("##kind", ImGui::ColorConvertU32ToFloat4(c), ImGuiColorEditFlags_NoTooltip,
                        ImVec2(10, 10));
     ImGui::SameLine();
-    ImGui::TextUnformatted(g.kind.c_str());
+    // The output-error diagnosis's regions carry their phrase (the verdict's words).
+    ImGui::TextUnformatted(g.description.empty() ? g.kind.c_str() : g.description.c_str());
     ++shown.regions;
   }
   ImGui::EndTable();
