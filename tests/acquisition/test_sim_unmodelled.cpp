@@ -17,7 +17,10 @@
 #include "acquisition/sim_setup.hpp"
 #include "model/modal.hpp"
 #include "tests/support/apc850_port.hpp"
+#include "tests/support/sim_capture.hpp"
 #include "tests/support/sim_truth.hpp"
+
+#include <hdf5.h>
 
 using namespace piezo;
 using cd = std::complex<double>;
@@ -33,6 +36,18 @@ acq::ParasiticResonance branch_spec() { return {31.25e3, 0.08, 60.0}; }
 cd y_tube(double w) { return cd(0, w) * apc850_port().charge_per_volt(w, beta7()); }
 cd y_branch(const acq::ParasiticBranch& b, double w) {  // 1/(R + jωL + 1/(jωC))
   return 1.0 / (b.r_ohm + cd(0, w * b.l_h) + 1.0 / cd(0, w * b.c_f));
+}
+double truth_attribute(const std::filesystem::path& file, const char* name) {  // NaN if absent
+  hid_t f = H5Fopen(file.c_str(), H5F_ACC_RDONLY, H5P_DEFAULT);
+  if (f < 0) return std::nan("");
+  double v = std::nan("");
+  if (H5Aexists_by_name(f, "truth", name, H5P_DEFAULT) > 0) {
+    hid_t a = H5Aopen_by_name(f, "truth", name, H5P_DEFAULT, H5P_DEFAULT);
+    H5Aread(a, H5T_NATIVE_DOUBLE, &v);
+    H5Aclose(a);
+  }
+  H5Fclose(f);
+  return v;
 }
 std::map<std::string, double> truth_map(const acq::SimSpec& s) {
   auto bench = acq::make_sim_bench(s, 3140.0);
@@ -237,4 +252,24 @@ TEST(SimUnmodelled, WallThicknessErrorKeepsTheInnerDiameterAndTracksTheCapacitan
   }
   s.unmodelled.wall_thickness_rel = -1.0;
   EXPECT_THROW(acq::true_geometry(s), std::invalid_argument);
+}
+
+TEST(SimUnmodelled, GeometryErrorCaptureDeclaresTheNominalTubeAndRecordsTheTrueOne) {
+  // The plan declares the reference tube in /setup (explicitly here); the
+  // bench's tube has a 3 % thinner wall; /truth says so, /setup does not.
+  acq::SimSpec s;
+  s.modes = 12;
+  s.unmodelled.wall_thickness_rel = -0.03;
+  auto plan = test::seed_lab_plan(1);
+  plan.samples = 2000;
+  plan.setup.inner_diameter_m = s.geometry.inner_diameter_m;
+  plan.setup.outer_diameter_m = s.geometry.outer_diameter_m;
+  plan.setup.length_m = s.geometry.length_m;
+  const auto path = test::scratch_dir("sim-unmodelled") / "wall.h5";
+  const auto cap = test::sim_capture(acq::make_sim_bench(s, plan.setup.divider_r1_ohm), plan, path);
+  EXPECT_EQ(cap.setup.geometry().outer_diameter_m, 0.019);
+  EXPECT_EQ(cap.setup.geometry().inner_diameter_m, 0.016);
+  EXPECT_EQ(truth_attribute(path, "unmodelled_wall_thickness_rel"), -0.03);
+  EXPECT_EQ(truth_attribute(path, "static_capacitance_f"), test::sim_port(s).c_static);
+  EXPECT_TRUE(std::isnan(truth_attribute(path, "unmodelled_acoustic_impedance")));
 }
