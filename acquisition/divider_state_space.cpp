@@ -106,11 +106,12 @@ DividerStateSpace::DividerStateSpace(const model::ModalPortModel& port, const Be
   for (const auto& m : port.modes)
     if (m.omega > 0 && m.participation != 0.0)
       modes.push_back({m.omega, m.participation,
-                       k.damping.alpha + k.damping.beta * m.kappa + 2.0 * k.extra_damping_ratio * m.omega +
-                           m.radiation_damping});
+                       k.damping.alpha + k.damping.beta * m.kappa +
+                           2.0 * k.extra_damping_ratio * m.omega + m.radiation_damping});
   for (const auto& b : k.parasitic_branches) {
     if (!(b.r_ohm >= 0 && b.l_h > 0 && b.c_f > 0))
-      throw std::invalid_argument("DividerStateSpace: a parasitic branch needs R >= 0, L > 0, C > 0");
+      throw std::invalid_argument(
+          "DividerStateSpace: a parasitic branch needs R >= 0, L > 0, C > 0");
     modes.push_back({1.0 / std::sqrt(b.l_h * b.c_f), 1.0 / std::sqrt(b.l_h), b.r_ohm / b.l_h});
   }
   model::EffectSet loss;

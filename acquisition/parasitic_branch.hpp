@@ -25,7 +25,7 @@ struct ParasiticBranch {  // element values
 struct ParasiticResonance {  // what a measurement shows
   double f_hz = 0;   // series resonance
   double k_eff = 0;  // effective coupling against the tube's capacitance, 0 < k < 1
-  double q = 0;      // √(L/C)/R, > 0
+  double q = 0;      // sqrt(L/C)/R, > 0
 };
 
 // Throws std::invalid_argument for f ≤ 0, k ∉ (0, 1), Q ≤ 0 or C_t ≤ 0.

@@ -53,7 +53,9 @@ model::TubeGeometry true_geometry(const SimSpec& spec) {
   const double rel = spec.unmodelled.wall_thickness_rel;
   if (!std::isfinite(rel) || !(rel > -1.0))
     throw std::invalid_argument("SimSpec: unmodelled.wall_thickness_rel must be finite and > -1");
-  if (rel != 0.0) g.outer_diameter_m = g.inner_diameter_m + (g.outer_diameter_m - g.inner_diameter_m) * (1.0 + rel);
+  if (rel != 0.0)
+    g.outer_diameter_m =
+        g.inner_diameter_m + (g.outer_diameter_m - g.inner_diameter_m) * (1.0 + rel);
   return g;
 }
 
@@ -82,7 +84,8 @@ std::shared_ptr<drivers::sim::SimBench> make_sim_bench(const SimSpec& spec, doub
   c.dielectric_loss = fx.dielectric_loss;
   c.damping = spec.damping;
   c.extra_damping_ratio = fx.mechanical_damping;
-  for (const auto& r : un.parasitic_branches) c.parasitic_branches.push_back(parasitic_branch(r, port.c_static));
+  for (const auto& r : un.parasitic_branches)
+    c.parasitic_branches.push_back(parasitic_branch(r, port.c_static));
 
   const auto iso = model::isotropic_params(mat.d);
   std::vector<std::pair<std::string, double>> truth = {
@@ -124,10 +127,10 @@ std::shared_ptr<drivers::sim::SimBench> make_sim_bench(const SimSpec& spec, doub
   imp.noise_rel[0] = imp.noise_rel[1] = spec.noise_rel;
   imp.noise_v[0] = imp.noise_v[1] = spec.noise_v;
   imp.adc_bits = spec.adc_bits;
-  auto physics = std::make_unique<FePhysics>(port, c, std::move(truth),
-                                             "FE tube " + mat.description + ", " +
-                                                 std::to_string(static_cast<int>(port.modes.size())) +
-                                                 " modes" + what);
+  auto physics = std::make_unique<FePhysics>(
+      port, c, std::move(truth),
+      "FE tube " + mat.description + ", " + std::to_string(static_cast<int>(port.modes.size())) +
+          " modes" + what);
   return std::make_shared<drivers::sim::SimBench>(std::move(physics), imp, spec.seed, spec.faults);
 }
 

@@ -38,8 +38,6 @@ struct UnmodelledEffects {
   // so a geometry-error case is SimSpec::geometry = the plan's declared
   // geometry and wall_thickness_rel = ±0.03. Must be > −1.
   double wall_thickness_rel = 0.0;
-
-  bool any() const { return !parasitic_branches.empty() || acoustic_impedance_pa_s_m != 0 || wall_thickness_rel != 0; }
 };
 
 struct SimSpec {

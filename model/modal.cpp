@@ -90,7 +90,8 @@ void ModalOptions::validate() const {
   if (!std::isfinite(end_mass_fraction) || end_mass_fraction < 0)
     throw std::invalid_argument(std::string(fn) + ": end_mass_fraction must be finite and >= 0");
   if (!std::isfinite(outer_surface_impedance) || outer_surface_impedance < 0)
-    throw std::invalid_argument(std::string(fn) + ": outer_surface_impedance must be finite and >= 0");
+    throw std::invalid_argument(std::string(fn) +
+                                ": outer_surface_impedance must be finite and >= 0");
 }
 
 const char* to_string(Symmetry s) {
@@ -299,7 +300,8 @@ ModalPortModel ModalSolver::port_model(const PiezoMaterialE& material, const Mod
     if (opt.outer_surface_impedance > 0)  // c_k += Z_a·φ_kᵀC_a1φ_k (outer_surface_damping.hpp)
       p.modes.back().radiation_damping =
           opt.outer_surface_impedance *
-          outer_surface_modal_damping(model_->mesh(), model_->dofs(), sc.shapes.col(static_cast<Eigen::Index>(j)));
+          outer_surface_modal_damping(model_->mesh(), model_->dofs(),
+                                      sc.shapes.col(static_cast<Eigen::Index>(j)));
     const double p2w2 = m.participation * m.participation / (m.omega * m.omega);
     sum1 += p2w2;
     sum2 += p2w2 / (m.omega * m.omega);

@@ -37,7 +37,8 @@ void outer_edge(const TubeMesh& mesh, int e, int node[3], double m[3][3]) {
 
 }  // namespace
 
-std::vector<Eigen::Triplet<double>> outer_surface_damping_triplets(const TubeMesh& mesh, const DofMap& dofs) {
+std::vector<Eigen::Triplet<double>> outer_surface_damping_triplets(const TubeMesh& mesh,
+                                                                   const DofMap& dofs) {
   std::vector<Eigen::Triplet<double>> trip;
   const int n_edges = (mesh.nodes_z() - 1) / 2;
   trip.reserve(static_cast<std::size_t>(9 * n_edges));
@@ -51,7 +52,8 @@ std::vector<Eigen::Triplet<double>> outer_surface_damping_triplets(const TubeMes
   return trip;
 }
 
-double outer_surface_modal_damping(const TubeMesh& mesh, const DofMap& dofs, const Eigen::VectorXd& phi) {
+double outer_surface_modal_damping(const TubeMesh& mesh, const DofMap& dofs,
+                                   const Eigen::VectorXd& phi) {
   const int n_edges = (mesh.nodes_z() - 1) / 2;
   double c = 0.0;
   for (int e = 0; e < n_edges; ++e) {

@@ -24,10 +24,12 @@ namespace piezo::model {
 
 // C_a for Z_a = 1 Pa·s/m as triplets on the global u_r DOFs of the outer
 // surface nodes (duplicates summed). Scale by Z_a.
-std::vector<Eigen::Triplet<double>> outer_surface_damping_triplets(const TubeMesh& mesh, const DofMap& dofs);
+std::vector<Eigen::Triplet<double>> outer_surface_damping_triplets(const TubeMesh& mesh,
+                                                                   const DofMap& dofs);
 
 // φᵀ C_a φ for Z_a = 1 (the per-mode damping per unit impedance, m²/kg for an
 // M-normalised φ), without assembling C_a: one edge integral per outer edge.
-double outer_surface_modal_damping(const TubeMesh& mesh, const DofMap& dofs, const Eigen::VectorXd& phi);
+double outer_surface_modal_damping(const TubeMesh& mesh, const DofMap& dofs,
+                                   const Eigen::VectorXd& phi);
 
 }  // namespace piezo::model

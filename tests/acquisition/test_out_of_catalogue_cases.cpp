@@ -31,11 +31,12 @@ TEST(OutOfCatalogueCases, EachAddsOneCauseInRangeAndWhereItShows) {
     const acq::SimSpec base = test::study_transducer(seed);
     ASSERT_TRUE(base.isotropic);
     const auto bare = test::detail::port_modes(base);
-    for (OocKind kind : {OocKind::parasitic_branch, OocKind::transversely_isotropic, OocKind::wall_thickness,
-                         OocKind::acoustic_load}) {
+    for (OocKind kind : {OocKind::parasitic_branch, OocKind::transversely_isotropic,
+                         OocKind::wall_thickness, OocKind::acoustic_load}) {
       const auto c = test::out_of_catalogue_case(kind, seed, base);
-      std::printf("  seed %llu %-22s [%7.0f, %7.0f] Hz  %s\n", static_cast<unsigned long long>(seed),
-                  test::to_string(kind), c.band_lo_hz, c.band_hi_hz, c.description.c_str());
+      std::printf("  seed %llu %-22s [%7.0f, %7.0f] Hz  %s\n",
+                  static_cast<unsigned long long>(seed), test::to_string(kind), c.band_lo_hz,
+                  c.band_hi_hz, c.description.c_str());
       // The catalogue is untouched: the diagnosis has nothing of it to fit.
       EXPECT_TRUE(same_effects(c.spec.effects, base.effects));
       EXPECT_EQ(c.spec.set, base.set);
@@ -44,8 +45,9 @@ TEST(OutOfCatalogueCases, EachAddsOneCauseInRangeAndWhereItShows) {
       EXPECT_GE(c.band_lo_hz, 100.0);
       EXPECT_LE(c.band_hi_hz, 1.03 * 120e3);
       const auto& un = c.spec.unmodelled;
-      const int causes = static_cast<int>(un.parasitic_branches.size()) + (un.acoustic_impedance_pa_s_m != 0) +
-                         (un.wall_thickness_rel != 0) + (c.spec.isotropic != base.isotropic);
+      const int causes = static_cast<int>(un.parasitic_branches.size()) +
+                         (un.acoustic_impedance_pa_s_m != 0) + (un.wall_thickness_rel != 0) +
+                         (c.spec.isotropic != base.isotropic);
       EXPECT_EQ(causes, 1);
       switch (kind) {
         case OocKind::parasitic_branch: {
@@ -87,7 +89,8 @@ TEST(OutOfCatalogueCases, WallErrorTakesBothSigns) {
   const acq::SimSpec base = test::study_transducer(1);
   int thinner = 0, thicker = 0;
   for (std::uint64_t seed = 1; seed <= 12; ++seed) {
-    const double rel = test::out_of_catalogue_case(OocKind::wall_thickness, seed, base).spec.unmodelled.wall_thickness_rel;
+    const double rel = test::out_of_catalogue_case(OocKind::wall_thickness, seed, base)
+                           .spec.unmodelled.wall_thickness_rel;
     (rel < 0 ? thinner : thicker)++;
   }
   std::printf("  12 seeds: %d thinner, %d thicker\n", thinner, thicker);
@@ -97,9 +100,10 @@ TEST(OutOfCatalogueCases, WallErrorTakesBothSigns) {
 
 TEST(OutOfCatalogueCases, TheSimulatedBenchTakesEachAndRecordsIt) {
   const acq::SimSpec base = test::study_transducer(5);
-  const std::map<OocKind, std::string> key = {{OocKind::parasitic_branch, "unmodelled_parasitic_f_hz"},
-                                              {OocKind::wall_thickness, "unmodelled_wall_thickness_rel"},
-                                              {OocKind::acoustic_load, "unmodelled_acoustic_impedance"}};
+  const std::map<OocKind, std::string> key = {
+      {OocKind::parasitic_branch, "unmodelled_parasitic_f_hz"},
+      {OocKind::wall_thickness, "unmodelled_wall_thickness_rel"},
+      {OocKind::acoustic_load, "unmodelled_acoustic_impedance"}};
   for (const auto& [kind, name] : key) {
     const auto c = test::out_of_catalogue_case(kind, 5, base);
     EXPECT_EQ(truth_map(c.spec).count(name), 1u) << name;
@@ -112,6 +116,6 @@ TEST(OutOfCatalogueCases, TheSimulatedBenchTakesEachAndRecordsIt) {
   const auto iso = model::resolve_material({base.material, true, base.set}).d;
   EXPECT_EQ(iso.s_e13, iso.s_e12);  // the isotropic class (§6.4.3)
   EXPECT_NE(full.s_e13, full.s_e12);
-  std::printf("  sE13/sE12: truth %.4f, isotropic class %.4f; d33/d31: truth %.3f\n", full.s_e13 / full.s_e12,
-              iso.s_e13 / iso.s_e12, full.d33 / full.d31);
+  std::printf("  sE13/sE12: truth %.4f, isotropic class %.4f; d33/d31: truth %.3f\n",
+              full.s_e13 / full.s_e12, iso.s_e13 / iso.s_e12, full.d33 / full.d31);
 }

@@ -62,7 +62,8 @@ TEST(SimUnmodelled, ParasiticBranchElementValuesFromResonance) {
   const auto b = acq::parasitic_branch(branch_spec(), ct);
   // Lossless C_t ∥ (L + C): series resonance at 1/√(LC), parallel at
   // 1/√(L·C·C_t/(C + C_t)) — the definitions, evaluated from the element values.
-  const double ws = 1 / std::sqrt(b.l_h * b.c_f), wp = 1 / std::sqrt(b.l_h * b.c_f * ct / (b.c_f + ct));
+  const double ws = 1 / std::sqrt(b.l_h * b.c_f),
+               wp = 1 / std::sqrt(b.l_h * b.c_f * ct / (b.c_f + ct));
   EXPECT_NEAR(ws / (2 * M_PI), 31.25e3, 1e-9 * 31.25e3);
   EXPECT_NEAR(std::sqrt((wp * wp - ws * ws) / (wp * wp)), 0.08, 1e-12);
   EXPECT_NEAR(std::sqrt(b.l_h / b.c_f) / b.r_ohm, 60.0, 1e-9);
@@ -85,11 +86,13 @@ TEST(SimUnmodelled, ParasiticBranchFollowsCircuitAlgebra) {
     for (double f : {1e3, 20e3, 30.9e3, 31.25e3, 31.6e3, 50.4e3, 80e3, 120e3}) {
       const double w = 2 * M_PI * f;
       const cd zt = 1.0 / (y_tube(w) + y_branch(b, w)) + c.series_resistance_ohm;
-      const cd yshunt = cd(0, w * c.parallel_capacitance_f) +
-                        (std::isfinite(c.daq_input_resistance_ohm) ? 1.0 / c.daq_input_resistance_ohm : 0.0);
+      const cd yshunt =
+          cd(0, w * c.parallel_capacitance_f) +
+          (std::isfinite(c.daq_input_resistance_ohm) ? 1.0 / c.daq_input_resistance_ohm : 0.0);
       const cd znode = 1.0 / (1.0 / zt + yshunt);
       const cd want = znode / (znode + c.r1_ohm);
-      EXPECT_LT(std::abs(ss.transfer(w) - want) / std::abs(want), 1e-9) << f << " fixture " << fixture;
+      EXPECT_LT(std::abs(ss.transfer(w) - want) / std::abs(want), 1e-9)
+          << f << " fixture " << fixture;
     }
   }
 }
@@ -98,7 +101,8 @@ TEST(SimUnmodelled, RadiationDampingEntersEveryModesDamping) {
   // The port's harmonic sum with c_k = βκ_k + c_a,k, written out here.
   model::ModalPortModel port = apc850_port();
   for (std::size_t k = 0; k < port.modes.size(); ++k)
-    if (!port.modes[k].residual) port.modes[k].radiation_damping = 1e3 * (1 + 0.1 * static_cast<double>(k));
+    if (!port.modes[k].residual)
+      port.modes[k].radiation_damping = 1e3 * (1 + 0.1 * static_cast<double>(k));
   acq::BenchCircuit c;
   c.damping = beta7();
   acq::DividerStateSpace ss(port, c);
@@ -146,8 +150,8 @@ TEST(SimUnmodelled, SteadySineWithTheBranchMatchesTheTransfer) {
     }
     const double x = M_PI * f / fs, foh = std::pow(std::sin(x) / x, 2);
     const cd got = cd(re, im) * (2.0 / t.size()) / foh, want = ss.transfer(w);
-    std::printf("  %.2f kHz: |v2/v1| sim %.8f, transfer %.8f, rel diff %.2e\n", f / 1e3, std::abs(got),
-                std::abs(want), std::abs(got - want) / std::abs(want));
+    std::printf("  %.2f kHz: |v2/v1| sim %.8f, transfer %.8f, rel diff %.2e\n", f / 1e3,
+                std::abs(got), std::abs(want), std::abs(got - want) / std::abs(want));
     EXPECT_LT(std::abs(got - want) / std::abs(want), 2e-4) << f;
   }
 }
@@ -193,13 +197,15 @@ TEST(SimUnmodelled, MeasuredConductanceShowsTheBranchsResonanceAndQ) {
   const double w_net = width([&](double f) { return g_meas(ss, f) - g_meas(ss_bare, f); }, f_net);
   const double g_bg = g_meas(ss_bare, spec.f_hz), q_raw = f_raw / w_raw, q_net = f_net / w_net;
   const double q_expected_raw = spec.q / (1 + b.r_ohm * g_bg);
-  std::printf("  G peak %.1f Hz (asked %.1f); Q from G - G_bg %.3f (asked %.1f); raw Q %.3f, "
-              "predicted Q/(1 + R G_bg) = %.3f (R G_bg = %.4f)\n",
-              f_raw, spec.f_hz, q_net, spec.q, q_raw, q_expected_raw, b.r_ohm * g_bg);
+  std::printf(
+      "  G peak %.1f Hz (asked %.1f); Q from G - G_bg %.3f (asked %.1f); raw Q %.3f, "
+      "predicted Q/(1 + R G_bg) = %.3f (R G_bg = %.4f)\n",
+      f_raw, spec.f_hz, q_net, spec.q, q_raw, q_expected_raw, b.r_ohm * g_bg);
   EXPECT_NEAR(f_raw / spec.f_hz, 1.0, 2e-3);  // the 0.5 Hz scan and the tube's background slope
   EXPECT_NEAR(f_net / spec.f_hz, 1.0, 1e-4);  // the 0.5 Hz scan
-  EXPECT_NEAR(q_net / spec.q, 1.0, 1e-3);     // exact up to the scan's peak value (quadratic: ~1e-6)
-  EXPECT_NEAR(q_raw / q_expected_raw, 1.0, 0.01);  // first order in R·G_bg, and G_bg's slope over the width
+  EXPECT_NEAR(q_net / spec.q, 1.0, 1e-3);  // exact up to the scan's peak value (quadratic: ~1e-6)
+  EXPECT_NEAR(q_raw / q_expected_raw, 1.0,
+              0.01);  // first order in R·G_bg, and G_bg's slope over the width
 }
 
 TEST(SimUnmodelled, TruthRecordsTheUnmodelledInputsOnlyWhenPresent) {
@@ -238,7 +244,8 @@ TEST(SimUnmodelled, WallThicknessErrorKeepsTheInnerDiameterAndTracksTheCapacitan
     const auto g = acq::true_geometry(s);
     EXPECT_EQ(g.inner_diameter_m, s.geometry.inner_diameter_m);
     EXPECT_NEAR((g.outer_diameter_m - g.inner_diameter_m) /
-                    (s.geometry.outer_diameter_m - s.geometry.inner_diameter_m), 1 + rel, 1e-12);
+                    (s.geometry.outer_diameter_m - s.geometry.inner_diameter_m),
+                1 + rel, 1e-12);
     EXPECT_EQ(g.length_m, s.geometry.length_m);
     // The electrode capacitance goes as 1/ln(Do/Di) (eq. 200, for the clamped
     // tube exactly up to the FE error; the free tube's C_static nearly so).

@@ -61,7 +61,8 @@ TEST(OuterSurfaceDamping, HalfModelEqualsTheWholeTube) {
       EXPECT_EQ(h.radiation_damping, 0.0);  // the pseudo-mode gets none
       continue;
     }
-    if (h.omega > whole.modes[whole.modes.size() - 2].omega) continue;  // beyond the whole tube's 24
+    if (h.omega > whole.modes[whole.modes.size() - 2].omega)
+      continue;  // beyond the whole tube's 24
     const PortMode* w = nullptr;
     for (const auto& m : whole.modes)
       if (!m.residual && std::abs(m.omega / h.omega - 1) < 1e-6) w = &m;
@@ -69,7 +70,8 @@ TEST(OuterSurfaceDamping, HalfModelEqualsTheWholeTube) {
     EXPECT_GT(h.radiation_damping, 0.0);
     EXPECT_NEAR(h.radiation_damping / w->radiation_damping, 1.0, 1e-6) << h.omega / (2 * M_PI);
     std::printf("  %9.1f Hz  c_a half %.6e  whole %.6e  1/s  (rel %.1e)\n", h.omega / (2 * M_PI),
-                h.radiation_damping, w->radiation_damping, h.radiation_damping / w->radiation_damping - 1);
+                h.radiation_damping, w->radiation_damping,
+                h.radiation_damping / w->radiation_damping - 1);
     ++matched;
   }
   EXPECT_GE(matched, 8);
@@ -116,11 +118,14 @@ TEST(OuterSurfaceDamping, ThinRingBreathingModeMatchesTheClosedForm) {
   ASSERT_NE(breathing, nullptr);
   const double nu = isotropic_params(d).nu12, rho = g.density_kg_m3;
   const double ri = g.inner_radius(), ro = g.outer_radius(), x = 2 - 2 * nu;
-  const double want = kWater * x * std::pow(ro, 1 - 2 * nu) / (rho * (std::pow(ro, x) - std::pow(ri, x)));
+  const double want =
+      kWater * x * std::pow(ro, 1 - 2 * nu) / (rho * (std::pow(ro, x) - std::pow(ri, x)));
   const double uniform = kWater * 2 * ro / (rho * (ro * ro - ri * ri));
-  std::printf("  breathing mode %.1f Hz: c_a %.6e 1/s, closed form %.6e (rel %+.2e), uniform-u_r form %.6e (rel %+.2e)\n",
-              breathing->omega / (2 * M_PI), breathing->radiation_damping, want,
-              breathing->radiation_damping / want - 1, uniform, breathing->radiation_damping / uniform - 1);
+  std::printf(
+      "  breathing mode %.1f Hz: c_a %.6e 1/s, closed form %.6e (rel %+.2e), uniform-u_r form %.6e "
+      "(rel %+.2e)\n",
+      breathing->omega / (2 * M_PI), breathing->radiation_damping, want,
+      breathing->radiation_damping / want - 1, uniform, breathing->radiation_damping / uniform - 1);
   // Tolerance: the closed form neglects the radial stress and the radial
   // variation of the inertia load, O((t/r)²) = 2.6e-3 here, the axial
   // kinetic share (1e-4), and the radial field of the short-circuited

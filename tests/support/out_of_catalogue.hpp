@@ -44,10 +44,14 @@ enum class OocKind { parasitic_branch, transversely_isotropic, wall_thickness, a
 
 inline const char* to_string(OocKind k) {
   switch (k) {
-    case OocKind::parasitic_branch: return "parasitic_branch";
-    case OocKind::transversely_isotropic: return "transversely_isotropic";
-    case OocKind::wall_thickness: return "wall_thickness";
-    default: return "acoustic_load";
+    case OocKind::parasitic_branch:
+      return "parasitic_branch";
+    case OocKind::transversely_isotropic:
+      return "transversely_isotropic";
+    case OocKind::wall_thickness:
+      return "wall_thickness";
+    default:
+      return "acoustic_load";
   }
 }
 
@@ -90,15 +94,18 @@ inline std::vector<ActiveMode> port_modes(const acq::SimSpec& spec) {
   std::vector<ActiveMode> m;
   for (const auto& pm : port.modes)
     if (!pm.residual && pm.omega > 0)
-      m.push_back({pm.omega / (2 * M_PI), pm.participation * pm.participation / (pm.omega * pm.omega * port.c_clamped),
+      m.push_back({pm.omega / (2 * M_PI),
+                   pm.participation * pm.participation / (pm.omega * pm.omega * port.c_clamped),
                    pm.radiation_damping / (2 * pm.omega)});
   return m;
 }
 // Band of the electrically active modes (coupling > 1e-3) inside [lo, hi], ±3 %.
-inline std::pair<double, double> active_band(const std::vector<ActiveMode>& modes, double lo, double hi) {
+inline std::pair<double, double> active_band(const std::vector<ActiveMode>& modes, double lo,
+                                             double hi) {
   double a = std::numeric_limits<double>::infinity(), b = 0;
   for (const auto& m : modes)
-    if (m.coupling > 1e-3 && m.f_hz >= lo && m.f_hz <= hi) a = std::min(a, m.f_hz), b = std::max(b, m.f_hz);
+    if (m.coupling > 1e-3 && m.f_hz >= lo && m.f_hz <= hi)
+      a = std::min(a, m.f_hz), b = std::max(b, m.f_hz);
   if (!(b > 0)) throw std::runtime_error("out_of_catalogue_case: no active mode in the band");
   return {0.97 * a, 1.03 * b};
 }
@@ -126,30 +133,39 @@ inline OocCase out_of_catalogue_case(OocKind kind, std::uint64_t seed, const acq
         const double x = lo + (hi - lo) * u(rng);
         bool clear = true;
         for (const auto& m : modes)
-          if (m.coupling > 1e-4 && std::abs(x - m.f_hz) < std::max(5e3, 0.1 * m.f_hz)) clear = false;
+          if (m.coupling > 1e-4 && std::abs(x - m.f_hz) < std::max(5e3, 0.1 * m.f_hz))
+            clear = false;
         if (clear) f = x;
       }
-      if (f == 0) throw std::runtime_error("out_of_catalogue_case: no frequency clear of the modes");
+      if (f == 0)
+        throw std::runtime_error("out_of_catalogue_case: no frequency clear of the modes");
       const acq::ParasiticResonance r{f, 0.05 + 0.07 * u(rng), 40.0 + 160.0 * u(rng)};
       c.spec.unmodelled.parasitic_branches.push_back(r);
       c.band_lo_hz = f * (1 - 1 / r.q);
       c.band_hi_hz = f * (1 + 1 / r.q);
-      std::snprintf(text, sizeof text, "parasitic R-L-C branch across the terminals: f %.0f Hz, k_eff %.3f, Q %.0f",
+      std::snprintf(text, sizeof text,
+                    "parasitic R-L-C branch across the terminals: f %.0f Hz, k_eff %.3f, Q %.0f",
                     r.f_hz, r.k_eff, r.q);
       break;
     }
     case OocKind::transversely_isotropic: {
       c.spec.isotropic = false;
-      std::tie(c.band_lo_hz, c.band_hi_hz) = detail::active_band(detail::port_modes(c.spec), band_lo_hz, band_hi_hz);
-      std::snprintf(text, sizeof text, "transversely isotropic truth (%s, full 4mm-class constants%s%s) under the isotropic fit class",
-                    base.material.c_str(), base.set.empty() ? "" : ", overrides ", base.set.c_str());
+      std::tie(c.band_lo_hz, c.band_hi_hz) =
+          detail::active_band(detail::port_modes(c.spec), band_lo_hz, band_hi_hz);
+      std::snprintf(text, sizeof text,
+                    "transversely isotropic truth (%s, full 4mm-class constants%s%s) under the "
+                    "isotropic fit class",
+                    base.material.c_str(), base.set.empty() ? "" : ", overrides ",
+                    base.set.c_str());
       break;
     }
     case OocKind::wall_thickness: {
       const double rel = u(rng) < 0.5 ? -0.03 : 0.03;
       c.spec.unmodelled.wall_thickness_rel = rel;
-      std::tie(c.band_lo_hz, c.band_hi_hz) = detail::active_band(detail::port_modes(c.spec), band_lo_hz, band_hi_hz);
-      std::snprintf(text, sizeof text, "wall thickness %+.0f %% of the declared one (inner diameter kept)", 100 * rel);
+      std::tie(c.band_lo_hz, c.band_hi_hz) =
+          detail::active_band(detail::port_modes(c.spec), band_lo_hz, band_hi_hz);
+      std::snprintf(text, sizeof text,
+                    "wall thickness %+.0f %% of the declared one (inner diameter kept)", 100 * rel);
       break;
     }
     case OocKind::acoustic_load: {
@@ -157,11 +173,13 @@ inline OocCase out_of_catalogue_case(OocKind kind, std::uint64_t seed, const acq
       const auto modes = detail::port_modes(c.spec);
       double zmax = 0;
       for (const auto& m : modes)
-        if (m.coupling > 1e-3 && m.f_hz >= band_lo_hz && m.f_hz <= band_hi_hz) zmax = std::max(zmax, m.radiation_zeta);
+        if (m.coupling > 1e-3 && m.f_hz >= band_lo_hz && m.f_hz <= band_hi_hz)
+          zmax = std::max(zmax, m.radiation_zeta);
       double a = std::numeric_limits<double>::infinity(), b = 0;
       std::string which;
       for (const auto& m : modes)
-        if (m.coupling > 1e-3 && m.f_hz >= band_lo_hz && m.f_hz <= band_hi_hz && m.radiation_zeta >= 0.5 * zmax) {
+        if (m.coupling > 1e-3 && m.f_hz >= band_lo_hz && m.f_hz <= band_hi_hz &&
+            m.radiation_zeta >= 0.5 * zmax) {
           a = std::min(a, m.f_hz), b = std::max(b, m.f_hz);
           char one[80];
           std::snprintf(one, sizeof one, " %.0f Hz (+%.4f)", m.f_hz, m.radiation_zeta);
@@ -170,7 +188,9 @@ inline OocCase out_of_catalogue_case(OocKind kind, std::uint64_t seed, const acq
       if (!(b > 0)) throw std::runtime_error("out_of_catalogue_case: no active mode in the band");
       c.band_lo_hz = 0.97 * a;
       c.band_hi_hz = 1.03 * b;
-      std::snprintf(text, sizeof text, "acoustic load on the outer surface, Z_a %.3g Pa·s/m; most damped modes (added damping ratio):%s",
+      std::snprintf(text, sizeof text,
+                    "acoustic load on the outer surface, Z_a %.3g Pa·s/m; most damped modes (added "
+                    "damping ratio):%s",
                     c.spec.unmodelled.acoustic_impedance_pa_s_m, which.c_str());
       break;
     }

@@ -32,7 +32,8 @@ inline model::ModalPortModel sim_port(const acq::SimSpec& spec) {
 inline std::vector<acq::ParasiticBranch> sim_parasitic_branches(const acq::SimSpec& spec,
                                                                 const model::ModalPortModel& port) {
   std::vector<acq::ParasiticBranch> b;
-  for (const auto& r : spec.unmodelled.parasitic_branches) b.push_back(acq::parasitic_branch(r, port.c_static));
+  for (const auto& r : spec.unmodelled.parasitic_branches)
+    b.push_back(acq::parasitic_branch(r, port.c_static));
   return b;
 }
 
