@@ -96,9 +96,24 @@ DividerStateSpace::DividerStateSpace(const model::ModalPortModel& port, const Be
   }
   const double ce = port.c_clamped + port.c_residual;
   if (!(ce > 0)) throw std::invalid_argument("DividerStateSpace: non-positive port capacitance");
-  std::vector<const model::PortMode*> modes;
+  // Second-order terms on the tube node: the port's modes (c_k = α + βκ_k +
+  // 2ξ_mω_k + radiation damping) and the parasitic branches (p² = 1/L,
+  // ω² = 1/(LC), c = R/L: parasitic_branch.hpp).
+  struct Term {
+    double omega, participation, damping;
+  };
+  std::vector<Term> modes;
   for (const auto& m : port.modes)
-    if (m.omega > 0 && m.participation != 0.0) modes.push_back(&m);
+    if (m.omega > 0 && m.participation != 0.0)
+      modes.push_back({m.omega, m.participation,
+                       k.damping.alpha + k.damping.beta * m.kappa +
+                           2.0 * k.extra_damping_ratio * m.omega + m.radiation_damping});
+  for (const auto& b : k.parasitic_branches) {
+    if (!(b.r_ohm >= 0 && b.l_h > 0 && b.c_f > 0))
+      throw std::invalid_argument(
+          "DividerStateSpace: a parasitic branch needs R >= 0, L > 0, C > 0");
+    modes.push_back({1.0 / std::sqrt(b.l_h * b.c_f), 1.0 / std::sqrt(b.l_h), b.r_ohm / b.l_h});
+  }
   model::EffectSet loss;
   loss.dielectric_loss = k.dielectric_loss;
   loss.dielectric_constant_phase = true;
@@ -152,9 +167,9 @@ DividerStateSpace::DividerStateSpace(const model::ModalPortModel& port, const Be
     row(i_d0 + j) += gj;
   }
   for (int m = 0; m < nm; ++m) {
-    const auto& md = *modes[m];
+    const Term& md = modes[m];
     const int ix = i_m0 + 2 * m, iy = ix + 1;
-    const double ck = k.damping.alpha + k.damping.beta * md.kappa + 2.0 * k.extra_damping_ratio * md.omega;
+    const double ck = md.damping;
     a_(ix, iy) = 1.0;
     a_(iy, ix) = -md.omega * md.omega;
     a_(iy, iy) = -ck;
@@ -171,7 +186,7 @@ DividerStateSpace::DividerStateSpace(const model::ModalPortModel& port, const Be
   tdiag(i_vt) = std::sqrt(c_inf);
   if (v2_state) tdiag(i_v2) = std::sqrt(k.parallel_capacitance_f);
   for (int j = 0; j < nd; ++j) tdiag(i_d0 + j) = std::sqrt(debye[j].first);
-  for (int m = 0; m < nm; ++m) tdiag(i_m0 + 2 * m) = modes[m]->omega;
+  for (int m = 0; m < nm; ++m) tdiag(i_m0 + 2 * m) = modes[m].omega;
   for (int r = 0; r < n; ++r)
     for (int q = 0; q < n; ++q) a_(r, q) *= tdiag(r) / tdiag(q);
   b_ = b_.cwiseProduct(tdiag);

@@ -8,6 +8,11 @@
 // Tube port (see model/port_model.hpp): Q = Ce·vt + Σ p_k x_k,
 //   x_k'' + c_k x_k' + ω_k² x_k = p_k vt,  Ce = C0 + C_res,  c_k = α + β κ_k,
 // so Q/V = Ce + Σ p_k² / (ω_k² − ω² + jω c_k) as in the harmonic analysis.
+// c_k also takes the port's per-mode radiation damping (PortMode::
+// radiation_damping, 0 unless the simulator asked for an acoustic load), and
+// parasitic R-L-C branches across the terminals enter as extra terms of the
+// same sum (acquisition/parasitic_branch.hpp): issue 21's out-of-catalogue
+// causes, simulator inputs only.
 // Integration is exact for piecewise-linear input: one matrix exponential of
 // the system augmented by the input and its slope per distinct step length.
 #include <Eigen/Dense>
@@ -17,6 +22,7 @@
 #include <span>
 #include <vector>
 
+#include "acquisition/parasitic_branch.hpp"
 #include "drivers/sim/bench_physics.hpp"
 #include "model/effects.hpp"
 #include "model/port_model.hpp"
@@ -40,6 +46,10 @@ struct BenchCircuit {
   //              ├─ parallel_capacitance ─ GND
   //              └─ daq_input_resistance ─ GND
   drivers::sim::DutSelection dut;
+  // Out of the catalogue (issue 21): series R-L-C branches in parallel with
+  // the tube port, inside the series lead resistance (at the terminals). They
+  // belong to the transducer: a calibration standard in its place has none.
+  std::vector<ParasiticBranch> parasitic_branches;
 };
 
 class DividerStateSpace {

@@ -1,5 +1,6 @@
 #include "acquisition/sim_setup.hpp"
 
+#include <cmath>
 #include <stdexcept>
 
 #include "acquisition/divider_state_space.hpp"
@@ -47,11 +48,23 @@ class FePhysics : public drivers::sim::BenchPhysics {
 
 }  // namespace
 
+model::TubeGeometry true_geometry(const SimSpec& spec) {
+  model::TubeGeometry g = spec.geometry;
+  const double rel = spec.unmodelled.wall_thickness_rel;
+  if (!std::isfinite(rel) || !(rel > -1.0))
+    throw std::invalid_argument("SimSpec: unmodelled.wall_thickness_rel must be finite and > -1");
+  if (rel != 0.0)
+    g.outer_diameter_m =
+        g.inner_diameter_m + (g.outer_diameter_m - g.inner_diameter_m) * (1.0 + rel);
+  return g;
+}
+
 std::shared_ptr<drivers::sim::SimBench> make_sim_bench(const SimSpec& spec, double nominal_r1_ohm) {
   if (!(nominal_r1_ohm > 0)) throw std::invalid_argument("make_sim_bench: R1 must be positive");
   const auto& fx = spec.effects;
+  const auto& un = spec.unmodelled;
   auto mat = model::resolve_material({spec.material, spec.isotropic, spec.set});
-  model::TubeGeometry g = spec.geometry;
+  model::TubeGeometry g = true_geometry(spec);
   g.density_kg_m3 = mat.density_kg_m3;
   g.validate();
   model::TubeModel tube(g);
@@ -59,6 +72,7 @@ std::shared_ptr<drivers::sim::SimBench> make_sim_bench(const SimSpec& spec, doub
   model::ModalOptions mo;
   mo.n_modes = spec.modes;
   mo.end_mass_fraction = fx.mass_loading;  // end-face masses: M + f·ΔM (model/end_mass.hpp)
+  mo.outer_surface_impedance = un.acoustic_impedance_pa_s_m;  // validated by port_model
   const auto e = model::to_e_form(mat.d);
   model::ModalPortModel port = solver.port_model(e, mo);
 
@@ -70,6 +84,8 @@ std::shared_ptr<drivers::sim::SimBench> make_sim_bench(const SimSpec& spec, doub
   c.dielectric_loss = fx.dielectric_loss;
   c.damping = spec.damping;
   c.extra_damping_ratio = fx.mechanical_damping;
+  for (const auto& r : un.parasitic_branches)
+    c.parasitic_branches.push_back(parasitic_branch(r, port.c_static));
 
   const auto iso = model::isotropic_params(mat.d);
   std::vector<std::pair<std::string, double>> truth = {
@@ -85,6 +101,25 @@ std::shared_ptr<drivers::sim::SimBench> make_sim_bench(const SimSpec& spec, doub
       {"static_capacitance_f", port.c_static}};
   for (const auto& info : model::effect_catalogue())
     truth.emplace_back("effect_" + std::string(info.name), fx.*(info.field));
+  // Issue 21's out-of-catalogue causes, only when present (absent ones leave
+  // the /truth group as it was). Branch i > 0 has the suffix _<i+1>.
+  std::string what;
+  for (std::size_t i = 0; i < un.parasitic_branches.size(); ++i) {
+    const auto& r = un.parasitic_branches[i];
+    const std::string sfx = i == 0 ? "" : "_" + std::to_string(i + 1);
+    truth.emplace_back("unmodelled_parasitic_f_hz" + sfx, r.f_hz);
+    truth.emplace_back("unmodelled_parasitic_k_eff" + sfx, r.k_eff);
+    truth.emplace_back("unmodelled_parasitic_q" + sfx, r.q);
+    what += ", parasitic branch at " + std::to_string(r.f_hz) + " Hz";
+  }
+  if (un.acoustic_impedance_pa_s_m != 0) {
+    truth.emplace_back("unmodelled_acoustic_impedance", un.acoustic_impedance_pa_s_m);
+    what += ", acoustic load " + std::to_string(un.acoustic_impedance_pa_s_m) + " Pa·s/m";
+  }
+  if (un.wall_thickness_rel != 0) {
+    truth.emplace_back("unmodelled_wall_thickness_rel", un.wall_thickness_rel);
+    what += ", wall thickness " + std::to_string(100.0 * un.wall_thickness_rel) + " %";
+  }
 
   drivers::sim::DaqImperfections imp;
   imp.channel_skew_s = fx.channel_skew_s;
@@ -92,10 +127,10 @@ std::shared_ptr<drivers::sim::SimBench> make_sim_bench(const SimSpec& spec, doub
   imp.noise_rel[0] = imp.noise_rel[1] = spec.noise_rel;
   imp.noise_v[0] = imp.noise_v[1] = spec.noise_v;
   imp.adc_bits = spec.adc_bits;
-  auto physics = std::make_unique<FePhysics>(port, c, std::move(truth),
-                                             "FE tube " + mat.description + ", " +
-                                                 std::to_string(static_cast<int>(port.modes.size())) +
-                                                 " modes");
+  auto physics = std::make_unique<FePhysics>(
+      port, c, std::move(truth),
+      "FE tube " + mat.description + ", " + std::to_string(static_cast<int>(port.modes.size())) +
+          " modes" + what);
   return std::make_shared<drivers::sim::SimBench>(std::move(physics), imp, spec.seed, spec.faults);
 }
 

@@ -7,12 +7,38 @@
 #include <string>
 #include <vector>
 
+#include "acquisition/parasitic_branch.hpp"
 #include "drivers/sim/sim_bench.hpp"
 #include "model/effects.hpp"
 #include "model/port_model.hpp"
 #include "model/tube_geometry.hpp"
 
 namespace piezo::acq {
+
+// Causes the effect catalogue (model/effects.hpp) does NOT describe, for
+// validating that the gap diagnosis answers "unexplained" rather than a false
+// name (issue 21). Simulator inputs only: they are kept out of
+// model::EffectSet so the diagnosis cannot fit them. All default to absent, and
+// an absent one changes nothing (not even the capture's /truth group).
+struct UnmodelledEffects {
+  // Series R-L-C branches across the tube's terminals (inside the series lead
+  // resistance), each given by its series resonance f, coupling k_eff and Q
+  // against the tube's static capacitance (acquisition/parasitic_branch.hpp).
+  std::vector<ParasiticResonance> parasitic_branches;
+  // Fluid loading the outer surface as a radial dashpot, Z_a = ρ_f·c_f in
+  // Pa·s/m (water 1.48e6): per-mode damping from the FE shapes
+  // (ModalOptions::outer_surface_impedance, model/outer_surface_damping.hpp);
+  // none on the residual pseudo-mode.
+  double acoustic_impedance_pa_s_m = 0.0;
+  // Geometry error: the true tube's wall is (1 + rel) times the wall of
+  // SimSpec::geometry, at the same inner diameter (outer diameter
+  // Di + (Do − Di)(1 + rel)). SimSpec::geometry stays the DECLARED tube: the
+  // measurement plan's Setup declares its own geometry independently (absent
+  // fields = model::TubeGeometry's defaults, the same as SimSpec's default),
+  // so a geometry-error case is SimSpec::geometry = the plan's declared
+  // geometry and wall_thickness_rel = ±0.03. Must be > −1.
+  double wall_thickness_rel = 0.0;
+};
 
 struct SimSpec {
   std::string material = "apc850";
@@ -27,7 +53,12 @@ struct SimSpec {
   std::uint64_t seed = 1;
   drivers::sim::FaultPlan faults;
   int modes = 24;  // short-circuit modes kept in the port model
+  UnmodelledEffects unmodelled;  // issue 21: causes outside the catalogue (simulator only)
 };
+
+// The tube the simulated bench really has: SimSpec::geometry with the
+// unmodelled wall-thickness error applied (density not yet set).
+model::TubeGeometry true_geometry(const SimSpec& spec);
 
 // `nominal_r1_ohm` is the resistor the technician declares; the bench's true
 // resistor is nominal·(1 + effects.r1_tolerance).

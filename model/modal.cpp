@@ -7,6 +7,8 @@
 #include <numeric>
 #include <stdexcept>
 
+#include "model/outer_surface_damping.hpp"
+
 namespace piezo::model {
 
 namespace {
@@ -87,6 +89,9 @@ void ModalOptions::validate() const {
     throw std::invalid_argument(std::string(fn) + ": active_coupling(_open) must be >= 0");
   if (!std::isfinite(end_mass_fraction) || end_mass_fraction < 0)
     throw std::invalid_argument(std::string(fn) + ": end_mass_fraction must be finite and >= 0");
+  if (!std::isfinite(outer_surface_impedance) || outer_surface_impedance < 0)
+    throw std::invalid_argument(std::string(fn) +
+                                ": outer_surface_impedance must be finite and >= 0");
 }
 
 const char* to_string(Symmetry s) {
@@ -253,7 +258,9 @@ ModalPortModel ModalSolver::half_port_model(const PiezoMaterialE& material, cons
   // Whole tube = two mirrored halves in parallel: every charge doubles, so C0,
   // C_static and the residual static share double, and a mode normalised on
   // the whole tube (φᵀMφ = 1 = 2·φ_halfᵀM_halfφ_half) has p² = 2·p_half²;
-  // ω and κ = φᵀK_UUφ/φᵀMφ are the half's.
+  // ω and κ = φᵀK_UUφ/φᵀMφ are the half's, and so is the radiation damping:
+  // the whole tube's outer surface is the half's and its mirror image, so
+  // φᵀC_aφ = 2·(φ_half/√2)ᵀC_a,half(φ_half/√2) = φ_halfᵀC_a,halfφ_half.
   p.c_clamped *= 2.0;
   p.c_static *= 2.0;
   p.c_residual *= 2.0;
@@ -286,9 +293,15 @@ ModalPortModel ModalSolver::port_model(const PiezoMaterialE& material, const Mod
   p.c_static = static_solve(material, m_uu, &us);
   double sum1 = 0, sum2 = 0, omega_max = 0;
   const double rigid_omega = 2.0 * M_PI * 1e-3 * opt.shift_hz;
-  for (const auto& m : sc.modes) {
+  for (std::size_t j = 0; j < sc.modes.size(); ++j) {
+    const Mode& m = sc.modes[j];
     if (m.omega <= rigid_omega) continue;  // rigid translation: p = 0 exactly
     p.modes.push_back({m.omega, m.participation, m.kappa, m.symmetry == Symmetry::symmetric});
+    if (opt.outer_surface_impedance > 0)  // c_k += Z_a·φ_kᵀC_a1φ_k (outer_surface_damping.hpp)
+      p.modes.back().radiation_damping =
+          opt.outer_surface_impedance *
+          outer_surface_modal_damping(model_->mesh(), model_->dofs(),
+                                      sc.shapes.col(static_cast<Eigen::Index>(j)));
     const double p2w2 = m.participation * m.participation / (m.omega * m.omega);
     sum1 += p2w2;
     sum2 += p2w2 / (m.omega * m.omega);
@@ -305,7 +318,7 @@ ModalPortModel ModalSolver::port_model(const PiezoMaterialE& material, const Mod
     res.participation = std::sqrt(r1) * wr;
     res.kappa = wr * wr;  // K_UU ≈ K_sc for the high modes it stands for
     res.symmetric = true;
-    res.residual = true;
+    res.residual = true;  // no radiation damping: it stands for modes whose shapes are not computed
     p.modes.push_back(res);
     p.c_residual = 0.0;
   }

@@ -45,6 +45,13 @@ struct ModalOptions {
   // the rest either way). ~3x faster; ignored when a ModalResult is asked for
   // or the mesh has an odd number of axial elements.
   bool mirror_symmetry = true;
+  // port_model() only, a SIMULATOR input (issue 21, out of the effect
+  // catalogue): characteristic impedance Z_a (Pa·s/m, water ≈ 1.48e6) of a
+  // fluid loading the outer cylindrical surface as a radial dashpot
+  // (model/outer_surface_damping.hpp). Each elastic mode gets
+  // PortMode::radiation_damping = Z_a·φ_kᵀ C_a1 φ_k; the residual pseudo-mode
+  // gets none. 0 (default) leaves every result unchanged. Finite, >= 0.
+  double outer_surface_impedance = 0.0;
   void validate() const;
 };
 

@@ -36,6 +36,12 @@ struct PortMode {
   double kappa = 0;          // φ_kᵀ K_UU φ_k (for βK_UU damping and Qm)
   bool symmetric = false;    // about the mid-plane
   bool residual = false;     // the pseudo-mode standing for all truncated modes
+  // Damping added to c_k by an acoustic load on the outer surface (1/s;
+  // ModalOptions::outer_surface_impedance, model/outer_surface_damping.hpp).
+  // A simulator input only (acquisition/divider_state_space.cpp adds it):
+  // charge_per_volt and the diagnosis ignore it. 0 unless asked for, and 0 on
+  // the residual pseudo-mode.
+  double radiation_damping = 0;
 };
 
 struct ModalPortModel {

@@ -6,6 +6,7 @@
 #include <complex>
 #include <functional>
 #include <memory>
+#include <vector>
 
 #include "acquisition/divider_state_space.hpp"
 #include "acquisition/sim_setup.hpp"
@@ -17,13 +18,23 @@ namespace piezo::test {
 
 inline model::ModalPortModel sim_port(const acq::SimSpec& spec) {
   auto mat = model::resolve_material({spec.material, spec.isotropic, spec.set});
-  model::TubeGeometry g = spec.geometry;
+  model::TubeGeometry g = acq::true_geometry(spec);  // with the unmodelled wall error, if any
   g.density_kg_m3 = mat.density_kg_m3;
   model::TubeModel tube(g);
   model::ModalSolver solver(tube);
   model::ModalOptions mo;
   mo.n_modes = spec.modes;
+  mo.outer_surface_impedance = spec.unmodelled.acoustic_impedance_pa_s_m;
   return solver.port_model(model::to_e_form(mat.d), mo);
+}
+
+// The unmodelled parasitic branches of `spec` as element values (as make_sim_bench sets them).
+inline std::vector<acq::ParasiticBranch> sim_parasitic_branches(const acq::SimSpec& spec,
+                                                                const model::ModalPortModel& port) {
+  std::vector<acq::ParasiticBranch> b;
+  for (const auto& r : spec.unmodelled.parasitic_branches)
+    b.push_back(acq::parasitic_branch(r, port.c_static));
+  return b;
 }
 
 // Z(f) of the bare transducer of `spec` (its fixture effects ignored).
@@ -32,7 +43,9 @@ inline std::function<std::complex<double>(double)> true_tube_impedance(const acq
   c.dielectric_loss = spec.effects.dielectric_loss;
   c.damping = spec.damping;
   c.extra_damping_ratio = spec.effects.mechanical_damping;
-  auto ss = std::make_shared<acq::DividerStateSpace>(sim_port(spec), c);
+  const auto port = sim_port(spec);
+  c.parasitic_branches = sim_parasitic_branches(spec, port);  // part of the transducer
+  auto ss = std::make_shared<acq::DividerStateSpace>(port, c);
   const double r1 = c.r1_ohm;
   return [ss, r1](double f) {
     const std::complex<double> t = ss->transfer(2 * M_PI * f);
@@ -55,7 +68,9 @@ inline std::function<std::complex<double>(double)> exact_measured_impedance(
   c.dielectric_loss = e.dielectric_loss;
   c.damping = spec.damping;
   c.extra_damping_ratio = e.mechanical_damping;
-  auto ss = std::make_shared<acq::DividerStateSpace>(sim_port(spec), c);
+  const auto port = sim_port(spec);
+  c.parasitic_branches = sim_parasitic_branches(spec, port);
+  auto ss = std::make_shared<acq::DividerStateSpace>(port, c);
   const double g = e.channel_gain, tau = e.channel_skew_s;
   return [ss, g, tau, r1_nominal](double f) {
     const double w = 2 * M_PI * f;
