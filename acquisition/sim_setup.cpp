@@ -1,6 +1,7 @@
 #include "acquisition/sim_setup.hpp"
 
 #include <cmath>
+#include <cstdio>
 #include <stdexcept>
 
 #include "acquisition/divider_state_space.hpp"
@@ -106,7 +107,10 @@ std::shared_ptr<drivers::sim::SimBench> make_sim_bench(const SimSpec& spec, doub
   std::string what;
   for (std::size_t i = 0; i < un.parasitic_branches.size(); ++i) {
     const auto& r = un.parasitic_branches[i];
-    const std::string sfx = i == 0 ? "" : "_" + std::to_string(i + 1);
+    // (snprintf: GCC 12 -O3 warns falsely (-Wrestrict) on "_" + std::to_string)
+    char sfx_buf[24] = "";
+    if (i > 0) std::snprintf(sfx_buf, sizeof sfx_buf, "_%zu", i + 1);
+    const std::string sfx = sfx_buf;
     truth.emplace_back("unmodelled_parasitic_f_hz" + sfx, r.f_hz);
     truth.emplace_back("unmodelled_parasitic_k_eff" + sfx, r.k_eff);
     truth.emplace_back("unmodelled_parasitic_q" + sfx, r.q);

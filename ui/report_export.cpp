@@ -135,7 +135,8 @@ nlohmann::json diagnosis_json(const update::GapDiagnosis& d) {
       rj["resonance"] = nullptr;
       if (g.resonance)
         rj["resonance"] = {{"f_hz", g.resonance->f_hz}, {"q", g.resonance->q}, {"k_eff", g.resonance->k_eff},
-                           {"c_f", g.resonance->c_f}, {"delta_chi2", g.resonance->delta_chi2}};
+                           {"c_f", g.resonance->c_f}, {"delta_chi2", g.resonance->delta_chi2},
+                           {"q_resolved", g.resonance->q_resolved}, {"q_min", g.resonance->q_min}};
     }
     j["regions"].push_back(rj);
   }

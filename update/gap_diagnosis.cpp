@@ -9,6 +9,8 @@
 #include <memory>
 #include <stdexcept>
 
+#include "model/bench_response.hpp"
+
 namespace piezo::update {
 
 namespace {
@@ -59,6 +61,43 @@ std::vector<double> extend(const std::vector<double>& base, const GapModel& m) {
   for (std::size_t i = 0; i < base.size() && i < x.size(); ++i) x[i] = base[i];
   return x;
 }
+// The misfit of `d` at x as a residual spectrum (update/residual_regions.hpp)
+// in impedance terms: "T" is the reported Z of the model, the drive 1,
+// e = Z_model − Z_meas, var = |Z|²(σ_ln|Z|² + σ_phase²), ∂Z/∂Y of the
+// transducer's admittance through the bench's effects — so that an extra
+// resonance, a level, a phase or a phase slope read the same as in the
+// output-error diagnosis (issue 21). Empty when the model cannot be built.
+std::vector<ResidualRegion> located_regions(const GapModel& m, const GapData& d, const std::vector<double>& x,
+                                            double r1_nominal_ohm) {
+  model::ModalPortModel port;
+  try {
+    port = m.exact_port(x);
+  } catch (const std::exception&) {
+    return {};
+  }
+  const auto damp = m.damping(x);
+  const auto fx = m.effects(x);
+  ResidualSpectrum s;
+  for (std::size_t i = 0; i < d.size(); ++i) {
+    const double w = 2.0 * M_PI * d.f_hz[i];
+    if (!(w > 0)) continue;
+    const std::complex<double> y = model::tube_admittance(port, damp, fx, w);
+    const std::complex<double> z = model::reported_impedance(y, fx, r1_nominal_ohm, w);
+    const std::complex<double> dy = 1e-6 * std::abs(y);
+    const std::complex<double> dz = (model::reported_impedance(y + dy, fx, r1_nominal_ohm, w) - z) / dy;
+    const double var = std::norm(d.z_ohm[i]) * (d.sigma_log_mag[i] * d.sigma_log_mag[i] + d.sigma_phase[i] * d.sigma_phase[i]);
+    if (!(var > 0) || !std::isfinite(var) || !std::isfinite(std::abs(z))) continue;
+    s.f_hz.push_back(d.f_hz[i]);
+    s.e.push_back(z - d.z_ohm[i]);
+    s.lv1.push_back(1.0);
+    s.t.push_back(z);
+    s.dt_dy.push_back(dz);
+    s.y_tube.push_back(y);
+    s.var.push_back(var);
+  }
+  return residual_regions(s, 2, 1e-3);
+}
+
 }  // namespace
 
 std::vector<std::string> supported_gap_effects() {
@@ -389,6 +428,41 @@ GapDiagnosis diagnose_gap(model::ModalSolver& solver, const MaterialClass& cls, 
     for (const auto& g : out.regions)
       if (!worst || g.chi2 > worst->chi2) worst = &g;
     const bool fit_gap = significant_gap(out.chi2_fit, out.dof_fit, opt.gap_tolerance);
+    // Where the misfit stands above the noise and what it looks like there
+    // (issue 21): on the fit data, or on the held-out data when only they
+    // show the gap; listed before the engineer's named regions.
+    const bool located_heldout = !fit_gap && heldout;
+    const auto located = located_regions(m, located_heldout ? *heldout : fit, base.x, r1);
+    std::vector<GapRegion> first;
+    std::string where;
+    for (std::size_t i = 0; i < located.size(); ++i) {
+      const ResidualRegion& g = located[i];
+      GapRegion rg;
+      rg.name = (located_heldout ? "held-out region " : "residual region ") + std::to_string(i + 1);
+      rg.f_lo_hz = g.f_lo_hz;
+      rg.f_hi_hz = g.f_hi_hz;
+      rg.points = g.bins;
+      rg.chi2 = g.chi2;
+      rg.share = g.share;
+      rg.excess = g.chi2 - 2.0 * g.bins;
+      rg.kind = g.kind;
+      rg.level_db = 20.0 * std::log10(std::max(1e-6, 1.0 + g.level_pct / 100.0));
+      rg.phase_deg = g.phase_deg;
+      rg.log10_p = g.log10_p;
+      rg.delay_s = g.delay_s;
+      rg.resonance = g.resonance;
+      rg.description = g.description;
+      first.push_back(rg);
+      where += (i > 0 ? "; and in " : located_heldout ? " The held-out data stand above the noise in "
+                                                      : " The misfit stands above the noise in ") + g.description;
+    }
+    if (!where.empty()) where += ".";
+    for (const auto& g : located)
+      if (g.resonance) {
+        where += " An extra resonance is a pole pair the model lacks: a mounting or fixture resonance, or a mode an "
+                 "electrode defect makes electrically active.";
+        break;
+      }
     if (fit_gap)
       std::snprintf(buf, sizeof buf,
                     "Unexplained gap (chi2/dof %.2f), mostly at %s (%s): no effect of the catalogue explains it on held-out data.",
@@ -399,7 +473,8 @@ GapDiagnosis diagnose_gap(model::ModalSolver& solver, const MaterialClass& cls, 
                     "the catalogue explains it; a second capture would tell a real gap from a held-out capture that "
                     "differs (drive, fixture, temperature).",
                     out.gap_heldout.value_or(0.0), out.gap_fit);
-    out.verdict = buf + alias_note;
+    out.verdict = buf + where + alias_note;
+    out.regions.insert(out.regions.begin(), first.begin(), first.end());  // (after `worst` is used)
   }
   out.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   say(1.0, "gap: done");

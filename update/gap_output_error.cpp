@@ -49,11 +49,15 @@ GapDiagnosis build(const OeResult& r, const std::string& fit_description, const 
   d.fit_description = fit_description + "; output-error residual, noise from " + r.noise_source;
   d.material_base = r.updated;
   d.damping_base = r.damping;
-  // Where the residual stands above the noise (a lack of fit only).
-  for (std::size_t i = 0; i < r.regions.size(); ++i) {
-    const ResidualRegion& g = r.regions[i];
+  // Where the residual stands above the noise (a lack of fit only): the
+  // fit's, else the held-out prediction's (another drive often shows what
+  // the fit's own record cannot).
+  const bool regions_heldout = r.regions.empty() && ho && !ho->base.regions.empty();
+  const std::vector<ResidualRegion>& regions = regions_heldout ? ho->base.regions : r.regions;
+  for (std::size_t i = 0; i < regions.size(); ++i) {
+    const ResidualRegion& g = regions[i];
     GapRegion rg;
-    rg.name = "residual region " + std::to_string(i + 1);
+    rg.name = (regions_heldout ? "held-out region " : "residual region ") + std::to_string(i + 1);
     rg.f_lo_hz = g.f_lo_hz;
     rg.f_hi_hz = g.f_hi_hz;
     rg.points = g.bins;
@@ -255,7 +259,10 @@ GapDiagnosis build(const OeResult& r, const std::string& fit_description, const 
                     r.band_lo_hz / 1e3, r.band_hi_hz / 1e3, r.band_excess, r.band_log10_p);
     std::string where;
     for (std::size_t i = 0; i < d.regions.size(); ++i)
-      where += (i == 0 ? " The residual stands above the noise in " : "; and in ") + d.regions[i].description;
+      where += (i > 0                ? "; and in "
+                : regions_heldout    ? " The held-out prediction stands above the noise in "
+                                     : " The residual stands above the noise in ") +
+               d.regions[i].description;
     if (!where.empty()) where += ".";
     for (const auto& g : d.regions)
       if (g.resonance) {

@@ -341,7 +341,10 @@ class Problem {
   // (the offsets), with its variance n·|L|²(σ1²|T|² + σ2²) under white noise
   // σ1 on v1 and σ2 on v2, the model's admittance and ∂T/∂Y.
   std::optional<ResidualSpectrum> residual_spectrum(const Eigen::VectorXd& x, double s1, double s2) {
-    const model::EffectSet fx = effects_at(x);
+    return residual_spectrum(x, effects_at(x), s1, s2);
+  }
+  std::optional<ResidualSpectrum> residual_spectrum(const Eigen::VectorXd& x, const model::EffectSet& fx, double s1,
+                                                    double s2) {
     const model::ModalPortModel* pp = port_of(x, fx.mass_loading);
     if (!pp) return std::nullopt;
     const model::RayleighDamping damp{0.0, co_.beta(x)};
@@ -1461,6 +1464,7 @@ OePrediction predict_output_error(model::ModalSolver& solver, const MaterialClas
   // linearly: a few Gauss-Newton steps of the penalised problem.
   const Eigen::Index np = covariance_rel.rows();
   const auto coord = effect.empty() ? std::nullopt : effect_coordinate(effect);
+  Eigen::VectorXd z = Eigen::VectorXd::Zero(kParams);  // the constants where the held-out data put them
   if ((np == kParams || (np == kParams + 1 && coord)) && covariance_rel.cols() == np && covariance_rel.allFinite()) {
     // C⁻¹ on C's positive eigenvalues (a covariance from a nearly singular
     // JᵀJ can carry rounding-negative ones; a direction C does not constrain
@@ -1478,7 +1482,7 @@ OePrediction predict_output_error(model::ModalSolver& solver, const MaterialClas
       if (!rz.allFinite()) return std::nullopt;
       return rz;
     };
-    Eigen::VectorXd z = Eigen::VectorXd::Zero(np);
+    z = Eigen::VectorXd::Zero(np);
     Eigen::VectorXd rz = r;
     double cost = chi2;
     for (int it = 0; it < 4; ++it) {
@@ -1536,6 +1540,14 @@ OePrediction predict_output_error(model::ModalSolver& solver, const MaterialClas
   if (!std::isfinite(chi2)) throw std::runtime_error("predict_output_error: the prediction is not finite");
   out.chi2_per_dof = chi2 / out.dof;
   out.chi2_limit = 1.0 + opt.lack_of_fit_z * std::sqrt(2.0 / out.dof + (out.noise_dof > 0 ? 2.0 / out.noise_dof : 0.0));
+  // Where the prediction misses (issue 21): the held-out data of another
+  // drive often show what the fit's own record cannot.
+  if (out.chi2_per_dof > out.chi2_limit) {
+    model::EffectSet fz = effects;
+    if (z.size() > kParams && coord) coord->apply(fz, z[kParams]);
+    if (const auto rs = prob.residual_spectrum(z.head(kParams), fz, noise.ch1, noise.ch2))
+      out.regions = residual_regions(*rs, 2, opt.lack_of_fit_p);
+  }
   return out;
 }
 

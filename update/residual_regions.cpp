@@ -225,19 +225,29 @@ std::vector<ResidualRegion> residual_regions(const ResidualSpectrum& s, int max_
         if (std::abs(s.f_hz[k] - f_best) < std::abs(s.f_hz[kb] - f_best)) kb = k;
       const double c_t = s.y_tube[kb].imag() / (kTwoPi * s.f_hz[kb]);
       x.k_eff = c_t > 0 ? std::sqrt(x.c_f / (x.c_f + c_t)) : NAN;
+      // The record's resolution: the median bin spacing.
+      std::vector<double> df;
+      for (std::size_t k = 1; k < n; ++k) df.push_back(s.f_hz[k] - s.f_hz[k - 1]);
+      std::nth_element(df.begin(), df.begin() + static_cast<long>(df.size() / 2), df.end());
+      const double bin = df[df.size() / 2];
+      x.q_resolved = x.f_hz / x.q >= 3.0 * bin;
+      x.q_min = x.f_hz / (3.0 * bin);
       g.kind = "extra resonance";
       g.resonance = x;
-      std::snprintf(buf, sizeof buf, "an extra resonance at %s kHz (Q %.3g, k_eff %.2g)", khz(x.f_hz).c_str(), x.q,
+      char qtext[64];
+      if (x.q_resolved) std::snprintf(qtext, sizeof qtext, "Q %.3g", x.q);
+      else std::snprintf(qtext, sizeof qtext, "Q above %.2g, narrower than the record resolves", x.q_min);
+      std::snprintf(buf, sizeof buf, "an extra resonance at %s kHz (%s, k_eff %.2g)", khz(x.f_hz).c_str(), qtext,
                     x.k_eff);
     } else if (top == score_sl) {
       g.kind = "phase slope";
       std::snprintf(buf, sizeof buf, "a phase slope (a delay of %.3g ns)", g.delay_s * 1e9);
     } else if (std::abs(lp.a[0]) >= std::abs(lp.a[1])) {
       g.kind = "level";
-      std::snprintf(buf, sizeof buf, "a level offset of %+.2g %%", g.level_pct);
+      std::snprintf(buf, sizeof buf, "a level offset of %+.3g %%", g.level_pct);
     } else {
       g.kind = "phase";
-      std::snprintf(buf, sizeof buf, "a phase offset of %+.2g deg", g.phase_deg);
+      std::snprintf(buf, sizeof buf, "a phase offset of %+.3g deg", g.phase_deg);
     }
     g.description = khz(g.f_lo_hz) + "-" + khz(g.f_hi_hz) + " kHz: " + buf;
     out.push_back(g);

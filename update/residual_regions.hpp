@@ -51,6 +51,11 @@ struct ResidualSpectrum {
 struct ExtraResonance {
   double f_hz = 0;       // the branch's series resonance
   double q = 0;
+  // A resonance narrower than 3 bins of the record (f/Q < 3/T_record) has
+  // its width set by the record, not by its damping: Q is then only known to
+  // exceed q_min = f·T_record/3 (q holds the fit, not to be quoted).
+  bool q_resolved = true;
+  double q_min = 0;
   double c_f = 0;        // motional capacitance C_b
   double k_eff = 0;      // effective coupling of the branch against the transducer's capacitance
   double delta_chi2 = 0;  // what it removes from the region's χ²

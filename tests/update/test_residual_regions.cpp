@@ -76,6 +76,23 @@ TEST(ResidualRegions, AnExtraResonanceIsFoundWithItsFrequencyQAndCoupling) {
   EXPECT_NE(g.description.find("extra resonance at 31.7"), std::string::npos) << g.description;
 }
 
+TEST(ResidualRegions, AResonanceNarrowerThanTheRecordResolvesHasOnlyALowerBoundOnQ) {
+  // Q 3000 at 31.7 kHz: 10.6 Hz wide, a fifth of a 50 Hz bin — the record cannot tell Q 3000 from 1000.
+  const double c = 3.9e-9, k = 0.05, cb = k * k / (1 - k * k) * c, fb = 31.7e3, q = 3000;
+  auto branch = [&](double f, cd, cd t) {
+    const double u = f / fb;
+    return -1e3 * t * t * cd(0.0, kTwoPi * f * cb) / cd(1 - u * u, u / q);
+  };
+  const auto regions = residual_regions(spectrum(branch, 1e-4, 9), 2, 1e-3);
+  ASSERT_FALSE(regions.empty());
+  ASSERT_TRUE(regions.front().resonance.has_value()) << regions.front().description;
+  const auto& x = *regions.front().resonance;
+  EXPECT_NEAR(x.f_hz, fb, 50.0);
+  EXPECT_FALSE(x.q_resolved) << "fitted Q " << x.q;
+  EXPECT_NEAR(x.q_min, fb / 150.0, 1e-6 * fb);  // f·T_record/3 with 50 Hz bins
+  EXPECT_NE(regions.front().description.find("narrower than the record resolves"), std::string::npos);
+}
+
 TEST(ResidualRegions, ALevelOffsetIsALevelNotAResonance) {
   // δT = −2 % of T between 30 and 32 kHz (a band-limited gain error).
   auto level = [](double f, cd, cd t) { return (f > 30e3 && f < 32e3) ? -0.02 * t : cd(0, 0); };
