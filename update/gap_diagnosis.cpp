@@ -433,36 +433,8 @@ GapDiagnosis diagnose_gap(model::ModalSolver& solver, const MaterialClass& cls, 
     // show the gap; listed before the engineer's named regions.
     const bool located_heldout = !fit_gap && heldout;
     const auto located = located_regions(m, located_heldout ? *heldout : fit, base.x, r1);
-    std::vector<GapRegion> first;
-    std::string where;
-    for (std::size_t i = 0; i < located.size(); ++i) {
-      const ResidualRegion& g = located[i];
-      GapRegion rg;
-      rg.name = (located_heldout ? "held-out region " : "residual region ") + std::to_string(i + 1);
-      rg.f_lo_hz = g.f_lo_hz;
-      rg.f_hi_hz = g.f_hi_hz;
-      rg.points = g.bins;
-      rg.chi2 = g.chi2;
-      rg.share = g.share;
-      rg.excess = g.chi2 - 2.0 * g.bins;
-      rg.kind = g.kind;
-      rg.level_db = 20.0 * std::log10(std::max(1e-6, 1.0 + g.level_pct / 100.0));
-      rg.phase_deg = g.phase_deg;
-      rg.log10_p = g.log10_p;
-      rg.delay_s = g.delay_s;
-      rg.resonance = g.resonance;
-      rg.description = g.description;
-      first.push_back(rg);
-      where += (i > 0 ? "; and in " : located_heldout ? " The held-out data stand above the noise in "
-                                                      : " The misfit stands above the noise in ") + g.description;
-    }
-    if (!where.empty()) where += ".";
-    for (const auto& g : located)
-      if (g.resonance) {
-        where += " An extra resonance is a pole pair the model lacks: a mounting or fixture resonance, or a mode an "
-                 "electrode defect makes electrically active.";
-        break;
-      }
+    const std::vector<GapRegion> first = located_gap_regions(located, located_heldout);
+    const std::string where = located_sentence(first, located_heldout ? "held-out data" : "misfit");
     if (fit_gap)
       std::snprintf(buf, sizeof buf,
                     "Unexplained gap (chi2/dof %.2f), mostly at %s (%s): no effect of the catalogue explains it on held-out data.",

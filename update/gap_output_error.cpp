@@ -54,25 +54,7 @@ GapDiagnosis build(const OeResult& r, const std::string& fit_description, const 
   // the fit's own record cannot).
   const bool regions_heldout = r.regions.empty() && ho && !ho->base.regions.empty();
   const std::vector<ResidualRegion>& regions = regions_heldout ? ho->base.regions : r.regions;
-  for (std::size_t i = 0; i < regions.size(); ++i) {
-    const ResidualRegion& g = regions[i];
-    GapRegion rg;
-    rg.name = (regions_heldout ? "held-out region " : "residual region ") + std::to_string(i + 1);
-    rg.f_lo_hz = g.f_lo_hz;
-    rg.f_hi_hz = g.f_hi_hz;
-    rg.points = g.bins;
-    rg.chi2 = g.chi2;
-    rg.share = g.share;
-    rg.excess = g.chi2 - 2.0 * g.bins;
-    rg.kind = g.kind;
-    rg.level_db = 20.0 * std::log10(std::max(1e-6, 1.0 + g.level_pct / 100.0));
-    rg.phase_deg = g.phase_deg;
-    rg.log10_p = g.log10_p;
-    rg.delay_s = g.delay_s;
-    rg.resonance = g.resonance;
-    rg.description = g.description;
-    d.regions.push_back(rg);
-  }
+  d.regions = located_gap_regions(regions, regions_heldout);
   // g = √max(0, χ²/N − 1): the excess over the noise.
   const double g_before = std::sqrt(std::max(0.0, r.chi2_per_dof - 1.0));
   const OeEffect* top = nullptr;
@@ -257,19 +239,7 @@ GapDiagnosis build(const OeResult& r, const std::string& fit_description, const 
                     "Unexplained gap in %.3g-%.3g kHz (residual %.3g times the noise there, chance 1e%.1f): no effect "
                     "of the catalogue explains it.",
                     r.band_lo_hz / 1e3, r.band_hi_hz / 1e3, r.band_excess, r.band_log10_p);
-    std::string where;
-    for (std::size_t i = 0; i < d.regions.size(); ++i)
-      where += (i > 0                ? "; and in "
-                : regions_heldout    ? " The held-out prediction stands above the noise in "
-                                     : " The residual stands above the noise in ") +
-               d.regions[i].description;
-    if (!where.empty()) where += ".";
-    for (const auto& g : d.regions)
-      if (g.resonance) {
-        where += " An extra resonance is a pole pair the model lacks: a mounting or fixture resonance, or a mode an "
-                 "electrode defect makes electrically active.";
-        break;
-      }
+    const std::string where = located_sentence(d.regions, regions_heldout ? "held-out prediction" : "residual");
     d.verdict = buf + where + near + heldout_note;
   }
   std::vector<std::string> aliases;

@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cmath>
 #include <complex>
+#include <string>
 
 namespace piezo::update {
 
@@ -158,6 +159,46 @@ std::vector<GapRegion> gap_regions(const GapModel& m, const GapData& d, const st
     g.kind = (g.excess < spread || arg < 0) ? "noise" : names[arg];
   }
   return regions;
+}
+
+std::vector<GapRegion> located_gap_regions(const std::vector<ResidualRegion>& regions, bool heldout) {
+  std::vector<GapRegion> out;
+  for (std::size_t i = 0; i < regions.size(); ++i) {
+    const ResidualRegion& g = regions[i];
+    GapRegion rg;
+    rg.name = (heldout ? "held-out region " : "residual region ") + std::to_string(i + 1);
+    rg.f_lo_hz = g.f_lo_hz;
+    rg.f_hi_hz = g.f_hi_hz;
+    rg.points = g.bins;
+    rg.chi2 = g.chi2;
+    rg.share = g.share;
+    rg.excess = g.chi2 - 2.0 * g.bins;
+    rg.kind = g.kind;
+    rg.level_db = 20.0 * std::log10(std::max(1e-6, 1.0 + g.level_pct / 100.0));
+    rg.phase_deg = g.phase_deg;
+    rg.log10_p = g.log10_p;
+    rg.delay_s = g.delay_s;
+    rg.resonance = g.resonance;
+    rg.description = g.description;
+    out.push_back(rg);
+  }
+  return out;
+}
+
+std::string located_sentence(const std::vector<GapRegion>& regions, const std::string& lead) {
+  std::string s;
+  bool resonance = false;
+  for (const auto& g : regions) {
+    if (g.description.empty()) continue;
+    s += (s.empty() ? " The " + lead + " stands above the noise in " : std::string("; and in ")) + g.description;
+    resonance = resonance || g.resonance.has_value();
+  }
+  if (s.empty()) return s;
+  s += ".";
+  if (resonance)
+    s += " An extra resonance is a pole pair the model lacks: a mounting or fixture resonance, or a mode an "
+         "electrode defect makes electrically active.";
+  return s;
 }
 
 }  // namespace piezo::update

@@ -34,6 +34,14 @@ struct GapRegion {
   std::string description;
 };
 
+// The located regions of update/residual_regions.hpp as GapRegions, named
+// "residual region i" or, found in held-out data, "held-out region i".
+std::vector<GapRegion> located_gap_regions(const std::vector<ResidualRegion>& regions, bool heldout);
+// The verdict's sentence on them: " The <lead> stands above the noise in
+// <description>; and in <description>." and, when one is an extra resonance,
+// what such a resonance is. Empty for no region.
+std::string located_sentence(const std::vector<GapRegion>& regions, const std::string& lead);
+
 // Regions of the misfit of model `m` at `x` against `d`.
 std::vector<GapRegion> gap_regions(const GapModel& m, const GapData& d, const std::vector<double>& x);
 

@@ -192,7 +192,7 @@ fs::path tmp_dir(const std::string& name) { return test::scratch_dir(name); }
 // control on four shots (the impedance-domain path).
 TEST(GapOutOfCatalogueCi, ParasiticBranchIsUnexplainedAndLocated) {
   OocTally t;
-  const auto r = run_ooc(0, 5, 0.02, 1, tmp_dir("ooc-ci"));
+  const auto r = run_ooc(0, 5, 0.02, 1, tmp_dir("ooc-ci-branch"));
   score(r, t);
   ASSERT_TRUE(r.result.diagnosis);
   const auto& d = *r.result.diagnosis;
@@ -209,7 +209,7 @@ TEST(GapOutOfCatalogueCi, ParasiticBranchIsUnexplainedAndLocated) {
 
 TEST(GapOutOfCatalogueCi, ControlOnFourShotsIsNone) {
   OocTally t;
-  const auto r = run_ooc(4, 6, 0.02, 4, tmp_dir("ooc-ci"));
+  const auto r = run_ooc(4, 6, 0.02, 4, tmp_dir("ooc-ci-control"));  // (its own folder: ctest -j runs the two side by side)
   score(r, t);
   ASSERT_TRUE(r.result.diagnosis);
   EXPECT_EQ(r.result.diagnosis->verdict_effect, "none") << r.result.diagnosis->verdict;

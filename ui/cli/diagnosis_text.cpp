@@ -23,6 +23,10 @@ void print_diagnosis(std::ostream& os, const update::GapDiagnosis& d) {
   if (!d.regions.empty()) os << "    where (share of chi2, kind):\n";
   for (const auto& g : d.regions) {
     if (g.points == 0) continue;
+    if (!g.description.empty()) {  // a located region (update/residual_regions.hpp): its phrase, as in the verdict
+      os << fmt("      %5.1f %%  ", 100 * g.share) << g.name << ": " << g.description << "\n";
+      continue;
+    }
     os << fmt("      %5.1f %%  ", 100 * g.share) << g.name << fmt(" [%.1f-%.1f kHz]: ", g.f_lo_hz / 1e3, g.f_hi_hz / 1e3)
        << g.kind;
     if (g.kind == "frequency shift") os << fmt(" %+.3f %%", g.shift_pct);
