@@ -28,6 +28,7 @@ inline constexpr ImU32 kColNoiseBand = IM_COL32(150, 150, 150, 255);     // grey
 inline constexpr ImU32 kColRegionShift = IM_COL32(255, 150, 0, 110);   // orange
 inline constexpr ImU32 kColRegionWidth = IM_COL32(255, 60, 60, 110);   // red
 inline constexpr ImU32 kColRegionLevel = IM_COL32(60, 120, 255, 110);  // blue
+inline constexpr ImU32 kColRegionResonance = IM_COL32(240, 220, 0, 110);  // yellow: an extra resonance (issue 21)
 inline constexpr ImU32 kColRegionPhase = IM_COL32(200, 80, 255, 110);  // violet
 inline constexpr ImU32 kColRegionNoise = IM_COL32(255, 255, 255, 14);  // neutral
 
@@ -36,7 +37,8 @@ inline ImU32 region_colour(std::string_view kind) {
   if (kind == "frequency shift") return kColRegionShift;
   if (kind == "peak width/height") return kColRegionWidth;
   if (kind == "level") return kColRegionLevel;
-  if (kind == "phase") return kColRegionPhase;
+  if (kind == "phase" || kind == "phase slope") return kColRegionPhase;
+  if (kind == "extra resonance") return kColRegionResonance;
   return kColRegionNoise;
 }
 

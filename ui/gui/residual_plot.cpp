@@ -12,10 +12,14 @@ const char* short_kind(const std::string& kind) {
   if (kind == "peak width/height") return "width";
   if (kind == "level") return "level";
   if (kind == "phase") return "phase";
+  if (kind == "phase slope") return "slope";
+  if (kind == "extra resonance") return "resonance";
   return "";
 }
 
 std::string region_detail(const update::GapRegion& g) {
+  // A located region (update/residual_regions.hpp) in the verdict's words.
+  if (!g.description.empty()) return g.name + ": " + g.description;
   char buf[200];
   int n = std::snprintf(buf, sizeof buf, "%s [%.1f-%.1f kHz]: %.0f %% of chi2, %s", g.name.c_str(),
                         g.f_lo_hz / 1e3, g.f_hi_hz / 1e3, 100 * g.share, g.kind.c_str());

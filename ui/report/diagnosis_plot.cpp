@@ -141,9 +141,15 @@ struct Band {
   const update::GapRegion* region;
 };
 
+// Where the diagnosis located an unexplained misfit (regions with their
+// phrase, update/residual_regions.hpp), only those: the named regions of the
+// impedance-domain diagnosis would overlap them.
 std::vector<Band> bands_of(const update::GapDiagnosis& d, double fmin, double fmax) {
   std::vector<Band> out;
+  const bool located = std::any_of(d.regions.begin(), d.regions.end(),
+                                   [](const update::GapRegion& g) { return !g.description.empty(); });
   for (const auto& g : d.regions) {
+    if (located && g.description.empty()) continue;
     const double lo = std::max(g.f_lo_hz, fmin), hi = std::min(g.f_hi_hz, fmax);
     if (hi > lo) out.push_back({lo, hi, &g});
   }
@@ -297,10 +303,14 @@ void region_names(const Frame& F, const std::vector<Band>& bands) {
   for (std::size_t k = 0; k < bands.size(); ++k) {
     const auto& g = *bands[k].region;
     names[k] = g.name;
-    if (g.share >= 0.1 && g.kind != "noise")
+    if (!g.description.empty())  // a located region: its phrase, the verdict's words
+      names[k] = g.description;
+    else if (g.share >= 0.1 && g.kind != "noise")
       names[k] += fmt(": %.0f %% of chi2, ", 100 * g.share) + g.kind;
     const double xa = ax(bands[k].lo), xz = ax(bands[k].hi);
     flat[k] = xz - xa > F.cv.text_width(names[k]) + 12;
+    if (!flat[k] && !g.description.empty())  // too long to stand in a narrow band: the kind (and where)
+      names[k] = g.resonance ? fmt("extra resonance %.2f kHz", g.resonance->f_hz / 1e3) : g.kind;
     xs[k] = flat[k] ? (xa + xz) / 2 : std::round((xa + xz) / 2 - lh / 2);
   }
   for (std::size_t k = 1; k < xs.size(); ++k)  // left to right: keep a line apart
