@@ -95,6 +95,28 @@ std::size_t select_order(const Eigen::VectorXd& s, double s_noise, std::size_t m
   return std::max<std::size_t>(p, 1);
 }
 
+std::size_t largest_drop_order(const Eigen::VectorXd& s, std::size_t max_order) {
+  if (s.size() < 2 || !(s[0] > 0.0))
+    throw std::invalid_argument("largest_drop_order: need two singular values and s_1 > 0");
+  const auto last = std::min<Eigen::Index>(static_cast<Eigen::Index>(std::max<std::size_t>(max_order, 1)),
+                                           s.size() - 1);
+  // Singular values at the SVD's rounding level (below 1e-13·s_1: ~1e3 ulp,
+  // what a dense SVD of a few-hundred-square matrix leaves of an exactly
+  // rank-deficient one) count as that level: the drop INTO the rounding is the
+  // numerical rank, ratios among rounding values mean nothing.
+  const double floor = 1e-13 * s[0];
+  std::size_t best = 1;
+  double best_ratio = 0.0;
+  for (Eigen::Index p = 1; p <= last; ++p) {  // drop between s_p and s_{p+1} (1-based)
+    const double ratio = std::max(s[p - 1], floor) / std::max(s[p], floor);
+    if (ratio > best_ratio) {
+      best_ratio = ratio;
+      best = static_cast<std::size_t>(p);
+    }
+  }
+  return best;
+}
+
 std::size_t decimation_factor(const PronyOptions& opt, double sample_rate_hz) {
   if (opt.decimation > 0) return opt.decimation;
   return opt.band_hz > 0.0 ? std::max<std::size_t>(
@@ -169,8 +191,10 @@ Decomposition decompose(const Eigen::Ref<const Eigen::MatrixXd>& y, double sampl
   if (automatic && k_used < 24)
     fail("too short for the automatic order: " + std::to_string(k_used) +
          " samples, need at least 24 (or give the order)");
-  Eigen::MatrixXd noise;  // simulated noise, scaled like the data (automatic order only)
-  if (automatic) {
+  // The noise-floor rule compares with simulated noise; the largest-drop rule needs none.
+  const bool noise_floor = automatic && opt.order_rule == OrderRule::NoiseFloor;
+  Eigen::MatrixXd noise;  // simulated noise, scaled like the data (noise-floor rule only)
+  if (noise_floor) {
     Eigen::MatrixXd mix = opt.noise_mixing;
     if (!mix.size()) {
       mix = Eigen::MatrixXd::Zero(m, m);
@@ -184,7 +208,7 @@ Decomposition decompose(const Eigen::Ref<const Eigen::MatrixXd>& y, double sampl
   }
   if (dec > 1) {
     ys = decimate(ys, dec);
-    if (automatic) noise = decimate(noise, dec);
+    if (noise_floor) noise = decimate(noise, dec);
     if (ys.rows() < 8)
       fail("too short for decimation by " + std::to_string(dec) + ": " + std::to_string(k_used) +
            " samples leave " + std::to_string(ys.rows()) + " (need 8); lower band_hz/decimation");
@@ -222,7 +246,7 @@ Decomposition decompose(const Eigen::Ref<const Eigen::MatrixXd>& y, double sampl
               : randomized_svd(h, std::min<Eigen::Index>(want, std::min(h.rows(), h.cols())),
                                opt.power_iterations, opt.seed);
   if (!(d.svd.s[0] > 0.0)) fail("the Hankel matrix is zero");
-  if (automatic) {
+  if (noise_floor) {
     BlockHankel hn(noise, xi, eta);
     d.noise_singular_value =
         randomized_svd(hn, std::min<Eigen::Index>(8, std::min(hn.rows(), hn.cols())), 4, opt.seed).s[0];
@@ -240,7 +264,11 @@ PronyFit realize(Decomposition& d, const Eigen::Ref<const Eigen::MatrixXd>& y,
   fit.decimation = d.dec;
   fit.singular_values = d.svd.s;
   fit.order_automatic = order == 0;
-  if (order == 0) {
+  if (order == 0 && opt.order_rule == OrderRule::LargestDrop) {
+    // The seed's rule (§5.1.2); the rank cap keeps the realization's H(1) valid.
+    fit.order = largest_drop_order(
+        d.svd.s, std::min<std::size_t>(opt.max_order, static_cast<std::size_t>(d.rank_cap)));
+  } else if (order == 0) {
     fit.noise_singular_value = d.noise_singular_value;
     fit.order = select_order(d.svd.s, d.noise_singular_value,
                              std::min<std::size_t>(opt.max_order, static_cast<std::size_t>(d.rank_cap)),

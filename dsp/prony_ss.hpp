@@ -26,6 +26,17 @@ enum class SvdMethod {
   Randomized,  // FFT-based Hankel products + randomized range finder (Halko et al. 2011)
 };
 
+// How the automatic order is read off the singular values of H(0).
+enum class OrderRule {
+  // The noise floor (eqs 162-163): see noise_threshold below (the default).
+  NoiseFloor,
+  // The seed's §5.1.2 rule: the largest drop s_p/s_{p+1} among the first
+  // max_order + 1 singular values (its Fig. 27: "a significant gap between its
+  // 26th and 27th singular values ... the model order is set equal to 26").
+  // Needs no noise level; see largest_drop_order().
+  LargestDrop,
+};
+
 struct PronyOptions {
   std::size_t rows = 0;  // ξ, block rows of H(0); 0: half of the samples used
   std::size_t cols = 0;  // η; 0: samples − ξ (the most H(1) allows)
@@ -37,6 +48,7 @@ struct PronyOptions {
   // noise at the data's noise level: p = #{s_k > noise_threshold·s_noise}
   // (and s_k > 1e-12·s_1, the numerical floor of noise-free data).
   double noise_threshold = 1.25;
+  OrderRule order_rule = OrderRule::NoiseFloor;
   // Noise model: signal noise = noise_mixing · w, w iid N(0, 1) (m × q). Empty:
   // independent noise per signal with the std from estimate_noise_std().
   Eigen::MatrixXd noise_mixing;
@@ -103,6 +115,12 @@ std::size_t decimation_factor(const PronyOptions& opt, double sample_rate_hz);
 // Hankel's largest singular value.
 std::size_t select_order(const Eigen::VectorXd& s, double s_noise, std::size_t max_order,
                          double noise_threshold);
+
+// The seed's rule (OrderRule::LargestDrop): the p in 1..min(max_order, size−1)
+// with the largest ratio s_p/s_{p+1} (1-based; s descending; values below
+// 1e-13·s_1, the SVD's rounding, count as 1e-13·s_1, so a numerically
+// rank-deficient H(0) drops at its numerical rank). Throws std::invalid_argument for fewer than 2 values or s_1 <= 0.
+std::size_t largest_drop_order(const Eigen::VectorXd& s, std::size_t max_order);
 
 // Robust white-noise std of an oversampled signal: MAD of the 6th differences
 // (C(12,6)·σ² for white noise), blind to steps and to content well below Nyquist.

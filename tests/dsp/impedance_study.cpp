@@ -71,6 +71,15 @@ dsp::DividerRecord record(const StudyInput& in, std::size_t k) {
 }
 }  // namespace
 
+StudyRow study_result(const StudyInput& in, const dsp::ImpedanceResult& r, const std::string& method) {
+  StudyRow row;
+  row.method = method;
+  row.samples = r.samples_used;
+  if (r.prony) row.order = r.prony->order;
+  score(in, r, row);
+  return row;
+}
+
 bool near_feature(const StudyInput& in, double f) {
   for (const auto* v : {&in.true_resonances_hz, &in.true_antiresonances_hz})
     for (double t : *v)

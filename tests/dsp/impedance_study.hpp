@@ -9,6 +9,7 @@
 #include <string>
 #include <vector>
 
+#include "dsp/impedance_types.hpp"
 #include "dsp/prony_ss.hpp"
 
 namespace piezo::study {
@@ -56,6 +57,10 @@ bool near_feature(const StudyInput& in, double f_hz);
 
 // Prony-SS on the first `samples` samples of record 0; `prony` as given except
 // that band_hz = 0 becomes the study band's top (f_hi_hz: decimation D = fs/(5·band)).
+// Scores an estimate of any method (e.g. the charge path, dsp/prony_charge.hpp)
+// against the truth of `in` exactly as the methods below are scored.
+StudyRow study_result(const StudyInput& in, const dsp::ImpedanceResult& r, const std::string& method);
+
 StudyRow study_prony(const StudyInput& in, std::size_t samples, dsp::PronyOptions prony = {});
 StudyRow study_fft(const StudyInput& in, bool difference = true);
 StudyRow study_xspec(const StudyInput& in, std::size_t segment, bool difference = true);
