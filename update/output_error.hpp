@@ -236,8 +236,9 @@ struct OePrediction {
   double chi2_limit = 0;    // chi2_per_dof beyond this: the prediction misses (OeOptions::lack_of_fit_z)
   int shots_used = 0;
   bool prediction_uncertainty = false;  // the fit's covariance was counted (see below)
-  // Where a prediction that misses (χ²/ν beyond its limit) stands above the
-  // noise, and what it looks like there (update/residual_regions.hpp).
+  // Where a prediction without an effect that misses (χ²/ν beyond its limit)
+  // stands above the noise, and what it looks like there
+  // (update/residual_regions.hpp).
   std::vector<ResidualRegion> regions;
   std::string noise_source, offset_model;
 };
