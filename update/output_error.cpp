@@ -10,6 +10,11 @@
 #include <complex>
 #include <cstdio>
 #include <functional>
+#include <memory>
+#include <thread>
+#include <atomic>
+#include <exception>
+#include <mutex>
 #include <optional>
 #include <stdexcept>
 
@@ -155,34 +160,56 @@ class Problem {
   // type-B perturbations of the chain and the re-evaluations at an answer
   // need no new modal solve. nullptr when the model cannot be built.
   const model::ModalPortModel* port_of(const Eigen::VectorXd& x, double end_mass) {
-    Key key;
-    key << x.head<4>(), end_mass;
-    for (auto& c : cache_)
-      if (c.key == key) {
-        c.used = ++clock_;
-        return c.port ? &*c.port : nullptr;
-      }
-    ++evaluations_;
-    std::optional<model::ModalPortModel> port;
-    try {
-      model::ModalOptions mo = modal_;
-      mo.end_mass_fraction = end_mass;
-      port = solver_.port_model(cls_.e_form(co_.params(x)), mo);
-      if (!port->converged) port.reset();
-    } catch (const std::exception&) {
-      port.reset();
+    const Key key = key_of(x, end_mass);
+    if (Cached* c = cached(key)) return c->port ? &*c->port : nullptr;
+    return insert(key, build(solver_, key));
+  }
+
+  // The port models of several points at once (an exact Jacobian's columns,
+  // a grid of starts), those not cached built on `threads` threads: this
+  // solver and a second one on the same tube. A port model is a function of
+  // its key alone (each solve starts from Spectra's fixed initial vector), so
+  // the answers do not depend on the thread count.
+  void prefetch(const std::vector<std::pair<Eigen::VectorXd, double>>& points) {
+    std::vector<Key> todo;
+    for (const auto& [x, mass] : points) {
+      const Key key = key_of(x, mass);
+      if (!cached(key) && std::find(todo.begin(), todo.end(), key) == todo.end()) todo.push_back(key);
     }
-    Cached* slot = nullptr;
-    if (cache_.size() < kCache) {
-      slot = &cache_.emplace_back();
+    if (todo.empty()) return;
+    std::vector<std::optional<model::ModalPortModel>> built(todo.size());
+    if (threads_ > 1 && todo.size() > 1) {
+      model::ModalSolver& second = second_solver();
+      // The second thread takes the odd points (one FE model each, equal work).
+      std::thread other([&] {
+        for (std::size_t i = 1; i < todo.size(); i += 2) built[i] = build(second, todo[i]);
+      });
+      for (std::size_t i = 0; i < todo.size(); i += 2) built[i] = build(solver_, todo[i]);
+      other.join();
     } else {
-      slot = &*std::min_element(cache_.begin(), cache_.end(),
-                                [](const Cached& a, const Cached& b) { return a.used < b.used; });
+      for (std::size_t i = 0; i < todo.size(); ++i) built[i] = build(solver_, todo[i]);
     }
-    slot->key = key;
-    slot->port = std::move(port);
-    slot->used = ++clock_;
-    return slot->port ? &*slot->port : nullptr;
+    for (std::size_t i = 0; i < todo.size(); ++i) insert(todo[i], std::move(built[i]));
+  }
+  void set_threads(int n) { threads_ = std::max(1, n); }
+  int threads() const { return threads_; }
+
+  // The same problem for another thread (the effect scan): its own FFT plan
+  // and buffers, `solver` for its FE models, this one's cache and tangent.
+  // Construct and destroy it on the thread that owns this one (FFTW's planner
+  // is not thread-safe; executing distinct plans is).
+  Problem(const Problem& o, model::ModalSolver& solver)
+      : solver_(solver), cls_(o.cls_), co_(o.co_), modal_(o.modal_), r1_(o.r1_), fx_(o.fx_), free_(o.free_),
+        fs_(o.fs_), n_(o.n_), nfft_(o.nfft_), fft_(o.nfft_), kmax_(o.kmax_), decim_(o.decim_), l_(o.l_),
+        lv1_(o.lv1_), ly_(o.ly_), spec_(o.spec_), buf_(o.buf_), idx_(o.idx_), tangent_(o.tangent_),
+        cache_(o.cache_), clock_(o.clock_) {}
+  Problem(const Problem&) = delete;
+  Problem& operator=(const Problem&) = delete;
+  // A second solver on the same tube (built on first use): prefetch's second
+  // thread, or a forked Problem's.
+  model::ModalSolver& second_solver() {
+    if (!solver2_) solver2_ = std::make_unique<model::ModalSolver>(solver_.model());
+    return *solver2_;
   }
 
   // The bench's known effects (OeData: a measured fixture's lead R, Cp, DAQ
@@ -428,7 +455,56 @@ class Problem {
     return r;
   }
 
+  using Key = Eigen::Matrix<double, 5, 1>;  // the constants' coordinates, the end mass
+  struct Cached {
+    Key key;
+    std::optional<model::ModalPortModel> port;
+    unsigned long used = 0;
+  };
+  static Key key_of(const Eigen::VectorXd& x, double end_mass) {
+    Key key;
+    key << x.head<4>(), end_mass;
+    return key;
+  }
+  Cached* cached(const Key& key) {
+    for (auto& c : cache_)
+      if (c.key == key) {
+        c.used = ++clock_;
+        return &c;
+      }
+    return nullptr;
+  }
+  // One FE port model (counted; thread-safe for distinct solvers).
+  std::optional<model::ModalPortModel> build(model::ModalSolver& solver, const Key& key) {
+    ++evaluations_;
+    try {
+      model::ModalOptions mo = modal_;
+      mo.end_mass_fraction = key[4];
+      Eigen::VectorXd x = Eigen::VectorXd::Zero(kParams);
+      x.head<4>() = key.head<4>();
+      auto port = solver.port_model(cls_.e_form(co_.params(x)), mo);
+      if (port.converged) return port;
+    } catch (const std::exception&) {
+    }
+    return std::nullopt;
+  }
+  const model::ModalPortModel* insert(const Key& key, std::optional<model::ModalPortModel> port) {
+    Cached* slot = nullptr;
+    if (cache_.size() < kCache) {
+      slot = &cache_.emplace_back();
+    } else {
+      slot = &*std::min_element(cache_.begin(), cache_.end(),
+                                [](const Cached& a, const Cached& b) { return a.used < b.used; });
+    }
+    slot->key = key;
+    slot->port = std::move(port);
+    slot->used = ++clock_;
+    return slot->port ? &*slot->port : nullptr;
+  }
+
   model::ModalSolver& solver_;
+  std::unique_ptr<model::ModalSolver> solver2_;  // prefetch's second thread (built on first use)
+  int threads_ = 1;
   const MaterialClass& cls_;
   Coordinates5 co_;
   model::ModalOptions modal_;
@@ -442,14 +518,8 @@ class Problem {
   std::vector<cd> l_, lv1_, ly_, spec_;
   std::vector<double> buf_;
   std::vector<std::size_t> idx_;
-  int evaluations_ = 0;
-  using Key = Eigen::Matrix<double, 5, 1>;  // the constants' coordinates, the end mass
-  struct Cached {
-    Key key;
-    std::optional<model::ModalPortModel> port;
-    unsigned long used = 0;
-  };
-  static constexpr std::size_t kCache = 8;  // an exact Jacobian's five models and the trials
+  std::atomic<int> evaluations_{0};
+  static constexpr std::size_t kCache = 16;  // a grid's nine models, an exact Jacobian's five and the trials
   static constexpr double kTangentReach = 0.05;
   // The check of tangent_near: relative error of the prediction (a veering
   // swaps participations by tens of percent, the curvature away from one
@@ -466,6 +536,22 @@ class Problem {
   } tangent_;
   std::vector<Cached> cache_;
   unsigned long clock_ = 0;
+
+ public:
+  // What the optimiser leaves behind (the cached models, the tangent): each
+  // scanned effect starts from the optimum's, so its answer does not depend on
+  // the order of the scan or the thread it runs on.
+  struct State {
+    std::vector<Cached> cache;
+    Tangent tangent;
+    unsigned long clock = 0;
+  };
+  State state() const { return {cache_, tangent_, clock_}; }
+  void restore(const State& s) {
+    cache_ = s.cache;
+    tangent_ = s.tangent;
+    clock_ = s.clock;
+  }
 };
 
 // The noise of a record's filtered error at transfer t: the shots' scatter,
@@ -654,6 +740,253 @@ struct LmOutcome {
   Eigen::MatrixXd j, jtj;  // at the answer (the runs that need them, see finish)
 };
 
+// The optimiser on one Problem: the weighted residual, its Jacobian, LM and
+// the exact J at an answer. The scan of the catalogue's effects runs one per
+// thread, each on its own Problem (Problem::fork).
+class Fitter {
+ public:
+  Fitter(Problem& prob, const OffsetWhitening& whiten, const double& sigma, const OeOptions& opt, double dof_fit)
+      : prob(prob), whiten(whiten), sigma(sigma), opt(opt), dof_fit(dof_fit) {}
+
+    std::optional<Eigen::VectorXd> weighted(const Eigen::VectorXd& x) {
+      auto r = prob.residual(x);
+      if (!r) return std::nullopt;
+      *r = whiten(std::move(*r)) / sigma;
+      if (!r->allFinite()) return std::nullopt;
+      return r;
+    }
+    // Columns from `first` on (the others kept as they are in j). The
+    // constants' columns through the port models' tangent near the last exact
+    // Jacobian (Problem::set_tangent), unless `exact`.
+    bool jacobian(const Eigen::VectorXd& x, const Eigen::VectorXd& r0, Eigen::MatrixXd& j, int first = 0,
+                  bool exact = false) {
+      const auto np = static_cast<int>(x.size());  // 5, or 6 with a free effect (scan_effects)
+      if (j.rows() != r0.size() || j.cols() != np) {
+        j.resize(r0.size(), np);
+        first = 0;
+      }
+      const bool tangent = !exact && first < 4 && prob.tangent_near(x);
+      {  // the columns' port models at once (the constants' unless through the tangent)
+        std::vector<std::pair<Eigen::VectorXd, double>> points;
+        for (int c = first; c < np; ++c) {
+          if (c < 4 && tangent) continue;
+          Eigen::VectorXd xp = x;
+          xp[c] += c >= 4 ? 1e-4 : 1e-6;
+          points.emplace_back(xp, prob.effects_at(xp).mass_loading);
+        }
+        if (points.size() > 1) prob.prefetch(points);
+      }
+      for (int c = first; c < np; ++c) {
+        const double h = c >= 4 ? 1e-4 : 1e-6;
+        if (c < 4 && tangent) {
+          if (const auto tt = prob.tangent_transfer(x, c, h)) {
+            const Eigen::VectorXd rt = whiten(prob.residual_of(*tt)) / sigma;
+            if (rt.allFinite()) {
+              j.col(c) = (rt - r0) / h;
+              continue;
+            }
+          }
+        }
+        Eigen::VectorXd xp = x;
+        xp[c] += h;
+        auto rp = weighted(xp);
+        if (!rp) {
+          xp[c] = x[c] - h;  // the other side
+          rp = weighted(xp);
+          if (!rp) return false;
+          j.col(c) = (r0 - *rp) / h;
+        } else {
+          j.col(c) = (*rp - r0) / h;
+        }
+      }
+      if (first == 0 && !tangent) prob.set_tangent(x, 1e-6);
+      return true;
+    }
+    // ½‖r/σ‖² at x on the port models' tangent anchored at `anchor`
+    // (Problem::tangent_model), NaN away from it.
+    double tangent_cost(const Eigen::VectorXd& anchor, const Eigen::VectorXd& x) {
+      const auto t = prob.tangent_model(anchor, x);
+      if (!t) return NAN;
+      const Eigen::VectorXd r = whiten(prob.residual_of(*t)) / sigma;
+      return r.allFinite() ? 0.5 * r.squaredNorm() : NAN;
+    }
+    // LM from x. A later start (`lead`: the optimum of the first) stops early
+    // once it is inside the lead's optimum (ΔxᵀJᵀJΔx < 9 at no lower cost: it
+    // would converge there, and no constant differs by 3 of its statistical
+    // sigmas, so the honesty check's 3-sigma test below cannot fire) or once it
+    // stalls far above it (its cost gap to the lead above max(50, 10·s²) and
+    // shrinking by less than a tenth per iteration: a local optimum the data
+    // reject, which the honesty check below ignores anyway).
+    // `j0`: the Jacobian at x when the caller has it (an effect scanned from the
+    // optimum: the five's columns there are the optimum's), saving its models.
+    // `freeze_material`: with j0, the four material columns stay j0's (an
+    // effect scanned from the optimum moves the constants by a fraction of their
+    // sigmas: their columns barely change, and each costs an FE port model);
+    // β's and the effect's are recomputed (no new model). finish() computes the
+    // exact J at the answer for the covariance.
+    LmOutcome levenberg_marquardt(Eigen::VectorXd x, const LmOutcome* lead, const Eigen::MatrixXd* j0 = nullptr,
+                                  bool freeze_material = false) {
+      LmOutcome o;
+      auto r = weighted(x);
+      if (!r) {
+        o.message = "the start cannot be simulated";
+        o.cost = INFINITY;
+        o.x = x;
+        return o;
+      }
+      double cost = 0.5 * r->squaredNorm();
+      double mu = 1e-3, last_drop = INFINITY;
+      // J by forward differences at every iterate: four FE port models (β's
+      // column reuses the cached one), or none near the last exact J (the
+      // port models' tangent, Problem::set_tangent). Broyden's rank-one updates
+      // instead were measured on the corpus: fewer models on the first start,
+      // but later starts crawl and can look stalled where the exact J joins the
+      // best optimum.
+      Eigen::MatrixXd j;
+      // An iteration that finds no lower cost (its J perhaps through the
+      // tangent or j0's frozen columns, its trials screened) runs again on the
+      // exact J, unscreened, before the run gives up.
+      bool strict = false;
+      for (int it = 1; it <= opt.max_iterations; ++it) {
+        o.iterations = it;
+        const bool have_j0 = j0 && j0->rows() == r->size() && j0->cols() == x.size();
+        bool j_ok = true;
+        if (strict) {
+          j_ok = jacobian(x, *r, j, 0, true);
+        } else if (it == 1 && have_j0) {
+          j = *j0;
+        } else if (freeze_material && have_j0) {
+          j = *j0;
+          j_ok = jacobian(x, *r, j, 4);
+        } else {
+          j_ok = jacobian(x, *r, j);
+        }
+        if (!j_ok) {
+          o.message = "the model could not be simulated near the estimate";
+          break;
+        }
+        const Eigen::MatrixXd jtj = j.transpose() * j;
+        const Eigen::VectorXd g = j.transpose() * *r;
+        bool accepted = false, done = false;
+        // A trial near x is screened on the tangent anchored at x first (its
+        // model exact at x, the slopes x_ref's): a step it says raises the cost
+        // is rejected without an FE model; one it says lowers it is computed.
+        auto screen = [&](const Eigen::VectorXd& anchor, const Eigen::VectorXd& xt) {
+          return strict ? NAN : tangent_cost(anchor, xt);
+        };
+        for (int tries = 0; tries < 14 && !accepted; ++tries) {
+          Eigen::MatrixXd a = jtj;
+          for (Eigen::Index p = 0; p < a.rows(); ++p) a(p, p) += mu * std::max(jtj(p, p), 1e-300);
+          Eigen::VectorXd step = a.ldlt().solve(-g);
+          // Trust region: no constant moves by more than 30 % in one step.
+          const double big = step.cwiseAbs().maxCoeff();
+          if (big > 0.3) step *= 0.3 / big;
+          const Eigen::VectorXd trial = x + step;
+          if (screen(x, trial) >= cost) {
+            mu *= 4.0;
+            if (step.cwiseAbs().maxCoeff() < opt.step_tolerance) accepted = done = true;
+            continue;
+          }
+          const auto rt = weighted(trial);
+          const double ct = rt ? 0.5 * rt->squaredNorm() : INFINITY;
+          if (ct < cost) {
+            const Eigen::VectorXd x_old = x;
+            x = trial;
+            r = rt;
+            double c_new = ct;
+            // Along a curved valley (resonances sliding into place) the
+            // Gauss-Newton step is far shorter than the way to the minimum: go
+            // on along it, doubling, while the cost keeps falling (one model per
+            // try instead of a Jacobian per step; screened as above).
+            Eigen::VectorXd ext = step;
+            for (int d = 0; d < 4 && mu < 1e-2; ++d) {
+              ext *= 2.0;
+              if (ext.cwiseAbs().maxCoeff() > 0.3) break;
+              const Eigen::VectorXd xe = x_old + ext;
+              if (screen(x, xe) >= c_new) break;
+              const auto re = weighted(xe);
+              const double ce = re ? 0.5 * re->squaredNorm() : INFINITY;
+              if (!(ce < c_new)) break;
+              x = xe;
+              r = re;
+              c_new = ce;
+            }
+            const double drop = cost - c_new;
+            last_drop = drop;
+            cost = c_new;
+            mu = std::max(mu / 3.0, 1e-12);
+            accepted = true;
+            // The cost is ½χ²: a decrease below 1e-2 leaves the estimate
+            // within ~0.15 of its sigma of the optimum.
+            done = step.cwiseAbs().maxCoeff() < opt.step_tolerance || drop < opt.cost_tolerance;
+          } else {
+            mu *= 4.0;
+            if (step.cwiseAbs().maxCoeff() < opt.step_tolerance) accepted = done = true;
+          }
+        }
+        if (done) {
+          o.converged = true;
+          break;
+        }
+        if (!accepted) {
+          if (!strict) {
+            strict = true;
+            --it;
+            continue;
+          }
+          double cosine = 0;
+          for (Eigen::Index p = 0; p < g.size(); ++p)
+            cosine = std::max(cosine, std::abs(g[p]) / std::sqrt(jtj(p, p) * 2.0 * cost + 1e-300));
+          if (cosine < 1e-4) {
+            o.converged = true;
+          } else {
+            o.message = "no decrease of the output error (gradient cosine " + std::to_string(cosine) + ")";
+          }
+          break;
+        }
+        strict = false;
+        if (lead && lead->jtj.rows() == x.size() && lead->x.size() == x.size()) {
+          const Eigen::VectorXd dx = x - lead->x;
+          const double gap = cost - lead->cost;
+          if (gap >= 0 && dx.dot(lead->jtj * dx) < 9.0) {
+            o.converged = true;
+            o.message = "joined the first start's optimum";
+            break;
+          }
+          const double s2 = std::max(1.0, 2.0 * lead->cost / dof_fit);
+          if (it >= 2 && gap > std::max(50.0, 10.0 * s2) && last_drop < 0.1 * gap) {
+            o.message = "stalled far above the first start's optimum";
+            break;
+          }
+        }
+      }
+      if (!o.converged && o.message.empty())
+        o.message = "did not converge in " + std::to_string(opt.max_iterations) + " iterations";
+      o.x = x;
+      o.cost = cost;
+      o.r = *r;
+      return o;
+    }
+    // J and JᵀJ at a run's answer (only the best one's are used), exact: the
+    // covariances are read from it (through the tangent, an effect's sigma
+    // came out up to a tenth off where it trades with epsT33).
+    void finish(LmOutcome& o) {
+      Eigen::MatrixXd j;
+      if (o.r.size() > 0 && jacobian(o.x, o.r, j, 0, true)) {
+        o.j = j;
+        o.jtj = j.transpose() * j;
+      }
+    }
+
+  Problem& prob;
+
+ private:
+  const OffsetWhitening& whiten;
+  const double& sigma;  // the noise the residual is weighted by (re-weighed once at the answer)
+  const OeOptions& opt;
+  double dof_fit;
+};
+
 }  // namespace
 
 std::optional<EffectCoordinate> effect_coordinate(const std::string& name) {
@@ -725,6 +1058,7 @@ OeResult fit_output_error(model::ModalSolver& solver, const MaterialClass& cls,
   }
   if (!(out.band_hz < fs / 4)) fail("band above a quarter of the sample rate");
   Problem prob(solver, cls, co, rec, data, out.band_hz, opt.modal);
+  prob.set_threads(opt.threads);
   out.residual_samples = static_cast<int>(prob.samples());
   if (prob.samples() < 4 * kParams) fail("too few samples in the band for five parameters");
 
@@ -761,225 +1095,52 @@ OeResult fit_output_error(model::ModalSolver& solver, const MaterialClass& cls,
   const OffsetWhitening whiten(prob, rec, *t_nominal, sigma);
   const int offset_dof = whiten.dof;
   out.offset_model = whiten.model;
-  auto weighted = [&](const Eigen::VectorXd& x) -> std::optional<Eigen::VectorXd> {
-    auto r = prob.residual(x);
-    if (!r) return std::nullopt;
-    *r = whiten(std::move(*r)) / sigma;
-    if (!r->allFinite()) return std::nullopt;
-    return r;
-  };
-  // Columns from `first` on (the others kept as they are in j). The
-  // constants' columns through the port models' tangent near the last exact
-  // Jacobian (Problem::set_tangent), unless `exact`.
-  auto jacobian = [&](const Eigen::VectorXd& x, const Eigen::VectorXd& r0, Eigen::MatrixXd& j, int first = 0,
-                      bool exact = false) {
-    const auto np = static_cast<int>(x.size());  // 5, or 6 with a free effect (scan_effects)
-    if (j.rows() != r0.size() || j.cols() != np) {
-      j.resize(r0.size(), np);
-      first = 0;
-    }
-    const bool tangent = !exact && first < 4 && prob.tangent_near(x);
-    for (int c = first; c < np; ++c) {
-      const double h = c >= 4 ? 1e-4 : 1e-6;
-      if (c < 4 && tangent) {
-        if (const auto tt = prob.tangent_transfer(x, c, h)) {
-          const Eigen::VectorXd rt = whiten(prob.residual_of(*tt)) / sigma;
-          if (rt.allFinite()) {
-            j.col(c) = (rt - r0) / h;
-            continue;
-          }
-        }
-      }
-      Eigen::VectorXd xp = x;
-      xp[c] += h;
-      auto rp = weighted(xp);
-      if (!rp) {
-        xp[c] = x[c] - h;  // the other side
-        rp = weighted(xp);
-        if (!rp) return false;
-        j.col(c) = (r0 - *rp) / h;
-      } else {
-        j.col(c) = (*rp - r0) / h;
-      }
-    }
-    if (first == 0 && !tangent) prob.set_tangent(x, 1e-6);
-    return true;
-  };
-  // ½‖r/σ‖² at x on the port models' tangent anchored at `anchor`
-  // (Problem::tangent_model), NaN away from it.
-  auto tangent_cost = [&](const Eigen::VectorXd& anchor, const Eigen::VectorXd& x) -> double {
-    const auto t = prob.tangent_model(anchor, x);
-    if (!t) return NAN;
-    const Eigen::VectorXd r = whiten(prob.residual_of(*t)) / sigma;
-    return r.allFinite() ? 0.5 * r.squaredNorm() : NAN;
-  };
-  // LM from x. A later start (`lead`: the optimum of the first) stops early
-  // once it is inside the lead's optimum (ΔxᵀJᵀJΔx < 9 at no lower cost: it
-  // would converge there, and no constant differs by 3 of its statistical
-  // sigmas, so the honesty check's 3-sigma test below cannot fire) or once it
-  // stalls far above it (its cost gap to the lead above max(50, 10·s²) and
-  // shrinking by less than a tenth per iteration: a local optimum the data
-  // reject, which the honesty check below ignores anyway).
   const double dof_fit = std::max(1.0, double(prob.samples()) - kParams - offset_dof);
-  // `j0`: the Jacobian at x when the caller has it (an effect scanned from the
-  // optimum: the five's columns there are the optimum's), saving its models.
-  // `freeze_material`: with j0, the four material columns stay j0's (an
-  // effect scanned from the optimum moves the constants by a fraction of their
-  // sigmas: their columns barely change, and each costs an FE port model);
-  // β's and the effect's are recomputed (no new model). finish() computes the
-  // exact J at the answer for the covariance.
-  auto levenberg_marquardt = [&](Eigen::VectorXd x, const LmOutcome* lead, const Eigen::MatrixXd* j0 = nullptr,
-                                 bool freeze_material = false) {
-    LmOutcome o;
-    auto r = weighted(x);
-    if (!r) {
-      o.message = "the start cannot be simulated";
-      o.cost = INFINITY;
-      o.x = x;
-      return o;
-    }
-    double cost = 0.5 * r->squaredNorm();
-    double mu = 1e-3, last_drop = INFINITY;
-    // J by forward differences at every iterate: four FE port models (β's
-    // column reuses the cached one), or none near the last exact J (the
-    // port models' tangent, Problem::set_tangent). Broyden's rank-one updates
-    // instead were measured on the corpus: fewer models on the first start,
-    // but later starts crawl and can look stalled where the exact J joins the
-    // best optimum.
-    Eigen::MatrixXd j;
-    // An iteration that finds no lower cost (its J perhaps through the
-    // tangent or j0's frozen columns, its trials screened) runs again on the
-    // exact J, unscreened, before the run gives up.
-    bool strict = false;
-    for (int it = 1; it <= opt.max_iterations; ++it) {
-      o.iterations = it;
-      const bool have_j0 = j0 && j0->rows() == r->size() && j0->cols() == x.size();
-      bool j_ok = true;
-      if (strict) {
-        j_ok = jacobian(x, *r, j, 0, true);
-      } else if (it == 1 && have_j0) {
-        j = *j0;
-      } else if (freeze_material && have_j0) {
-        j = *j0;
-        j_ok = jacobian(x, *r, j, 4);
-      } else {
-        j_ok = jacobian(x, *r, j);
-      }
-      if (!j_ok) {
-        o.message = "the model could not be simulated near the estimate";
-        break;
-      }
-      const Eigen::MatrixXd jtj = j.transpose() * j;
-      const Eigen::VectorXd g = j.transpose() * *r;
-      bool accepted = false, done = false;
-      // A trial near x is screened on the tangent anchored at x first (its
-      // model exact at x, the slopes x_ref's): a step it says raises the cost
-      // is rejected without an FE model; one it says lowers it is computed.
-      auto screen = [&](const Eigen::VectorXd& anchor, const Eigen::VectorXd& xt) {
-        return strict ? NAN : tangent_cost(anchor, xt);
-      };
-      for (int tries = 0; tries < 14 && !accepted; ++tries) {
-        Eigen::MatrixXd a = jtj;
-        for (Eigen::Index p = 0; p < a.rows(); ++p) a(p, p) += mu * std::max(jtj(p, p), 1e-300);
-        Eigen::VectorXd step = a.ldlt().solve(-g);
-        // Trust region: no constant moves by more than 30 % in one step.
-        const double big = step.cwiseAbs().maxCoeff();
-        if (big > 0.3) step *= 0.3 / big;
-        const Eigen::VectorXd trial = x + step;
-        if (screen(x, trial) >= cost) {
-          mu *= 4.0;
-          if (step.cwiseAbs().maxCoeff() < opt.step_tolerance) accepted = done = true;
-          continue;
-        }
-        const auto rt = weighted(trial);
-        const double ct = rt ? 0.5 * rt->squaredNorm() : INFINITY;
-        if (ct < cost) {
-          const Eigen::VectorXd x_old = x;
-          x = trial;
-          r = rt;
-          double c_new = ct;
-          // Along a curved valley (resonances sliding into place) the
-          // Gauss-Newton step is far shorter than the way to the minimum: go
-          // on along it, doubling, while the cost keeps falling (one model per
-          // try instead of a Jacobian per step; screened as above).
-          Eigen::VectorXd ext = step;
-          for (int d = 0; d < 4 && mu < 1e-2; ++d) {
-            ext *= 2.0;
-            if (ext.cwiseAbs().maxCoeff() > 0.3) break;
-            const Eigen::VectorXd xe = x_old + ext;
-            if (screen(x, xe) >= c_new) break;
-            const auto re = weighted(xe);
-            const double ce = re ? 0.5 * re->squaredNorm() : INFINITY;
-            if (!(ce < c_new)) break;
-            x = xe;
-            r = re;
-            c_new = ce;
-          }
-          const double drop = cost - c_new;
-          last_drop = drop;
-          cost = c_new;
-          mu = std::max(mu / 3.0, 1e-12);
-          accepted = true;
-          // The cost is ½χ²: a decrease below 1e-2 leaves the estimate
-          // within ~0.15 of its sigma of the optimum.
-          done = step.cwiseAbs().maxCoeff() < opt.step_tolerance || drop < opt.cost_tolerance;
-        } else {
-          mu *= 4.0;
-          if (step.cwiseAbs().maxCoeff() < opt.step_tolerance) accepted = done = true;
-        }
-      }
-      if (done) {
-        o.converged = true;
-        break;
-      }
-      if (!accepted) {
-        if (!strict) {
-          strict = true;
-          --it;
-          continue;
-        }
-        double cosine = 0;
-        for (Eigen::Index p = 0; p < g.size(); ++p)
-          cosine = std::max(cosine, std::abs(g[p]) / std::sqrt(jtj(p, p) * 2.0 * cost + 1e-300));
-        if (cosine < 1e-4) {
-          o.converged = true;
-        } else {
-          o.message = "no decrease of the output error (gradient cosine " + std::to_string(cosine) + ")";
-        }
-        break;
-      }
-      strict = false;
-      if (lead && lead->jtj.rows() == x.size() && lead->x.size() == x.size()) {
-        const Eigen::VectorXd dx = x - lead->x;
-        const double gap = cost - lead->cost;
-        if (gap >= 0 && dx.dot(lead->jtj * dx) < 9.0) {
-          o.converged = true;
-          o.message = "joined the first start's optimum";
-          break;
-        }
-        const double s2 = std::max(1.0, 2.0 * lead->cost / dof_fit);
-        if (it >= 2 && gap > std::max(50.0, 10.0 * s2) && last_drop < 0.1 * gap) {
-          o.message = "stalled far above the first start's optimum";
-          break;
-        }
-      }
-    }
-    if (!o.converged && o.message.empty())
-      o.message = "did not converge in " + std::to_string(opt.max_iterations) + " iterations";
-    o.x = x;
-    o.cost = cost;
-    o.r = *r;
-    return o;
+  Fitter fitter(prob, whiten, sigma, opt, dof_fit);
+  auto weighted = [&](const Eigen::VectorXd& x) { return fitter.weighted(x); };
+  auto levenberg_marquardt = [&](const Eigen::VectorXd& x, const LmOutcome* lead,
+                                 const Eigen::MatrixXd* j0 = nullptr, bool freeze_material = false) {
+    return fitter.levenberg_marquardt(x, lead, j0, freeze_material);
   };
-  // J and JᵀJ at a run's answer (only the best one's are used), exact: the
-  // covariances are read from it (through the tangent, an effect's sigma
-  // came out up to a tenth off where it trades with epsT33).
-  auto finish = [&](LmOutcome& o) {
-    Eigen::MatrixXd j;
-    if (o.r.size() > 0 && jacobian(o.x, o.r, j, 0, true)) {
-      o.j = j;
-      o.jtj = j.transpose() * j;
+  auto finish = [&](LmOutcome& o) { fitter.finish(o); };
+  // Independent tasks (the later starts, the scanned effects) on up to
+  // `threads` threads: the fit's Problem and a fork of it on the second
+  // solver. Each task starts from `start` (Problem::State), so its answer
+  // does not depend on the thread or the order; `order` lists the longest first.
+  int models_elsewhere = 0;  // FE models the forks built
+  auto in_parallel = [&](const std::vector<std::size_t>& order, const Problem::State& start,
+                         const std::function<void(Problem&, Fitter&, std::size_t)>& task) {
+    std::atomic<std::size_t> next{0};
+    std::mutex error_mutex;
+    std::exception_ptr error;
+    auto work = [&](Problem& p, Fitter& f) {
+      for (std::size_t k = next++; k < order.size(); k = next++) {
+        try {
+          p.restore(start);
+          task(p, f, order[k]);
+        } catch (...) {
+          const std::lock_guard<std::mutex> lock(error_mutex);
+          if (!error) error = std::current_exception();
+        }
+      }
+    };
+    if (prob.threads() > 1 && order.size() > 1) {
+      Problem other(prob, prob.second_solver());
+      Fitter other_fit(other, whiten, sigma, opt, dof_fit);
+      const int threads = prob.threads();
+      prob.set_threads(1);  // (the second solver is the other thread's now)
+      std::thread t([&] { work(other, other_fit); });
+      work(prob, fitter);
+      t.join();
+      prob.set_threads(threads);
+      models_elsewhere += other.evaluations();
+    } else {
+      work(prob, fitter);
     }
+    // And the fit's Problem as the tasks found it (what its own thread's last
+    // task left would differ with the thread count).
+    prob.restore(start);
+    if (error) std::rethrow_exception(error);
   };
 
   // Coarse stage: the 3 × 3 grid over YE11 and nu12.
@@ -993,22 +1154,42 @@ OeResult fit_output_error(model::ModalSolver& solver, const MaterialClass& cls,
       Eigen::VectorXd x = Eigen::VectorXd::Zero(kParams);
       x[0] = std::log1p(a * opt.grid_span_ye11);
       x[1] = b * opt.grid_span_nu12;
-      const auto r = weighted(x);
-      grid.push_back({x, r ? 0.5 * r->squaredNorm() : INFINITY});
+      grid.push_back({x, INFINITY});
     }
+  {
+    std::vector<std::pair<Eigen::VectorXd, double>> points;
+    for (const auto& g : grid) points.emplace_back(g.x, prob.effects().mass_loading);
+    prob.prefetch(points);
+  }
+  for (auto& g : grid) {
+    const auto r = weighted(g.x);
+    g.cost = r ? 0.5 * r->squaredNorm() : INFINITY;
+  }
   std::sort(grid.begin(), grid.end(), [](const Start& a, const Start& b) { return a.cost < b.cost; });
   out.starts = static_cast<int>(grid.size());
   std::vector<LmOutcome> runs;
   runs.reserve(static_cast<std::size_t>(std::max(1, opt.refine)));
-  for (int i = 0; i < std::min<int>(opt.refine, static_cast<int>(grid.size())); ++i) {
-    if (!std::isfinite(grid[static_cast<std::size_t>(i)].cost)) break;
-    runs.push_back(levenberg_marquardt(grid[static_cast<std::size_t>(i)].x, runs.empty() ? nullptr : &runs.front()));
-    if (runs.size() == 1) finish(runs.front());  // the later starts measure against its metric
-    out.iterations += runs.back().iterations;
+  // The best start first; the later ones (measured against its optimum: the
+  // lead test) side by side.
+  std::size_t n_starts = 0;
+  while (n_starts < std::min<std::size_t>(static_cast<std::size_t>(std::max(0, opt.refine)), grid.size()) &&
+         std::isfinite(grid[n_starts].cost))
+    ++n_starts;
+  if (n_starts > 0) {
+    runs.push_back(levenberg_marquardt(grid[0].x, nullptr));
+    finish(runs.front());  // the later starts measure against its metric
+    std::vector<LmOutcome> later(n_starts - 1);
+    std::vector<std::size_t> order(later.size());
+    for (std::size_t k = 0; k < order.size(); ++k) order[k] = k;
+    in_parallel(order, prob.state(), [&](Problem&, Fitter& f, std::size_t k) {
+      later[k] = f.levenberg_marquardt(grid[k + 1].x, &runs.front());
+    });
+    for (auto& o : later) runs.push_back(std::move(o));
+    for (const auto& o : runs) out.iterations += o.iterations;
   }
   std::sort(runs.begin(), runs.end(), [](const LmOutcome& a, const LmOutcome& b) { return a.cost < b.cost; });
   if (!runs.empty() && runs.front().jtj.rows() != kParams) finish(runs.front());
-  out.evaluations = prob.evaluations();
+  out.evaluations = prob.evaluations() + models_elsewhere;
   if (runs.empty() || !std::isfinite(runs.front().cost)) {
     out.status = UpdateStatus::solver_failure;
     out.message = "no start of the output-error fit could be simulated";
@@ -1200,16 +1381,16 @@ OeResult fit_output_error(model::ModalSolver& solver, const MaterialClass& cls,
   };
   std::vector<Refit> refits;
   // The effect's numbers from its run.
-  auto fill = [&](OeEffect& e, Refit& rf) {
+  auto fill = [&](Problem& p, Fitter& f, OeEffect& e, Refit& rf) {
     LmOutcome& run = rf.run;
-    finish(run);
+    f.finish(run);
     // One Gauss-Newton step on J at the answer (a run with the material
     // columns frozen stops where J₀ᵀr = 0, a fraction of a sigma from Jᵀr = 0).
     if (run.jtj.rows() == run.x.size() && run.r.size() == run.j.rows()) {
       const Eigen::VectorXd step = -run.jtj.ldlt().solve(run.j.transpose() * run.r);
       if (step.allFinite() && step.cwiseAbs().maxCoeff() < 0.3) {
         const Eigen::VectorXd xt = run.x + step;
-        if (const auto rt = weighted(xt); rt && 0.5 * rt->squaredNorm() < run.cost) {
+        if (const auto rt = f.weighted(xt); rt && 0.5 * rt->squaredNorm() < run.cost) {
           run.x = xt;
           run.r = *rt;
           run.cost = 0.5 * rt->squaredNorm();
@@ -1219,7 +1400,7 @@ OeResult fit_output_error(model::ModalSolver& solver, const MaterialClass& cls,
     e.converged = run.converged;
     e.material = co.params(run.x.head(kParams));
     e.beta_s = co.beta(run.x.head(kParams));
-    e.effect_set = prob.effects();
+    e.effect_set = p.effects();
     rf.apply(e.effect_set, run.x[kParams]);
     const double dof_e = std::max(1.0, dof - 1.0);
     e.chi2_per_dof = 2.0 * run.cost / dof_e;
@@ -1245,7 +1426,7 @@ OeResult fit_output_error(model::ModalSolver& solver, const MaterialClass& cls,
       e.value = v;
       e.sigma = sv;
     }
-    const auto st = spectral_lack_of_fit(run.r, prob.residual_psd(*t_best, ch1, ch2), prob.residual_bin_hz());
+    const auto st = spectral_lack_of_fit(run.r, p.residual_psd(*t_best, ch1, ch2), p.residual_bin_hz());
     e.band_log10_p = st.log10_p;
     const bool physical = daq ? v > 0 : (e.value >= rf.info->lower && e.value <= rf.info->upper);
     e.significant = !e.alias && run.converged && physical &&
@@ -1253,22 +1434,35 @@ OeResult fit_output_error(model::ModalSolver& solver, const MaterialClass& cls,
     e.explains = e.significant && e.chi2_per_dof <= out.chi2_limit && st.log10_p >= std::log10(opt.lack_of_fit_p);
   };
   // The catalogue's effects, one at a time, as a sixth coordinate from the
-  // optimum (effect_coordinate).
-  for (const auto& name : opt.scan_effects) {
-    if (!best.converged || best.j.rows() == 0 || !t_best) break;
+  // optimum (effect_coordinate). Each starts from the optimum's state
+  // (Problem::State) and runs on one of up to two threads — the fit's solver
+  // and a second one, each with its own Problem — so its answer is the same
+  // whatever thread runs it and in what order; the result lists them in the
+  // catalogue's order.
+  struct Scanned {
+    OeEffect e;
+    std::optional<Refit> rf;  // an LM run (not the linear answer)
+  };
+  std::vector<std::string> scan_names;
+  if (best.converged && best.j.rows() != 0 && t_best)
+    for (const auto& name : opt.scan_effects) {
+      if (!model::find_effect(name))
+        throw std::invalid_argument("scan_effects: no effect '" + name + "' in the catalogue");
+      if (effect_coordinate(name)) scan_names.push_back(name);  // (else in the catalogue, not in this model)
+    }
+  auto scan_one = [&](Problem& p, Fitter& f, const std::string& name) {
+    Scanned s;
     const model::EffectInfo* info = model::find_effect(name);
-    if (!info) throw std::invalid_argument("scan_effects: no effect '" + name + "' in the catalogue");
     const auto coord = effect_coordinate(name);
-    if (!coord) continue;  // in the catalogue, not in this model
     const double typical = coord->typical;
     const auto& apply = coord->apply;
     const auto& value = coord->value;
     OeEffect e;
-    const int models_before = prob.evaluations();
+    const int models_before = p.evaluations();
     e.name = name;
     e.typical = name == "daq_input_resistance" ? 1.0 / typical : typical;
     e.unit = info->unit;
-    prob.free_effect(apply);
+    p.free_effect(apply);
     Eigen::VectorXd x0(kParams + 1);
     x0 << best.x, 0.0;
     // Alias: the effect's column against the five's at their optimum. And
@@ -1276,10 +1470,10 @@ OeResult fit_output_error(model::ModalSolver& solver, const MaterialClass& cls,
     // order, (j⊥ᵀr)²/‖j⊥‖², j⊥ its column beyond the five's span.
     double score = INFINITY, step_lin = 0, jperp2 = 0;
     Eigen::MatrixXd j_start;  // J at x0: the five's columns at the optimum and the effect's
-    if (auto r0 = weighted(x0)) {
+    if (auto r0 = f.weighted(x0)) {
       Eigen::VectorXd xp = x0;
       xp[kParams] = 1e-4;
-      if (auto rp = weighted(xp)) {
+      if (auto rp = f.weighted(xp)) {
         const Eigen::VectorXd je = (*rp - *r0) / 1e-4;
         if (best.j.rows() == je.size()) {
           j_start.resize(je.size(), kParams + 1);
@@ -1309,7 +1503,7 @@ OeResult fit_output_error(model::ModalSolver& solver, const MaterialClass& cls,
       e.linearised = true;
       e.material = out.updated;
       e.beta_s = out.damping.beta;
-      e.effect_set = prob.effects();
+      e.effect_set = p.effects();
       apply(e.effect_set, step_lin);
       e.delta_chi2 = score;
       e.chi2_per_dof = (2.0 * best.cost - score) / std::max(1.0, dof - 1.0);
@@ -1319,8 +1513,8 @@ OeResult fit_output_error(model::ModalSolver& solver, const MaterialClass& cls,
       e.covariance_rel = Eigen::MatrixXd::Zero(kParams + 1, kParams + 1);
       e.covariance_rel.topLeftCorner(kParams, kParams) = out.covariance_rel;
       e.covariance_rel(kParams, kParams) = s2e / jperp2;
-      out.effects.push_back(e);
-      continue;
+      s.e = std::move(e);
+      return s;
     }
     // An end mass moves the modes far along a curved valley the five already
     // follow part way (4 % of added mass fits as YE11 −2.8 % at χ²/ν ≈ 1):
@@ -1328,23 +1522,23 @@ OeResult fit_output_error(model::ModalSolver& solver, const MaterialClass& cls,
     // misfit it also starts at 2 % and 4 % (each evaluation an FE model).
     const Eigen::MatrixXd* j0 = j_start.size() ? &j_start : nullptr;
     // (The end mass moves the modes themselves: its runs keep the exact J.)
-    LmOutcome run = levenberg_marquardt(x0, nullptr, j0, name != "mass_loading");
+    LmOutcome run = f.levenberg_marquardt(x0, nullptr, j0, name != "mass_loading");
     if (!run.converged && name != "mass_loading" && std::isfinite(run.cost)) {
       // The frozen columns did not get there: on from where it stopped, exactly.
-      LmOutcome exact = levenberg_marquardt(run.x, nullptr);
+      LmOutcome exact = f.levenberg_marquardt(run.x, nullptr);
       if (exact.converged || exact.cost < run.cost) run = std::move(exact);
     }
     if (name == "mass_loading" && out.lack_of_fit) {
       // The later starts stop once inside the best one's optimum or stalled
       // far above it (levenberg_marquardt's lead test, on the six).
-      finish(run);
+      f.finish(run);
       for (double start : {2.0, 4.0}) {
         Eigen::VectorXd xs = x0;
         xs[kParams] = start;
-        LmOutcome other = levenberg_marquardt(xs, &run);
+        LmOutcome other = f.levenberg_marquardt(xs, &run);
         if (other.cost < run.cost) {
           run = std::move(other);
-          finish(run);
+          f.finish(run);
         }
       }
     }
@@ -1353,28 +1547,48 @@ OeResult fit_output_error(model::ModalSolver& solver, const MaterialClass& cls,
     // at 1 % noise a misfit of its own; the capture chooses.
     if (name == "dielectric_loss") {
       e.law = "frequency-independent";
-      prob.free_effect([apply](model::EffectSet& fx, double x) {
+      p.free_effect([apply](model::EffectSet& fx, double x) {
         apply(fx, x);
         fx.dielectric_constant_phase = true;
       });
-      LmOutcome causal = levenberg_marquardt(x0, nullptr);  // (its effect column is another)
+      LmOutcome causal = f.levenberg_marquardt(x0, nullptr);  // (its effect column is another)
       if (causal.cost < run.cost) {
         run = std::move(causal);
         e.law = "constant-phase";
       } else {
-        prob.free_effect(apply);
+        p.free_effect(apply);
       }
     }
-    Refit rf{out.effects.size(), apply, value, typical, info, std::move(run)};
+    Refit rf{0, apply, value, typical, info, std::move(run)};
     if (e.law == "constant-phase")
       rf.apply = [apply](model::EffectSet& fx, double x) {
         apply(fx, x);
         fx.dielectric_constant_phase = true;
       };
-    fill(e, rf);
-    e.fe_models = prob.evaluations() - models_before;
-    out.effects.push_back(e);
-    refits.push_back(std::move(rf));
+    fill(p, f, e, rf);
+    e.fe_models = p.evaluations() - models_before;
+    s.e = std::move(e);
+    s.rf = std::move(rf);
+    return s;
+  };
+  {
+    std::vector<Scanned> scanned(scan_names.size());
+    // The longest first: an end mass (up to three LM runs, an FE model per
+    // evaluation), the dielectric loss (two laws).
+    auto rank = [](const std::string& n) { return n == "mass_loading" ? 0 : n == "dielectric_loss" ? 1 : 2; };
+    std::vector<std::size_t> order(scan_names.size());
+    for (std::size_t i = 0; i < order.size(); ++i) order[i] = i;
+    std::stable_sort(order.begin(), order.end(),
+                     [&](std::size_t a, std::size_t b) { return rank(scan_names[a]) < rank(scan_names[b]); });
+    in_parallel(order, prob.state(),
+                [&](Problem& p, Fitter& f, std::size_t i) { scanned[i] = scan_one(p, f, scan_names[i]); });
+    for (auto& s : scanned) {
+      if (s.rf) {
+        s.rf->index = out.effects.size();
+        refits.push_back(std::move(*s.rf));
+      }
+      out.effects.push_back(std::move(s.e));
+    }
   }
   // Under a lack of fit the five may sit in another basin (β and a shifted
   // YE11/nu12 absorbing part of the effect: a 30 Ω lead on one 2 % shot fits
@@ -1389,11 +1603,17 @@ OeResult fit_output_error(model::ModalSolver& solver, const MaterialClass& cls,
       return out.effects[a->index].delta_chi2 > out.effects[b->index].delta_chi2;
     });
     if (order.size() > 2) order.resize(2);
-    for (Refit* rf : order) {
-      prob.free_effect(rf->apply);
-      const int models_before = prob.evaluations();
+    // Each from the state after the scan, side by side (in_parallel).
+    std::vector<std::size_t> tasks(order.size());
+    for (std::size_t k = 0; k < tasks.size(); ++k) tasks[k] = k;
+    in_parallel(tasks, prob.state(), [&](Problem& p, Fitter& f, std::size_t k) {
+      Refit* rf = order[k];
+      p.free_effect(rf->apply);
+      const int models_before = p.evaluations();
       Eigen::VectorXd xg_best;
       double cg_best = INFINITY;
+      std::vector<Eigen::VectorXd> regrid;
+      std::vector<std::pair<Eigen::VectorXd, double>> points;
       for (int a = -1; a <= 1; ++a)
         for (int b = -1; b <= 1; ++b) {
           Eigen::VectorXd xg = Eigen::VectorXd::Zero(kParams + 1);
@@ -1401,19 +1621,24 @@ OeResult fit_output_error(model::ModalSolver& solver, const MaterialClass& cls,
           xg[1] = b * opt.grid_span_nu12;
           xg[4] = rf->run.x[4];
           xg[kParams] = rf->run.x[kParams];
-          const auto rg = weighted(xg);
-          const double cg = rg ? 0.5 * rg->squaredNorm() : INFINITY;
-          if (cg < cg_best) cg_best = cg, xg_best = xg;
+          regrid.push_back(xg);
+          points.emplace_back(xg, p.effects_at(xg).mass_loading);
         }
-      if (!std::isfinite(cg_best)) continue;
+      p.prefetch(points);
+      for (const auto& xg : regrid) {
+        const auto rg = f.weighted(xg);
+        const double cg = rg ? 0.5 * rg->squaredNorm() : INFINITY;
+        if (cg < cg_best) cg_best = cg, xg_best = xg;
+      }
+      if (!std::isfinite(cg_best)) return;
       // (fill() has finished the run: it leads, as the first start leads the five's later ones.)
-      LmOutcome other = levenberg_marquardt(xg_best, &rf->run);
+      LmOutcome other = f.levenberg_marquardt(xg_best, &rf->run);
       if (other.cost < rf->run.cost) {
         rf->run = std::move(other);
-        fill(out.effects[rf->index], *rf);
+        fill(p, f, out.effects[rf->index], *rf);  // (each task its own effect)
       }
-      out.effects[rf->index].fe_models += prob.evaluations() - models_before;
-    }
+      out.effects[rf->index].fe_models += p.evaluations() - models_before;
+    });
   }
   prob.free_effect({});
   std::sort(out.effects.begin(), out.effects.end(),
@@ -1421,7 +1646,7 @@ OeResult fit_output_error(model::ModalSolver& solver, const MaterialClass& cls,
 
   out.status = best.converged ? UpdateStatus::converged : UpdateStatus::max_iterations;
   out.message = best.converged ? "" : best.message;
-  out.evaluations = prob.evaluations();
+  out.evaluations = prob.evaluations() + models_elsewhere;
   out.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   return out;
 }

@@ -108,6 +108,11 @@ struct OeOptions {
   // model/effects.hpp; empty: none). Each costs an LM run from the optimum;
   // mass_loading builds an FE model per evaluation.
   std::vector<std::string> scan_effects;
+  // FE port models built at once where a step needs several (an exact
+  // Jacobian's columns, a grid of starts): 2 uses a second modal solver on a
+  // second thread; the answers are the same for any count. 1 where the caller
+  // already keeps every core busy (a batch replay with --jobs > 1).
+  int threads = 2;
   double effect_significance = 25.0;  // Δχ² (one parameter) beyond this, scaled by χ²/ν when > 1
   double alias_threshold = 0.05;
 };

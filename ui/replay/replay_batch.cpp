@@ -215,6 +215,8 @@ Outcome replay_capture(const fs::path& file, const ReplayOptions& opt, const Sin
     req.isotropic = opt.isotropic;
     req.seed_chain = opt.seed_chain;
     req.oe_options = opt.oe_options;
+    // --jobs workers keep the cores busy already: one thread per fit then.
+    if (opt.jobs > 1) req.oe_options.threads = 1;
     if (const auto ho = heldout_for(file, opt.holdout)) {
       req.heldout_capture = ho->string();
       req.heldout_optional = true;
