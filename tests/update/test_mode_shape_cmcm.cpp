@@ -1,0 +1,266 @@
+// update/mode_shape_cmcm: the direct CMCM with target mode shapes of seed
+// Appendix D, on our FE tube: Table D.1's numerical study (original and target
+// from the same FE model), exact and with noisy shapes.
+#include <gtest/gtest.h>
+
+#include <Eigen/Dense>
+#include <cmath>
+#include <cstdio>
+#include <random>
+
+#include "update/condensed_stiffness.hpp"
+#include "update/mode_shape_cmcm.hpp"
+#include "tests/support/tube_fixture.hpp"
+
+namespace piezo::update {
+namespace {
+
+using model::Electrodes;
+using model::kEps0;
+
+// Table D.1 (the seed's absolute e-form numbers; εS11 = 0 as D.2 assumes).
+model::PiezoMaterialE table_d1_original() {
+  model::PiezoMaterialE m;
+  m.c_e11 = 9.2e10;
+  m.c_e12 = 4.4e10;
+  m.c_e13 = 4.2e10;
+  m.c_e33 = 8e10;
+  m.c_e44 = 2.2e10;
+  m.eps_s33 = 538 * kEps0;
+  m.eps_s11 = 0;
+  m.e33 = 17.3;
+  m.e31 = -5.363;
+  m.e15 = 12.8;
+  return m;
+}
+model::PiezoMaterialE table_d1_target() {
+  model::PiezoMaterialE m;
+  m.c_e11 = 11.04e10;
+  m.c_e12 = 5.104e10;
+  m.c_e13 = 4.62e10;
+  m.c_e33 = 8.48e10;
+  m.c_e44 = 2.53e10;
+  m.eps_s33 = 800 * kEps0;
+  m.eps_s11 = 0;
+  m.e33 = 30;
+  m.e31 = -10;
+  m.e15 = 15;
+  return m;
+}
+
+// The exact α of the target against the base, in the unknowns' order.
+std::array<double, kModeShapeUnknowns> exact_alpha(const model::PiezoMaterialE& b,
+                                                   const model::PiezoMaterialE& t) {
+  const auto wb = model::weights(b), wt = model::weights(t);
+  std::array<double, kModeShapeUnknowns> a{};
+  for (int n = 0; n < 5; ++n) a[n] = wt[n] / wb[n] - 1.0;
+  const int k[6] = {0, 1, 2, 0, 0, 1}, l[6] = {0, 1, 2, 1, 2, 2};
+  for (int u = 0; u < 6; ++u)
+    a[5 + u] = (wt[5 + k[u]] * wt[5 + l[u]] / t.eps_s33) / (wb[5 + k[u]] * wb[5 + l[u]] / b.eps_s33) - 1.0;
+  return a;
+}
+
+class ModeShapeCmcm : public test::TubeFixture {
+ protected:
+  static void SetUpTestSuite() {
+    TubeFixture::SetUpTestSuite();
+    target_ = table_d1_target();
+    const ModeShapeCmcmOptions o;
+    targets_.short_circuit = elastic_modes(solver_->solve(target_, Electrodes::short_circuit, o.modal), 12);
+    targets_.open_circuit = elastic_modes(solver_->solve(target_, Electrodes::open_circuit, o.modal), 12);
+    targets_.eps_t33 = model::to_d_form(target_).eps_t33;  // exact; the capacitance's value is in README
+  }
+  static double rel(double a, double b) { return a / b - 1.0; }
+  static void print(const char* what, const ModeShapeCmcmResult& r) {
+    const auto t = table_d1_target();
+    const double tv[9] = {t.c_e11, t.c_e12, t.c_e13, t.c_e33, t.c_e44, t.eps_s33, t.e33, t.e31, t.e15};
+    const auto& u = r.updated;
+    const double uv[9] = {r.c_e[0], r.c_e[1], r.c_e[2], r.c_e[3], r.c_e[4], u.eps_s33, u.e33, u.e31, u.e15};
+    const char* names[9] = {"cE11", "cE12", "cE13", "cE33", "cE44", "epsS33", "e33", "e31", "e15"};
+    std::printf("[%s] %s: rank1 defect %.2e, residual lifted %.2e refined %.2e, GN %d\n", what,
+                to_string(r.staging), r.rank1_defect, r.residual_lifted, r.residual, r.refine_iterations);
+    for (int p = 0; p < 9; ++p) std::printf("  %-7s target %.6g updated %.6g  rel %+.3e\n", names[p], tv[p], uv[p], rel(uv[p], tv[p]));
+    for (const auto& eq : r.systems) {
+      std::printf("  system %lldx%lld rank %d, singular values:", static_cast<long long>(eq.g.rows()),
+                  static_cast<long long>(eq.g.cols()), eq.rank);
+      for (Eigen::Index s = 0; s < eq.singular_values.size(); ++s) std::printf(" %.2e", eq.singular_values[s]);
+      std::printf("\n  independence:");
+      for (std::size_t c = 0; c < eq.unknowns.size(); ++c)
+        std::printf(" %s %.2e", mode_shape_unknown_name(eq.unknowns[c]), eq.independence[static_cast<Eigen::Index>(c)]);
+      std::printf("\n");
+    }
+  }
+  static inline model::PiezoMaterialE target_;
+  static inline ModeShapeTargets targets_;
+};
+
+TEST_F(ModeShapeCmcm, ExactShapesJointRecoverTableD1) {
+  const auto r = mode_shape_cmcm(*tube_, *solver_, table_d1_original(), targets_);
+  print("exact shapes", r);
+  ASSERT_TRUE(r.ok) << r.message;
+  const auto a = exact_alpha(table_d1_original(), target_);
+  for (int u = 0; u < kModeShapeUnknowns; ++u)
+    std::printf("  alpha %-14s exact %+.6f lifted %+.6f refined %+.6f\n", mode_shape_unknown_name(u), a[u],
+                r.alpha_lifted[u], r.alpha[u]);
+}
+
+TEST_F(ModeShapeCmcm, ExactShapesSeedStaging) {
+  ModeShapeCmcmOptions o;
+  o.staging = ModeShapeStaging::seed;
+  const auto r = mode_shape_cmcm(*tube_, *solver_, table_d1_original(), targets_, o);
+  print("exact shapes", r);
+  ASSERT_TRUE(r.ok) << r.message;
+}
+
+// Two noise models for the target shapes, each independent between modes and
+// electrode conditions:
+//  white:  δ_j ~ N(0, (nu·rms(Φ*_j))² I), every DOF on its own (a measurement
+//          at every node);
+//  modal:  δ_j = nu·Σ_k ξ_k φ*_k over the other target modes k of the lowest
+//          `kContamination` (M-normalised, ξ ~ N(0, 1)): leakage between modes,
+//          what a modal identification leaves in a shape — smooth.
+enum class Noise { white, modal };
+constexpr int kContamination = 24;
+
+// First-order covariance of the lifted α. Row m = (i, j) of eq. 187 is
+// h_m = Φ_iᵀ(K* − λ*_jM)Φ*_j / Φ_iᵀKΦ*_j, zero at the truth, so
+// δh_m = w_mᵀδ_j / K0_m with w_m = (K* − λ*_jM)Φ_i, and δα = −G⁺δh.
+// For modal noise w_mᵀφ*_k = (λ*_k − λ*_j)Φ_iᵀMφ*_k.
+class ErrorModel {
+ public:
+  ErrorModel(const model::TubeModel& tube, model::ModalSolver& solver, const model::PiezoMaterialE& base,
+             const model::PiezoMaterialE& target, const ModeShapeTargets& t) : n_u_(tube.n_u()) {
+    const ModeShapeCmcmOptions o;
+    model::ModalOptions wide = o.modal;
+    wide.n_modes = kContamination + 1;
+    const Eigen::MatrixXd eye = Eigen::MatrixXd::Identity(n_u_, n_u_);
+    for (int e = 0; e < 2; ++e) {
+      const Electrodes el = e == 0 ? Electrodes::short_circuit : Electrodes::open_circuit;
+      Side& s = side_[e];
+      const ModalData md = elastic_modes(solver.solve(base, el, o.modal), o.n_model_modes);
+      const ModalData& td = e == 0 ? t.short_circuit : t.open_circuit;
+      s.basis = elastic_modes(solver.solve(target, el, wide), kContamination);
+      s.phis = td.shapes;
+      s.lambda_star = td.lambda;
+      s.w_k = CondensedStiffness(tube, target, el).bilinear(md.shapes, eye);
+      s.w_m = md.shapes.transpose() * (tube.split().m * eye);
+      s.mb = md.shapes.transpose() * (tube.split().m * s.basis.shapes);
+      s.k0 = CondensedStiffness(tube, base, el).bilinear(md.shapes, td.shapes);
+    }
+  }
+  Eigen::MatrixXd covariance(const ModeShapeEquations& eq, Noise noise, double nu) const {
+    const Eigen::Index rows = eq.g.rows();
+    Eigen::MatrixXd sigma_h = Eigen::MatrixXd::Zero(rows, rows);
+    for (Eigen::Index m = 0; m < rows; ++m)
+      for (Eigen::Index q = 0; q < rows; ++q) {
+        if (eq.electrodes[m] != eq.electrodes[q] || eq.pairs[m].second != eq.pairs[q].second) continue;
+        const Side& s = side_[eq.electrodes[m] == Electrodes::short_circuit ? 0 : 1];
+        const int j = eq.pairs[m].second, i1 = eq.pairs[m].first, i2 = eq.pairs[q].first;
+        double c = 0;
+        if (noise == Noise::white) {
+          const double sj = nu * s.phis.col(j).norm() / std::sqrt(static_cast<double>(n_u_));
+          const Eigen::VectorXd w1 = s.w_k.row(i1) - s.lambda_star[j] * s.w_m.row(i1);
+          const Eigen::VectorXd w2 = s.w_k.row(i2) - s.lambda_star[j] * s.w_m.row(i2);
+          c = sj * sj * w1.dot(w2);
+        } else {
+          for (int k = 0; k < kContamination; ++k) {
+            if (k == j) continue;
+            const double dl = s.basis.lambda[k] - s.lambda_star[j];
+            c += nu * nu * dl * dl * s.mb(i1, k) * s.mb(i2, k);
+          }
+        }
+        sigma_h(m, q) = c / (s.k0(i1, j) * s.k0(i2, j));
+      }
+    const Eigen::MatrixXd gp = eq.g.completeOrthogonalDecomposition().pseudoInverse();
+    return gp * sigma_h * gp.transpose();
+  }
+  ModalData perturb(const ModalData& d, Electrodes el, Noise noise, double nu, std::mt19937& rng) const {
+    std::normal_distribution<double> n01;
+    const Side& s = side_[el == Electrodes::short_circuit ? 0 : 1];
+    ModalData o = d;
+    for (Eigen::Index c = 0; c < o.shapes.cols(); ++c) {
+      if (noise == Noise::white) {
+        const double sd = nu * d.shapes.col(c).norm() / std::sqrt(static_cast<double>(n_u_));
+        for (Eigen::Index r = 0; r < o.shapes.rows(); ++r) o.shapes(r, c) += sd * n01(rng);
+      } else {
+        for (int k = 0; k < kContamination; ++k)
+          if (k != c) o.shapes.col(c) += nu * n01(rng) * s.basis.shapes.col(k);
+      }
+    }
+    return o;
+  }
+
+ private:
+  struct Side {
+    ModalData basis;                       // target modes for the modal noise
+    Eigen::MatrixXd phis, w_k, w_m, mb, k0;
+    Eigen::VectorXd lambda_star;
+  };
+  int n_u_;
+  std::array<Side, 2> side_;
+};
+
+struct NoiseRun {
+  double rms_z = 0;                     // lifted α errors in units of the predicted σ
+  std::array<double, 5> sigma_c{};      // predicted σ of α1..α5 (= relative σ of cE_n)
+  std::array<double, 5> max_err_c{};    // largest |relative error| of the refined cE_n over the seeds
+  int physical = 0;                     // runs that ended with a physical material
+};
+
+NoiseRun run_noise(const ErrorModel& em, const ModeShapeTargets& exact_t, const ModeShapeEquations& eq,
+                   const model::TubeModel& tube, model::ModalSolver& solver, const model::PiezoMaterialE& base,
+                   const model::PiezoMaterialE& target, Noise noise, double nu, unsigned seeds) {
+  const Eigen::MatrixXd cov = em.covariance(eq, noise, nu);
+  const auto a_true = exact_alpha(base, target);
+  NoiseRun out;
+  std::printf("%s noise %.1e, predicted sigma of alpha:", noise == Noise::white ? "white" : "modal", nu);
+  for (int u = 0; u < kModeShapeUnknowns; ++u) std::printf(" %.2e", std::sqrt(cov(u, u)));
+  std::printf("\n");
+  for (int n = 0; n < 5; ++n) out.sigma_c[n] = std::sqrt(cov(n, n));
+  const double tc[5] = {target.c_e11, target.c_e12, target.c_e13, target.c_e33, target.c_e44};
+  double z2 = 0;
+  int nz = 0;
+  for (unsigned seed = 1; seed <= seeds; ++seed) {
+    std::mt19937 rng(seed);
+    ModeShapeTargets t = exact_t;
+    t.short_circuit = em.perturb(exact_t.short_circuit, Electrodes::short_circuit, noise, nu, rng);
+    t.open_circuit = em.perturb(exact_t.open_circuit, Electrodes::open_circuit, noise, nu, rng);
+    const auto r = mode_shape_cmcm(tube, solver, base, t);
+    std::printf("  seed %u %s z:", seed, r.ok ? "ok  " : "FAIL");
+    for (int u = 0; u < kModeShapeUnknowns; ++u) {
+      const double z = (r.alpha_lifted[u] - a_true[u]) / std::sqrt(cov(u, u));
+      std::printf(" %+.2f", z);
+      z2 += z * z;
+      ++nz;
+    }
+    std::printf(" | rel err cE");
+    for (int n = 0; n < 5; ++n) {
+      const double e = r.c_e[n] / tc[n] - 1.0;
+      out.max_err_c[n] = std::max(out.max_err_c[n], std::abs(e));
+      std::printf(" %+.1e", e);
+    }
+    if (r.ok) {
+      ++out.physical;
+      const auto& u = r.updated;
+      std::printf(" epsS33 %+.1e e31 %+.1e e33 %+.1e e15 %+.1e", u.eps_s33 / target.eps_s33 - 1,
+                  u.e31 / target.e31 - 1, u.e33 / target.e33 - 1, u.e15 / target.e15 - 1);
+    }
+    std::printf("\n");
+  }
+  out.rms_z = std::sqrt(z2 / nz);
+  std::printf("  rms z %.3f over %d, physical %d/%u\n", out.rms_z, nz, out.physical, seeds);
+  return out;
+}
+
+TEST_F(ModeShapeCmcm, NoisyShapes) {
+  const auto base = table_d1_original();
+  const auto exact = mode_shape_cmcm(*tube_, *solver_, base, targets_);
+  ASSERT_TRUE(exact.ok) << exact.message;
+  const ErrorModel em(*tube_, *solver_, base, target_, targets_);
+  for (Noise noise : {Noise::white, Noise::modal})
+    for (double nu : {1e-5, 1e-3, 1e-2})
+      run_noise(em, targets_, exact.systems[0], *tube_, *solver_, base, target_, noise, nu, 8);
+}
+
+}  // namespace
+}  // namespace piezo::update
