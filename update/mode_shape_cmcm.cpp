@@ -114,7 +114,7 @@ struct Block {
 ModeShapeEquations equations(const std::vector<Block>& blocks, const Base& b,
                              const std::vector<int>& cols, const std::vector<int>& fixed,
                              const std::array<double, kModeShapeUnknowns>& alpha,
-                             double min_cross) {
+                             double min_cross, bool cross_modes) {
   ModeShapeEquations eq;
   eq.unknowns = cols;
   std::vector<Eigen::VectorXd> rows;
@@ -123,6 +123,7 @@ ModeShapeEquations equations(const std::vector<Block>& blocks, const Base& b,
     const Terms& t = *bl.terms;
     for (Eigen::Index i = 0; i < t.m.rows(); ++i) {
       for (Eigen::Index j = 0; j < t.m.cols(); ++j) {
+        if (!cross_modes && i != j) continue;
         const double kij = k0(t, b, static_cast<int>(i), static_cast<int>(j));
         const double mij = t.m(i, j);
         if (std::abs(mij) < min_cross || kij == 0) continue;  // both sides M-normalised
@@ -288,14 +289,14 @@ ModeShapeCmcmResult mode_shape_cmcm(const model::TubeModel& tube, model::ModalSo
   for (int u = 0; u < kModeShapeUnknowns; ++u) all.push_back(u);
   std::array<double, kModeShapeUnknowns> a{};
   if (opt.staging == ModeShapeStaging::joint) {
-    res.systems.push_back(equations({sc, oc}, b, all, {}, a, opt.min_cross));
+    res.systems.push_back(equations({sc, oc}, b, all, {}, a, opt.min_cross, opt.cross_modes));
     const Eigen::VectorXd x = solve(res.systems.back());
     for (int u = 0; u < kModeShapeUnknowns; ++u) a[u] = x[u];
   } else {
-    res.systems.push_back(equations({sc}, b, elastic, {}, a, opt.min_cross));  // D.1
+    res.systems.push_back(equations({sc}, b, elastic, {}, a, opt.min_cross, opt.cross_modes));  // D.1
     const Eigen::VectorXd x1 = solve(res.systems.back());
     for (int u = 0; u < 5; ++u) a[u] = x1[u];
-    res.systems.push_back(equations({oc}, b, coupling, elastic, a, opt.min_cross));  // D.2
+    res.systems.push_back(equations({oc}, b, coupling, elastic, a, opt.min_cross, opt.cross_modes));  // D.2
     const Eigen::VectorXd x2 = solve(res.systems.back());
     for (int u = 5; u < kModeShapeUnknowns; ++u) a[u] = x2[u - 5];
   }

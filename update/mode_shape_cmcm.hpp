@@ -65,6 +65,11 @@ struct ModeShapeCmcmOptions {
   double svd_rel_tol = 1e-10; // eq. 193 truncation
   // Pairs with |Φ_iᵀMΦ*_j| < min_cross·‖Φ_i‖_M‖Φ*_j‖_M are skipped (no information, eq. 182 ill-posed).
   double min_cross = 1e-3;
+  // Include the i ≠ j pairs (the seed: N_i × N_j equations). Their rows carry
+  // the shape change (Φ_iᵀMΦ*_j is of the order of α) and so amplify any error
+  // in the target shapes by 1/Φ_iᵀMΦ*_j; with i = j only, the 2 × 12 rows are
+  // the eigenvalue equations evaluated with the target shapes (update/README.md).
+  bool cross_modes = true;
   int refine_iterations = 20;  // Gauss–Newton on (cE_n, g_k); 0 keeps the lifted answer
   model::ModalOptions modal = [] {
     model::ModalOptions o;

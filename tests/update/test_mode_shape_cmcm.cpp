@@ -94,22 +94,89 @@ class ModeShapeCmcm : public test::TubeFixture {
   static inline ModeShapeTargets targets_;
 };
 
-TEST_F(ModeShapeCmcm, ExactShapesJointRecoverTableD1) {
-  const auto r = mode_shape_cmcm(*tube_, *solver_, table_d1_original(), targets_);
-  print("exact shapes", r);
-  ASSERT_TRUE(r.ok) << r.message;
-  const auto a = exact_alpha(table_d1_original(), target_);
-  for (int u = 0; u < kModeShapeUnknowns; ++u)
-    std::printf("  alpha %-14s exact %+.6f lifted %+.6f refined %+.6f\n", mode_shape_unknown_name(u), a[u],
-                r.alpha_lifted[u], r.alpha[u]);
+void expect_material_near(const ModeShapeCmcmResult& r, const model::PiezoMaterialE& t, double tol) {
+  EXPECT_NEAR(r.updated.c_e11 / t.c_e11, 1.0, tol);
+  EXPECT_NEAR(r.updated.c_e12 / t.c_e12, 1.0, tol);
+  EXPECT_NEAR(r.updated.c_e13 / t.c_e13, 1.0, tol);
+  EXPECT_NEAR(r.updated.c_e33 / t.c_e33, 1.0, tol);
+  EXPECT_NEAR(r.updated.c_e44 / t.c_e44, 1.0, tol);
+  EXPECT_NEAR(r.updated.eps_s33 / t.eps_s33, 1.0, tol);
+  EXPECT_NEAR(r.updated.e31 / t.e31, 1.0, tol);
+  EXPECT_NEAR(r.updated.e33 / t.e33, 1.0, tol);
+  EXPECT_NEAR(r.updated.e15 / t.e15, 1.0, tol);
 }
 
-TEST_F(ModeShapeCmcm, ExactShapesSeedStaging) {
+// Exact target shapes: with the coupling terms lifted, K is exactly linear in
+// the eleven unknowns, so eq. 187 holds exactly at the true α and G has full
+// rank (11) — the answer is exact up to the modal solver's accuracy
+// (Lanczos tolerance 1e-10) times ‖G⁺‖ = 1/σ_min ≈ 13: 1e-8 with margin
+// (measured 2.4e-10). D.11 with the exact εT33 then gives e31, e33, εS33.
+TEST_F(ModeShapeCmcm, ExactShapesRecoverTableD1) {
+  const auto base = table_d1_original();
+  const auto r = mode_shape_cmcm(*tube_, *solver_, base, targets_);
+  print("exact shapes", r);
+  ASSERT_TRUE(r.ok) << r.message;
+  ASSERT_EQ(r.systems.size(), 1u);
+  EXPECT_EQ(r.systems[0].rank, kModeShapeUnknowns);
+  const auto a = exact_alpha(base, target_);
+  for (int u = 0; u < kModeShapeUnknowns; ++u) {
+    EXPECT_NEAR(r.alpha_lifted[u], a[u], 1e-8) << mode_shape_unknown_name(u);
+    EXPECT_NEAR(r.alpha[u], a[u], 1e-8) << mode_shape_unknown_name(u);
+  }
+  EXPECT_LT(r.rank1_defect, 1e-8);
+  expect_material_near(r, target_, 1e-8);
+}
+
+// The diagonal pairs alone (2 × 12 rows) still determine all eleven unknowns
+// from exact shapes, on a much worse conditioned system (σ_min/σ_max ≈ 2e-6,
+// ‖G⁺‖ ≈ 8e4): 1e-6 (measured 4e-10).
+TEST_F(ModeShapeCmcm, ExactShapesDiagonalPairsOnly) {
+  ModeShapeCmcmOptions o;
+  o.cross_modes = false;
+  const auto r = mode_shape_cmcm(*tube_, *solver_, table_d1_original(), targets_, o);
+  print("exact shapes, i = j only", r);
+  ASSERT_TRUE(r.ok) << r.message;
+  EXPECT_EQ(r.systems[0].g.rows(), 24);
+  EXPECT_EQ(r.systems[0].rank, kModeShapeUnknowns);
+  expect_material_near(r, target_, 1e-6);
+}
+
+// The seed's staging: D.1 holds the coupling at the base model's. On our FE
+// model the potentials inside the wall are condensed in the short circuit as
+// well, so the short-circuit stiffness carries the coupling terms and D.1
+// absorbs their change into the elastic constants (cE13, cE33 +59 %). With the
+// base's coupling already equal to the target's, the same staging is exact —
+// the bias is that term and nothing else.
+TEST_F(ModeShapeCmcm, SeedStagingIsBiasedByTheShortCircuitCoupling) {
   ModeShapeCmcmOptions o;
   o.staging = ModeShapeStaging::seed;
   const auto r = mode_shape_cmcm(*tube_, *solver_, table_d1_original(), targets_, o);
   print("exact shapes", r);
-  ASSERT_TRUE(r.ok) << r.message;
+  ASSERT_EQ(r.systems.size(), 2u);
+  EXPECT_GT(std::abs(rel(r.c_e[2], target_.c_e13)), 0.05);
+  EXPECT_GT(std::abs(rel(r.c_e[3], target_.c_e33)), 0.05);
+
+  auto base = table_d1_original();
+  base.e31 = target_.e31;
+  base.e33 = target_.e33;
+  base.e15 = target_.e15;
+  base.eps_s33 = target_.eps_s33;
+  const auto rk = mode_shape_cmcm(*tube_, *solver_, base, targets_, o);
+  print("exact shapes, coupling known", rk);
+  ASSERT_TRUE(rk.ok) << rk.message;
+  expect_material_near(rk, target_, 1e-8);
+}
+
+TEST_F(ModeShapeCmcm, RejectsWhatAppendixDDoesNotCover) {
+  auto base = table_d1_original();
+  base.eps_s11 = 1e-9;
+  EXPECT_THROW(mode_shape_cmcm(*tube_, *solver_, base, targets_), std::invalid_argument);
+  base = table_d1_original();
+  base.e15 = 0;
+  EXPECT_THROW(mode_shape_cmcm(*tube_, *solver_, base, targets_), std::invalid_argument);
+  ModeShapeTargets t = targets_;
+  t.eps_t33 = 0;
+  EXPECT_THROW(mode_shape_cmcm(*tube_, *solver_, table_d1_original(), t), std::invalid_argument);
 }
 
 // Two noise models for the target shapes, each independent between modes and
@@ -209,7 +276,8 @@ struct NoiseRun {
 
 NoiseRun run_noise(const ErrorModel& em, const ModeShapeTargets& exact_t, const ModeShapeEquations& eq,
                    const model::TubeModel& tube, model::ModalSolver& solver, const model::PiezoMaterialE& base,
-                   const model::PiezoMaterialE& target, Noise noise, double nu, unsigned seeds) {
+                   const model::PiezoMaterialE& target, Noise noise, double nu, unsigned seeds,
+                   const ModeShapeCmcmOptions& opt = {}) {
   const Eigen::MatrixXd cov = em.covariance(eq, noise, nu);
   const auto a_true = exact_alpha(base, target);
   NoiseRun out;
@@ -225,7 +293,7 @@ NoiseRun run_noise(const ErrorModel& em, const ModeShapeTargets& exact_t, const 
     ModeShapeTargets t = exact_t;
     t.short_circuit = em.perturb(exact_t.short_circuit, Electrodes::short_circuit, noise, nu, rng);
     t.open_circuit = em.perturb(exact_t.open_circuit, Electrodes::open_circuit, noise, nu, rng);
-    const auto r = mode_shape_cmcm(tube, solver, base, t);
+    const auto r = mode_shape_cmcm(tube, solver, base, t, opt);
     std::printf("  seed %u %s z:", seed, r.ok ? "ok  " : "FAIL");
     for (int u = 0; u < kModeShapeUnknowns; ++u) {
       const double z = (r.alpha_lifted[u] - a_true[u]) / std::sqrt(cov(u, u));
@@ -252,14 +320,46 @@ NoiseRun run_noise(const ErrorModel& em, const ModeShapeTargets& exact_t, const 
   return out;
 }
 
-TEST_F(ModeShapeCmcm, NoisyShapes) {
+// Noisy shapes. (1) In the linear regime (nu = 1e-6) the lifted α's errors
+// must follow the first-order prediction: the RMS of error/σ over 8 seeds ×
+// 11 unknowns is 1 for a correct prediction; the unknowns' errors are strongly
+// correlated within a seed (cE11..cE33 move together), ~3 independent per
+// seed, so its spread is ≈ 0.14 and [0.6, 1.5] is asserted (measured 0.71-1.30).
+// (2) At the 1 % the predicted σ of the elastic α's exceeds 0.5 for
+// both noise models with the seed's N_i × N_j rows (and 0.5 for cE11 with
+// i = j rows under modal noise): Appendix D cannot identify the constants
+// from 1 %-accurate shapes on this tube; the observed errors must be of that
+// scale (RMS of error/σ between 0.05 and 3: past the linear regime the
+// answers saturate or leave the physical domain, so not 1).
+TEST_F(ModeShapeCmcm, NoisyShapesFollowTheFirstOrderPrediction) {
   const auto base = table_d1_original();
+  ModeShapeCmcmOptions diag;
+  diag.cross_modes = false;
   const auto exact = mode_shape_cmcm(*tube_, *solver_, base, targets_);
-  ASSERT_TRUE(exact.ok) << exact.message;
+  const auto exact_diag = mode_shape_cmcm(*tube_, *solver_, base, targets_, diag);
+  ASSERT_TRUE(exact.ok && exact_diag.ok);
   const ErrorModel em(*tube_, *solver_, base, target_, targets_);
-  for (Noise noise : {Noise::white, Noise::modal})
-    for (double nu : {1e-5, 1e-3, 1e-2})
-      run_noise(em, targets_, exact.systems[0], *tube_, *solver_, base, target_, noise, nu, 8);
+  for (Noise noise : {Noise::white, Noise::modal}) {
+    for (bool cross : {true, false}) {
+      const auto& eq = cross ? exact.systems[0] : exact_diag.systems[0];
+      const ModeShapeCmcmOptions& o = cross ? ModeShapeCmcmOptions{} : diag;
+      std::printf("%s rows: ", cross ? "all" : "i = j");
+      const NoiseRun lin = run_noise(em, targets_, eq, *tube_, *solver_, base, target_, noise, 1e-6, 8, o);
+      EXPECT_GT(lin.rms_z, 0.6);
+      EXPECT_LT(lin.rms_z, 1.5);
+      EXPECT_EQ(lin.physical, 8);
+      std::printf("%s rows: ", cross ? "all" : "i = j");
+      (void)run_noise(em, targets_, eq, *tube_, *solver_, base, target_, noise, 1e-3, 8, o);
+      std::printf("%s rows: ", cross ? "all" : "i = j");
+      const NoiseRun one = run_noise(em, targets_, eq, *tube_, *solver_, base, target_, noise, 1e-2, 8, o);
+      EXPECT_GT(one.rms_z, 0.05);
+      EXPECT_LT(one.rms_z, 3.0);
+      if (cross)
+        for (int n = 0; n < 5; ++n) EXPECT_GT(one.sigma_c[n], 0.5) << n;
+      else
+        EXPECT_GT(one.sigma_c[0], 0.5);
+    }
+  }
 }
 
 }  // namespace
