@@ -97,6 +97,19 @@ double direction(const Terms& t, const Base& b, int u, int i, int j) {
   return b.p(k, l) * (t.cpl[k][l](i, j) + t.cpl[l][k](i, j));
 }
 
+// Column of unknown u. With the seed's linearisation of D.10,
+// √((1+α_k)(1+α_l)) ≈ 1 + (α_k + α_l)/2, the cross terms have no unknown of
+// their own: b_k's column takes half of each cross term it enters.
+double column(const Terms& t, const Base& b, int u, int i, int j, bool linearised) {
+  double d = direction(t, b, u, i, j);
+  if (linearised && u >= 5 && u < 8)
+    for (int c = 8; c < kModeShapeUnknowns; ++c) {
+      const auto [k, l] = kPairs[c - 5];
+      if (k == u - 5 || l == u - 5) d += 0.5 * direction(t, b, c, i, j);
+    }
+  return d;
+}
+
 double k0(const Terms& t, const Base& b, int i, int j) {
   double v = 0;
   for (int u = 0; u < kModeShapeUnknowns; ++u) v += direction(t, b, u, i, j);
@@ -114,7 +127,7 @@ struct Block {
 ModeShapeEquations equations(const std::vector<Block>& blocks, const Base& b,
                              const std::vector<int>& cols, const std::vector<int>& fixed,
                              const std::array<double, kModeShapeUnknowns>& alpha,
-                             double min_cross, bool cross_modes) {
+                             double min_cross, bool cross_modes, bool linearised) {
   ModeShapeEquations eq;
   eq.unknowns = cols;
   std::vector<Eigen::VectorXd> rows;
@@ -130,10 +143,11 @@ ModeShapeEquations equations(const std::vector<Block>& blocks, const Base& b,
         Eigen::VectorXd row(static_cast<Eigen::Index>(cols.size()));
         for (std::size_t c = 0; c < cols.size(); ++c)
           row[static_cast<Eigen::Index>(c)] =
-              direction(t, b, cols[c], static_cast<int>(i), static_cast<int>(j)) / kij;  // eq. 182
+              column(t, b, cols[c], static_cast<int>(i), static_cast<int>(j), linearised) / kij;  // eq. 182
         // eqs 180-181/185-187: λ*_j Φ_iᵀMΦ*_j / Φ_iᵀKΦ*_j − 1 (= λ*_j/λ_i − 1 for exact Φ_i).
         double f = bl.target->lambda[j] * mij / kij - 1.0;
-        for (int u : fixed) f -= alpha[u] * direction(t, b, u, static_cast<int>(i), static_cast<int>(j)) / kij;
+        for (int u : fixed)
+          f -= alpha[u] * column(t, b, u, static_cast<int>(i), static_cast<int>(j), linearised) / kij;
         rows.push_back(row);
         rhs.push_back(f);
         eq.electrodes.push_back(bl.electrodes);
@@ -283,23 +297,34 @@ ModeShapeCmcmResult mode_shape_cmcm(const model::TubeModel& tube, model::ModalSo
     eq.singular_values = s.singular_values;
     eq.rank = s.rank;
     eq.independence = independence(eq.g);
+    eq.right_singular_vectors = Eigen::JacobiSVD<Eigen::MatrixXd>(eq.g, Eigen::ComputeThinV).matrixV();
     return s.x;
   };
-  std::vector<int> elastic{0, 1, 2, 3, 4}, coupling{5, 6, 7, 8, 9, 10}, all;
-  for (int u = 0; u < kModeShapeUnknowns; ++u) all.push_back(u);
+  const bool lin = opt.linearise_cross_terms;
+  const int n_unknowns = lin ? 8 : kModeShapeUnknowns;
+  std::vector<int> elastic{0, 1, 2, 3, 4}, coupling, all;
+  for (int u = 0; u < n_unknowns; ++u) {
+    all.push_back(u);
+    if (u >= 5) coupling.push_back(u);
+  }
   std::array<double, kModeShapeUnknowns> a{};
   if (opt.staging == ModeShapeStaging::joint) {
-    res.systems.push_back(equations({sc, oc}, b, all, {}, a, opt.min_cross, opt.cross_modes));
+    res.systems.push_back(equations({sc, oc}, b, all, {}, a, opt.min_cross, opt.cross_modes, lin));
     const Eigen::VectorXd x = solve(res.systems.back());
-    for (int u = 0; u < kModeShapeUnknowns; ++u) a[u] = x[u];
+    for (int u = 0; u < n_unknowns; ++u) a[u] = x[u];
   } else {
-    res.systems.push_back(equations({sc}, b, elastic, {}, a, opt.min_cross, opt.cross_modes));  // D.1
+    res.systems.push_back(equations({sc}, b, elastic, {}, a, opt.min_cross, opt.cross_modes, lin));  // D.1
     const Eigen::VectorXd x1 = solve(res.systems.back());
     for (int u = 0; u < 5; ++u) a[u] = x1[u];
-    res.systems.push_back(equations({oc}, b, coupling, elastic, a, opt.min_cross, opt.cross_modes));  // D.2
+    res.systems.push_back(equations({oc}, b, coupling, elastic, a, opt.min_cross, opt.cross_modes, lin));  // D.2
     const Eigen::VectorXd x2 = solve(res.systems.back());
-    for (int u = 5; u < kModeShapeUnknowns; ++u) a[u] = x2[u - 5];
+    for (int u = 5; u < n_unknowns; ++u) a[u] = x2[u - 5];
   }
+  if (lin)  // the seed's reading of the cross terms' corrections
+    for (int u = 8; u < kModeShapeUnknowns; ++u) {
+      const auto [k, l] = kPairs[u - 5];
+      a[u] = 0.5 * (a[5 + k] + a[5 + l]);
+    }
   for (const auto& eq : res.systems)
     if (eq.g.rows() == 0) {
       res.message = "mode_shape_cmcm: no usable mode pairs (all cross products below min_cross)";

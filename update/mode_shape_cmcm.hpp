@@ -70,6 +70,10 @@ struct ModeShapeCmcmOptions {
   // in the target shapes by 1/Φ_iᵀMΦ*_j; with i = j only, the 2 × 12 rows are
   // the eigenvalue equations evaluated with the target shapes (update/README.md).
   bool cross_modes = true;
+  // The seed's D.10 read as eq. 173 by linearising √((1+α_k)(1+α_l)) ≈
+  // 1 + (α_k + α_l)/2: eight unknowns, biased for large changes (kept to show
+  // by how much; the default lifts the cross terms, exact).
+  bool linearise_cross_terms = false;
   int refine_iterations = 20;  // Gauss–Newton on (cE_n, g_k); 0 keeps the lifted answer
   model::ModalOptions modal = [] {
     model::ModalOptions o;
@@ -91,6 +95,7 @@ struct ModeShapeEquations {
   std::vector<model::Electrodes> electrodes;  // per row
   std::vector<std::pair<int, int>> pairs;     // per row (model mode i, target mode j)
   Eigen::VectorXd singular_values;
+  Eigen::MatrixXd right_singular_vectors;  // columns: directions in α, largest σ first
   // Per column: fraction of its norm left after projection onto the other
   // columns (1 = independent, ≪ 1 = nearly a combination of the others).
   Eigen::VectorXd independence;
