@@ -322,7 +322,7 @@ NoiseRun run_noise(const ErrorModel& em, const ModeShapeTargets& exact_t, const 
     t.short_circuit = em.perturb(exact_t.short_circuit, Electrodes::short_circuit, noise, nu, rng);
     t.open_circuit = em.perturb(exact_t.open_circuit, Electrodes::open_circuit, noise, nu, rng);
     const auto r = mode_shape_cmcm(tube, solver, base, t, opt);
-    std::printf("  seed %u %s z:", seed, r.ok ? "ok  " : "FAIL");
+    std::printf("  seed %u %s z:", seed, r.ok ? "ok          " : "non-physical");
     for (int u = 0; u < kModeShapeUnknowns; ++u) {
       const double z = (r.alpha_lifted[u] - a_true[u]) / std::sqrt(cov(u, u));
       std::printf(" %+.2f", z);
