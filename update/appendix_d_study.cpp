@@ -46,7 +46,8 @@ namespace {
 
 // The divider capture of the target (seed ch. 5 lab drive), as test_output_error's.
 OeData simulate_capture(model::ModalSolver& solver, const model::PiezoMaterialE& target,
-                        const AppendixDOptions& o, std::vector<double>& v1, std::vector<double>& v2) {
+                        const AppendixDOptions& o, std::vector<double>& v1,
+                        std::vector<double>& v2) {
   const double fs = 10e6;
   const std::size_t n = 20000, pre = 200;
   v1.assign(n, 0.0);
@@ -79,8 +80,8 @@ OeData simulate_capture(model::ModalSolver& solver, const model::PiezoMaterialE&
 }  // namespace
 
 AppendixDStudy appendix_d_study(const model::TubeModel& tube, model::ModalSolver& solver,
-                                const model::PiezoMaterialE& original, const model::PiezoMaterialE& target,
-                                const AppendixDOptions& o) {
+                                const model::PiezoMaterialE& original,
+                                const model::PiezoMaterialE& target, const AppendixDOptions& o) {
   AppendixDStudy s;
   const model::ModalOptions fopt = CmcmOptions{}.modal;
   s.f_original = model_frequencies(solver, original, 3, 3, fopt);
@@ -91,8 +92,10 @@ AppendixDStudy appendix_d_study(const model::TubeModel& tube, model::ModalSolver
   // (a) Appendix D: target shapes and eigenvalues, εT33 by eq. 201.
   ModeShapeTargets t;
   const int nm = o.shapes.n_model_modes;
-  t.short_circuit = elastic_modes(solver.solve(target, Electrodes::short_circuit, o.shapes.modal), nm);
-  t.open_circuit = elastic_modes(solver.solve(target, Electrodes::open_circuit, o.shapes.modal), nm);
+  t.short_circuit =
+      elastic_modes(solver.solve(target, Electrodes::short_circuit, o.shapes.modal), nm);
+  t.open_circuit =
+      elastic_modes(solver.solve(target, Electrodes::open_circuit, o.shapes.modal), nm);
   s.eps_t33_eq201 = eps_t33_from_low_z(tube.geometry(), z_low, o.f_low_hz);
   t.eps_t33 = s.eps_t33_eq201;
   s.shapes = mode_shape_cmcm(tube, solver, original, t, o.shapes);
@@ -114,7 +117,8 @@ AppendixDStudy appendix_d_study(const model::TubeModel& tube, model::ModalSolver
   std::vector<double> v1, v2;
   const OeData data = simulate_capture(solver, target, o, v1, v2);
   s.output_error_started_from_cmcm = o.output_error_from_cmcm && s.cmcm.ok();
-  s.output_error = fit_output_error(solver, cls, s.output_error_started_from_cmcm ? s.cmcm.updated : p0, data);
+  s.output_error =
+      fit_output_error(solver, cls, s.output_error_started_from_cmcm ? s.cmcm.updated : p0, data);
 
   const model::PiezoMaterialE ma = s.shapes.updated;
   const model::PiezoMaterialE mb = cls.e_form(s.cmcm.updated);
@@ -151,29 +155,32 @@ std::string to_markdown(const AppendixDStudy& s) {
   std::ostringstream o;
   char buf[512];
   auto pct = [](double v, double t) { return 100.0 * (v / t - 1.0); };
-  o << "| constant | target | (a) shapes | (b) CMCM | (c) output error | err (a) % | err (b) % | err (c) % |\n"
+  o << "| constant | target | (a) shapes | (b) CMCM | (c) output error | err (a) % | err (b) % | "
+       "err (c) % |\n"
        "|---|---|---|---|---|---|---|---|\n";
   for (const auto& r : s.rows) {
-    std::snprintf(buf, sizeof buf, "| %s (%s) | %.5g | %.5g | %.5g | %.5g | %+.2e | %+.3f | %+.3f |\n",
-                  r.name.c_str(), r.unit.c_str(), r.target / r.scale, r.shapes / r.scale, r.cmcm / r.scale,
-                  r.output_error / r.scale, pct(r.shapes, r.target), pct(r.cmcm, r.target),
-                  pct(r.output_error, r.target));
+    std::snprintf(buf, sizeof buf,
+                  "| %s (%s) | %.5g | %.5g | %.5g | %.5g | %+.2e | %+.3f | %+.3f |\n",
+                  r.name.c_str(), r.unit.c_str(), r.target / r.scale, r.shapes / r.scale,
+                  r.cmcm / r.scale, r.output_error / r.scale, pct(r.shapes, r.target),
+                  pct(r.cmcm, r.target), pct(r.output_error, r.target));
     o << buf;
   }
   o << "\n| active mode (Hz) | original | target | (a) | (b) | (c) |\n|---|---|---|---|---|---|\n";
   auto fr = [&](const char* what, const std::vector<double>& f0, const std::vector<double>& t,
-                const std::vector<double>& a, const std::vector<double>& b, const std::vector<double>& c) {
+                const std::vector<double>& a, const std::vector<double>& b,
+                const std::vector<double>& c) {
     for (std::size_t k = 0; k < t.size(); ++k) {
       auto at = [&](const std::vector<double>& v) { return k < v.size() ? v[k] : std::nan(""); };
-      std::snprintf(buf, sizeof buf, "| %s %zu | %.1f | %.1f | %.1f | %.1f | %.1f |\n", what, k + 1, at(f0), t[k],
-                    at(a), at(b), at(c));
+      std::snprintf(buf, sizeof buf, "| %s %zu | %.1f | %.1f | %.1f | %.1f | %.1f |\n", what, k + 1,
+                    at(f0), t[k], at(a), at(b), at(c));
       o << buf;
     }
   };
-  fr("resonance", s.f_original.resonances_hz, s.f_target.resonances_hz, s.f_shapes.resonances_hz, s.f_cmcm.resonances_hz,
-     s.f_output_error.resonances_hz);
-  fr("anti-resonance", s.f_original.antiresonances_hz, s.f_target.antiresonances_hz, s.f_shapes.antiresonances_hz, s.f_cmcm.antiresonances_hz,
-     s.f_output_error.antiresonances_hz);
+  fr("resonance", s.f_original.resonances_hz, s.f_target.resonances_hz, s.f_shapes.resonances_hz,
+     s.f_cmcm.resonances_hz, s.f_output_error.resonances_hz);
+  fr("anti-resonance", s.f_original.antiresonances_hz, s.f_target.antiresonances_hz,
+     s.f_shapes.antiresonances_hz, s.f_cmcm.antiresonances_hz, s.f_output_error.antiresonances_hz);
   return o.str();
 }
 

@@ -38,9 +38,9 @@ struct AppendixDOptions {
 };
 
 struct AppendixDRow {
-  std::string name;    // cE11 … e15, epsT33
-  std::string unit;    // as printed: GPa, ε0, C/m²
-  double scale = 1;    // SI value / printed value
+  std::string name;                                           // cE11 … e15, epsT33
+  std::string unit;                                           // as printed: GPa, ε0, C/m²
+  double scale = 1;                                           // SI value / printed value
   double target = 0, shapes = 0, cmcm = 0, output_error = 0;  // SI
 };
 
@@ -57,7 +57,8 @@ struct AppendixDStudy {
 };
 
 AppendixDStudy appendix_d_study(const model::TubeModel& tube, model::ModalSolver& solver,
-                                const model::PiezoMaterialE& original, const model::PiezoMaterialE& target,
+                                const model::PiezoMaterialE& original,
+                                const model::PiezoMaterialE& target,
                                 const AppendixDOptions& options = {});
 
 // The table as Markdown (what update/README.md carries).

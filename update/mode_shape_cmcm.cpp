@@ -33,9 +33,11 @@ const char* to_string(ModeShapeStaging s) {
 
 const char* mode_shape_unknown_name(int n) {
   static constexpr const char* names[kModeShapeUnknowns] = {
-      "cE11", "cE12", "cE13", "cE33", "cE44", "e31^2/epsS33", "e33^2/epsS33", "e15^2/epsS33",
+      "cE11",          "cE12",          "cE13",         "cE33",
+      "cE44",          "e31^2/epsS33",  "e33^2/epsS33", "e15^2/epsS33",
       "e31e33/epsS33", "e31e15/epsS33", "e33e15/epsS33"};
-  if (n < 0 || n >= kModeShapeUnknowns) throw std::invalid_argument("mode_shape_unknown_name: index");
+  if (n < 0 || n >= kModeShapeUnknowns)
+    throw std::invalid_argument("mode_shape_unknown_name: index");
   return names[n];
 }
 
@@ -50,14 +52,15 @@ double eps_s33_d11(const model::PiezoMaterialE& elastic, double g31, double g33,
 namespace {
 
 // Coupling pairs (k, l) of the lifted unknowns 5..10: b1, b2, b3, then the cross terms.
-constexpr std::array<std::pair<int, int>, 6> kPairs{{{0, 0}, {1, 1}, {2, 2}, {0, 1}, {0, 2}, {1, 2}}};
+constexpr std::array<std::pair<int, int>, 6> kPairs{
+    {{0, 0}, {1, 1}, {2, 2}, {0, 1}, {0, 2}, {1, 2}}};
 
 // Bilinear forms Φᵀ(·)Φ* of the pieces of the condensed stiffness of one
 // electrode condition (split matrices of the TubeModel, nothing re-assembled).
 struct Terms {
-  std::array<Eigen::MatrixXd, 5> el;                   // Φᵀ K_cn Φ* (eq. 234)
-  std::array<std::array<Eigen::MatrixXd, 3>, 3> cpl;   // Φᵀ K_ek N⁻¹ K_elᵀ Φ* (D.4-D.9 without b)
-  Eigen::MatrixXd m;                                   // Φᵀ M Φ*
+  std::array<Eigen::MatrixXd, 5> el;                  // Φᵀ K_cn Φ* (eq. 234)
+  std::array<std::array<Eigen::MatrixXd, 3>, 3> cpl;  // Φᵀ K_ek N⁻¹ K_elᵀ Φ* (D.4-D.9 without b)
+  Eigen::MatrixXd m;                                  // Φᵀ M Φ*
 };
 
 Terms make_terms(const model::TubeModel& tube, Electrodes electrodes, const Eigen::MatrixXd& x,
@@ -126,8 +129,8 @@ struct Block {
 // with values `alpha` are moved to the right-hand side.
 ModeShapeEquations equations(const std::vector<Block>& blocks, const Base& b,
                              const std::vector<int>& cols, const std::vector<int>& fixed,
-                             const std::array<double, kModeShapeUnknowns>& alpha,
-                             double min_cross, bool cross_modes, bool linearised) {
+                             const std::array<double, kModeShapeUnknowns>& alpha, double min_cross,
+                             bool cross_modes, bool linearised) {
   ModeShapeEquations eq;
   eq.unknowns = cols;
   std::vector<Eigen::VectorXd> rows;
@@ -143,11 +146,13 @@ ModeShapeEquations equations(const std::vector<Block>& blocks, const Base& b,
         Eigen::VectorXd row(static_cast<Eigen::Index>(cols.size()));
         for (std::size_t c = 0; c < cols.size(); ++c)
           row[static_cast<Eigen::Index>(c)] =
-              column(t, b, cols[c], static_cast<int>(i), static_cast<int>(j), linearised) / kij;  // eq. 182
+              column(t, b, cols[c], static_cast<int>(i), static_cast<int>(j), linearised) /
+              kij;  // eq. 182
         // eqs 180-181/185-187: λ*_j Φ_iᵀMΦ*_j / Φ_iᵀKΦ*_j − 1 (= λ*_j/λ_i − 1 for exact Φ_i).
         double f = bl.target->lambda[j] * mij / kij - 1.0;
         for (int u : fixed)
-          f -= alpha[u] * column(t, b, u, static_cast<int>(i), static_cast<int>(j), linearised) / kij;
+          f -= alpha[u] * column(t, b, u, static_cast<int>(i), static_cast<int>(j), linearised) /
+               kij;
         rows.push_back(row);
         rhs.push_back(f);
         eq.electrodes.push_back(bl.electrodes);
@@ -203,18 +208,20 @@ double dalpha(const std::array<double, 8>& th, int u, int v) {
   return d;
 }
 
-double residual_norm(const ModeShapeEquations& eq, const std::array<double, kModeShapeUnknowns>& a) {
+double residual_norm(const ModeShapeEquations& eq,
+                     const std::array<double, kModeShapeUnknowns>& a) {
   Eigen::VectorXd x(static_cast<Eigen::Index>(eq.unknowns.size()));
-  for (std::size_t c = 0; c < eq.unknowns.size(); ++c) x[static_cast<Eigen::Index>(c)] = a[eq.unknowns[c]];
+  for (std::size_t c = 0; c < eq.unknowns.size(); ++c)
+    x[static_cast<Eigen::Index>(c)] = a[eq.unknowns[c]];
   return (eq.g * x - eq.f).norm();
 }
 
 // Gauss–Newton on the physical unknowns that enter `eq`, the others fixed.
 int refine(const ModeShapeEquations& eq, std::array<double, 8>& th, int max_it, double rel_tol) {
-  std::vector<int> free;
+  std::vector<int> free;  // θ_v that some column of eq depends on (y_k > 0, so ∂α/∂y ≠ 0)
   for (int v = 0; v < 8; ++v)
     for (int u : eq.unknowns)
-      if (dalpha(th, u, v) != 0 || (u >= 5 && v >= 5)) {
+      if (dalpha(th, u, v) != 0) {
         free.push_back(v);
         break;
       }
@@ -222,11 +229,13 @@ int refine(const ModeShapeEquations& eq, std::array<double, 8>& th, int max_it, 
   for (; it < max_it; ++it) {
     const auto a = alpha_of(th);
     Eigen::VectorXd x(static_cast<Eigen::Index>(eq.unknowns.size()));
-    Eigen::MatrixXd da(static_cast<Eigen::Index>(eq.unknowns.size()), static_cast<Eigen::Index>(free.size()));
+    Eigen::MatrixXd da(static_cast<Eigen::Index>(eq.unknowns.size()),
+                       static_cast<Eigen::Index>(free.size()));
     for (std::size_t c = 0; c < eq.unknowns.size(); ++c) {
       x[static_cast<Eigen::Index>(c)] = a[eq.unknowns[c]];
       for (std::size_t v = 0; v < free.size(); ++v)
-        da(static_cast<Eigen::Index>(c), static_cast<Eigen::Index>(v)) = dalpha(th, eq.unknowns[c], free[v]);
+        da(static_cast<Eigen::Index>(c), static_cast<Eigen::Index>(v)) =
+            dalpha(th, eq.unknowns[c], free[v]);
     }
     const Eigen::VectorXd r = eq.g * x - eq.f;
     const TsvdSolution step = solve_tsvd(eq.g * da, -r, rel_tol);
@@ -251,19 +260,25 @@ ModeShapeCmcmResult mode_shape_cmcm(const model::TubeModel& tube, model::ModalSo
                                     const ModeShapeCmcmOptions& opt) {
   model::validate(base, "mode_shape_cmcm");
   if (base.eps_s11 != 0)
-    throw std::invalid_argument("mode_shape_cmcm: Appendix D.2 assumes epsS11 = 0 in the base model");
+    throw std::invalid_argument(
+        "mode_shape_cmcm: Appendix D.2 assumes epsS11 = 0 in the base model");
   const Base b{{base.c_e11, base.c_e12, base.c_e13, base.c_e33, base.c_e44},
                {base.e31, base.e33, base.e15},
                base.eps_s33};
   for (double v : b.c)
-    if (!(v != 0)) throw std::invalid_argument("mode_shape_cmcm: zero elastic constant in the base");
+    if (!(v != 0))
+      throw std::invalid_argument("mode_shape_cmcm: zero elastic constant in the base");
   for (double v : b.e)
-    if (!(v != 0)) throw std::invalid_argument("mode_shape_cmcm: zero piezoelectric constant in the base");
+    if (!(v != 0))
+      throw std::invalid_argument("mode_shape_cmcm: zero piezoelectric constant in the base");
   for (const ModalData* d : {&targets.short_circuit, &targets.open_circuit})
-    if (d->shapes.rows() != tube.n_u() || d->shapes.cols() != d->lambda.size() || d->lambda.size() == 0)
-      throw std::invalid_argument("mode_shape_cmcm: target shapes must be n_u x J with J eigenvalues, J > 0");
+    if (d->shapes.rows() != tube.n_u() || d->shapes.cols() != d->lambda.size() ||
+        d->lambda.size() == 0)
+      throw std::invalid_argument(
+          "mode_shape_cmcm: target shapes must be n_u x J with J eigenvalues, J > 0");
   if (!(targets.eps_t33 > 0)) throw std::invalid_argument("mode_shape_cmcm: eps_t33 must be > 0");
-  if (opt.n_model_modes < 1) throw std::invalid_argument("mode_shape_cmcm: n_model_modes must be >= 1");
+  if (opt.n_model_modes < 1)
+    throw std::invalid_argument("mode_shape_cmcm: n_model_modes must be >= 1");
 
   ModeShapeCmcmResult res;
   res.staging = opt.staging;
@@ -273,7 +288,8 @@ ModeShapeCmcmResult mode_shape_cmcm(const model::TubeModel& tube, model::ModalSo
   // electrode condition. Shapes M-normalised so that min_cross is relative.
   auto normalised = [&](ModalData d) {
     const Eigen::MatrixXd mx = tube.split().m * d.shapes;
-    for (Eigen::Index c = 0; c < d.shapes.cols(); ++c) d.shapes.col(c) /= std::sqrt(d.shapes.col(c).dot(mx.col(c)));
+    for (Eigen::Index c = 0; c < d.shapes.cols(); ++c)
+      d.shapes.col(c) /= std::sqrt(d.shapes.col(c).dot(mx.col(c)));
     return d;
   };
   const ModalData tsc = normalised(targets.short_circuit), toc = normalised(targets.open_circuit);
@@ -297,7 +313,8 @@ ModeShapeCmcmResult mode_shape_cmcm(const model::TubeModel& tube, model::ModalSo
     eq.singular_values = s.singular_values;
     eq.rank = s.rank;
     eq.independence = independence(eq.g);
-    eq.right_singular_vectors = Eigen::JacobiSVD<Eigen::MatrixXd>(eq.g, Eigen::ComputeThinV).matrixV();
+    eq.right_singular_vectors =
+        Eigen::JacobiSVD<Eigen::MatrixXd>(eq.g, Eigen::ComputeThinV).matrixV();
     return s.x;
   };
   const bool lin = opt.linearise_cross_terms;
@@ -313,10 +330,12 @@ ModeShapeCmcmResult mode_shape_cmcm(const model::TubeModel& tube, model::ModalSo
     const Eigen::VectorXd x = solve(res.systems.back());
     for (int u = 0; u < n_unknowns; ++u) a[u] = x[u];
   } else {
-    res.systems.push_back(equations({sc}, b, elastic, {}, a, opt.min_cross, opt.cross_modes, lin));  // D.1
+    res.systems.push_back(
+        equations({sc}, b, elastic, {}, a, opt.min_cross, opt.cross_modes, lin));  // D.1
     const Eigen::VectorXd x1 = solve(res.systems.back());
     for (int u = 0; u < 5; ++u) a[u] = x1[u];
-    res.systems.push_back(equations({oc}, b, coupling, elastic, a, opt.min_cross, opt.cross_modes, lin));  // D.2
+    res.systems.push_back(
+        equations({oc}, b, coupling, elastic, a, opt.min_cross, opt.cross_modes, lin));  // D.2
     const Eigen::VectorXd x2 = solve(res.systems.back());
     for (int u = 5; u < n_unknowns; ++u) a[u] = x2[u - 5];
   }
@@ -341,8 +360,8 @@ ModeShapeCmcmResult mode_shape_cmcm(const model::TubeModel& tube, model::ModalSo
   for (int k = 0; k < 3; ++k) {
     if (!(1.0 + a[5 + k] > 0)) {
       std::ostringstream s;
-      s << "mode_shape_cmcm: the lifted solve gives " << mode_shape_unknown_name(5 + k) << " <= 0 (alpha "
-        << a[5 + k] << "); not physical";
+      s << "mode_shape_cmcm: the lifted solve gives " << mode_shape_unknown_name(5 + k)
+        << " <= 0 (alpha " << a[5 + k] << "); not physical";
       res.message = s.str();
       return res;
     }

@@ -61,9 +61,10 @@ const char* to_string(ModeShapeStaging s);
 
 struct ModeShapeCmcmOptions {
   ModeShapeStaging staging = ModeShapeStaging::joint;
-  int n_model_modes = 12;     // lowest elastic modes of the base model per electrode condition
-  double svd_rel_tol = 1e-10; // eq. 193 truncation
-  // Pairs with |Φ_iᵀMΦ*_j| < min_cross·‖Φ_i‖_M‖Φ*_j‖_M are skipped (no information, eq. 182 ill-posed).
+  int n_model_modes = 12;      // lowest elastic modes of the base model per electrode condition
+  double svd_rel_tol = 1e-10;  // eq. 193 truncation
+  // Pairs with |Φ_iᵀMΦ*_j| < min_cross·‖Φ_i‖_M‖Φ*_j‖_M are skipped (no information, eq. 182
+  // ill-posed).
   double min_cross = 1e-3;
   // Include the i ≠ j pairs (the seed: N_i × N_j equations). Their rows carry
   // the shape change (Φ_iᵀMΦ*_j is of the order of α) and so amplify any error
@@ -91,7 +92,7 @@ const char* mode_shape_unknown_name(int n);
 struct ModeShapeEquations {
   Eigen::MatrixXd g;
   Eigen::VectorXd f;
-  std::vector<int> unknowns;                 // columns of g → unknown index
+  std::vector<int> unknowns;                  // columns of g → unknown index
   std::vector<model::Electrodes> electrodes;  // per row
   std::vector<std::pair<int, int>> pairs;     // per row (model mode i, target mode j)
   Eigen::VectorXd singular_values;
@@ -111,9 +112,9 @@ struct ModeShapeCmcmResult {
   double rank1_defect = 0;  // max_kl |(1+α_kl) − s·√((1+α_kk)(1+α_ll))| of the lifted answer
   int refine_iterations = 0;
   double residual_lifted = 0, residual = 0;  // ‖Gα − f‖ of each answer (all stages' rows)
-  std::array<double, 3> b_base{}, b{};      // e31²/εS33, e33²/εS33, e15²/εS33
-  std::array<double, 5> c_e{};              // updated cE11, cE12, cE13, cE33, cE44
-  model::PiezoMaterialE updated;            // after D.11 (εS11 kept at 0)
+  std::array<double, 3> b_base{}, b{};       // e31²/εS33, e33²/εS33, e15²/εS33
+  std::array<double, 5> c_e{};               // updated cE11, cE12, cE13, cE33, cE44
+  model::PiezoMaterialE updated;             // after D.11 (εS11 kept at 0)
   // One entry per linear solve: the joint system, or D.1 then D.2.
   std::vector<ModeShapeEquations> systems;
 };

@@ -6,8 +6,8 @@
 #include <cstdio>
 #include <cstdlib>
 
-#include "update/appendix_d_study.hpp"
 #include "tests/support/tube_fixture.hpp"
+#include "update/appendix_d_study.hpp"
 
 namespace piezo::update {
 namespace {
@@ -16,13 +16,16 @@ class AppendixD : public test::TubeFixture {};
 
 void print(const AppendixDStudy& s) {
   std::printf("%s", to_markdown(s).c_str());
-  std::printf("(a) %s; epsT33 by eq. 201 %.2f eps0\n(b) %s %s\n(c) %s %s, from %s, chi2/dof %.4g (limit %.4g), lack of fit %d\n",
-              s.shapes.ok ? "ok" : s.shapes.message.c_str(), s.eps_t33_eq201 / model::kEps0,
-              to_string(s.cmcm.status), s.cmcm.message.c_str(), to_string(s.output_error.status),
-              s.output_error.message.c_str(), s.output_error_started_from_cmcm ? "(b)" : "the original",
-              s.output_error.chi2_per_dof, s.output_error.chi2_limit, s.output_error.lack_of_fit);
+  std::printf(
+      "(a) %s; epsT33 by eq. 201 %.2f eps0\n(b) %s %s\n(c) %s %s, from %s, chi2/dof %.4g (limit "
+      "%.4g), lack of fit %d\n",
+      s.shapes.ok ? "ok" : s.shapes.message.c_str(), s.eps_t33_eq201 / model::kEps0,
+      to_string(s.cmcm.status), s.cmcm.message.c_str(), to_string(s.output_error.status),
+      s.output_error.message.c_str(), s.output_error_started_from_cmcm ? "(b)" : "the original",
+      s.output_error.chi2_per_dof, s.output_error.chi2_limit, s.output_error.lack_of_fit);
   for (const auto& p : s.output_error.parameters)
-    std::printf("    (c) %s %.6g ± %.2g %s %s\n", p.name.c_str(), p.value, p.sigma, p.status.c_str(), p.reason.c_str());
+    std::printf("    (c) %s %.6g ± %.2g %s %s\n", p.name.c_str(), p.value, p.sigma,
+                p.status.c_str(), p.reason.c_str());
 }
 
 // What each path guarantees on this target:

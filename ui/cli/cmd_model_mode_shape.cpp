@@ -45,7 +45,8 @@ void run_mode_shape(Context& ctx, const ModeShapeArgs& a) {
 
   const model::TubeModel tube{model::TubeGeometry{}};
   model::ModalSolver solver(tube);
-  const auto s = update::appendix_d_study(tube, solver, update::table_d1_original(), update::table_d1_target(), o);
+  const auto s = update::appendix_d_study(tube, solver, update::table_d1_original(),
+                                          update::table_d1_target(), o);
 
   nlohmann::json j;
   j["rows"] = nlohmann::json::array();
@@ -68,7 +69,8 @@ void run_mode_shape(Context& ctx, const ModeShapeArgs& a) {
                        {"unknowns", unk},
                        {"rank", eq.rank},
                        {"singular_values", std::vector<double>(eq.singular_values.data(),
-                                                               eq.singular_values.data() + eq.singular_values.size())}});
+                                                               eq.singular_values.data() +
+                                                                   eq.singular_values.size())}});
   }
   j["mode_shape_cmcm"] = {{"ok", s.shapes.ok},
                           {"message", s.shapes.message},
@@ -86,22 +88,26 @@ void run_mode_shape(Context& ctx, const ModeShapeArgs& a) {
   if (ctx.json) {
     print_json(j);
   } else {
-    std::printf("Seed Appendix D, Table D.1 on the default tube: (a) mode-shape CMCM (%s%s%s), "
-                "(b) extended CMCM from frequencies, (c) output-error fit of a simulated capture "
-                "(noise %.3g)\n\n",
-                update::to_string(s.shapes.staging), a.linearise ? ", D.10 linearised" : "",
-                a.diagonal ? ", i = j pairs" : "", a.capture_noise);
+    std::printf(
+        "Seed Appendix D, Table D.1 on the default tube: (a) mode-shape CMCM (%s%s%s), "
+        "(b) extended CMCM from frequencies, (c) output-error fit of a simulated capture "
+        "(noise %.3g)\n\n",
+        update::to_string(s.shapes.staging), a.linearise ? ", D.10 linearised" : "",
+        a.diagonal ? ", i = j pairs" : "", a.capture_noise);
     std::printf("%s\n", update::to_markdown(s).c_str());
-    std::printf("(a) %s; epsT33 for D.11 by eq. 201: %.2f eps0\n", s.shapes.ok ? "ok" : s.shapes.message.c_str(),
-                s.eps_t33_eq201 / model::kEps0);
+    std::printf("(a) %s; epsT33 for D.11 by eq. 201: %.2f eps0\n",
+                s.shapes.ok ? "ok" : s.shapes.message.c_str(), s.eps_t33_eq201 / model::kEps0);
     for (const auto& eq : s.shapes.systems) {
-      std::printf("    %lld equations, rank %d, singular values", static_cast<long long>(eq.g.rows()), eq.rank);
-      for (Eigen::Index k = 0; k < eq.singular_values.size(); ++k) std::printf(" %.3g", eq.singular_values[k]);
+      std::printf("    %lld equations, rank %d, singular values",
+                  static_cast<long long>(eq.g.rows()), eq.rank);
+      for (Eigen::Index k = 0; k < eq.singular_values.size(); ++k)
+        std::printf(" %.3g", eq.singular_values[k]);
       std::printf("\n");
     }
-    std::printf("(b) %s %s\n(c) %s %s (chi2/dof %.4g%s)\n", update::to_string(s.cmcm.status), s.cmcm.message.c_str(),
-                update::to_string(s.output_error.status), s.output_error.message.c_str(),
-                s.output_error.chi2_per_dof, s.output_error.lack_of_fit ? ", lack of fit" : "");
+    std::printf("(b) %s %s\n(c) %s %s (chi2/dof %.4g%s)\n", update::to_string(s.cmcm.status),
+                s.cmcm.message.c_str(), update::to_string(s.output_error.status),
+                s.output_error.message.c_str(), s.output_error.chi2_per_dof,
+                s.output_error.lack_of_fit ? ", lack of fit" : "");
   }
   if (!s.shapes.ok) ctx.exit_code = kInternal;
 }
@@ -111,7 +117,8 @@ void run_mode_shape(Context& ctx, const ModeShapeArgs& a) {
 void register_mode_shape_command(CLI::App* model, Context& ctx) {
   auto args = std::make_shared<ModeShapeArgs>();
   auto* cmd = model->add_subcommand(
-      "mode-shape-cmcm", "Seed Appendix D: Table D.1 by mode-shape CMCM, extended CMCM and output error");
+      "mode-shape-cmcm",
+      "Seed Appendix D: Table D.1 by mode-shape CMCM, extended CMCM and output error");
   cmd->add_option("--capture-noise", args->capture_noise,
                   "Noise of (c)'s simulated capture, std(noise)/std(clean) per channel")
       ->capture_default_str();
@@ -121,9 +128,8 @@ void register_mode_shape_command(CLI::App* model, Context& ctx) {
   cmd->add_flag("--linearise-cross-terms", args->linearise, "The seed's linearised D.10 (biased)");
   cmd->add_flag("--diagonal-pairs", args->diagonal, "Only the i = j mode pairs");
   add_json_flag(cmd, ctx);
-  cmd->callback([&ctx, args] {
-    ctx.exit_code = run_command(ctx, [&] { run_mode_shape(ctx, *args); });
-  });
+  cmd->callback(
+      [&ctx, args] { ctx.exit_code = run_command(ctx, [&] { run_mode_shape(ctx, *args); }); });
 }
 
 }  // namespace piezo::cli
