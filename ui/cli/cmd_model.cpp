@@ -3,6 +3,7 @@
 //   model modal     --material M [--isotropic] [--set k=v,…] [--modes N] [--json]
 //   model impedance --material M --fmin HZ --fmax HZ --step HZ [--rayleigh-beta S] [--csv|--json]
 //   model sensitivity [--material M] [--band HZ] [--json]   (Appendix C.1, model/sensitivity.hpp)
+//   model mode-shape-cmcm [--json] …                         (Appendix D, cmd_model_mode_shape.cpp)
 // Exit codes: 0 ok, 2 bad input (unknown material, bad --set), 1 non-convergence
 // or internal failure.
 #include <cmath>
@@ -343,6 +344,8 @@ void register_model_commands(CLI::App& app, Context& ctx) {
   sens->callback([&ctx, sens_args, band] {
     ctx.exit_code = run_command(ctx, [&] { run_sensitivity(ctx, *sens_args, *band); });
   });
+
+  register_mode_shape_command(model, ctx);
 }
 
 }  // namespace piezo::cli
