@@ -8,6 +8,7 @@
 #include <map>
 
 #include "acquisition/contained_read.hpp"
+#include "drivers/instrument_uri.hpp"
 #include "acquisition/capture_calibration.hpp"
 #include "acquisition/capture_file.hpp"
 #include "acquisition/divider_record.hpp"
@@ -58,7 +59,7 @@ acq::Capture acquire(const PipelineRequest& req, PipelineResult& out, const Stag
     out.stages.push_back({"acquire", false, "replay of " + req.replay_capture});
     return cap;
   }
-  if (req.instrument == "sim") sim = acq::make_sim_bench(req.sim, req.plan.setup.divider_r1_ohm);
+  if (drivers::is_sim_address(req.instrument)) sim = acq::make_sim_bench(req.sim, req.plan.setup.divider_r1_ohm);
   acq::Bench bench = acq::open_bench({req.instrument, req.daq.empty() ? std::nullopt : std::optional(req.daq)}, sim);
   out.awg_idn = bench.awg->identity();
   out.daq_idn = bench.daq->identity();

@@ -19,6 +19,7 @@
 #include "drivers/sim/sim_redpitaya.hpp"
 #include "drivers/sim/sim_tektronix_awg.hpp"
 #include "drivers/sim/tcp_server.hpp"
+#include "drivers/instrument_uri.hpp"
 #include "ui/cli/cli_common.hpp"
 
 namespace piezo::cli {
@@ -149,7 +150,7 @@ void register_measure_commands(CLI::App& app, Context& ctx) {
       plan.validate();
       acq::BenchAddress addr{a->instrument, a->daq.empty() ? std::nullopt : std::optional(a->daq)};
       std::shared_ptr<drivers::sim::SimBench> sim;
-      if (a->instrument == "sim") {
+      if (drivers::is_sim_address(a->instrument)) {
         sim = acq::make_sim_bench(sim_spec(a->sim, plan.setup.geometry()), plan.setup.divider_r1_ohm);
         if (!plan.setup.material) plan.setup.material = a->sim.material;
       } else if (!a->sim.effects.empty()) {
