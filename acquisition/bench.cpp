@@ -42,7 +42,7 @@ std::unique_ptr<Daq> open_comedi(const std::string& address, const std::shared_p
                                   "(--instrument sim or sim?awg=tektronix)");
     return std::make_unique<comedi::Driver>(std::make_unique<sim::SimComediBoard>(sim_bench, a.device, a.sim_softcal), a);
   }
-  return std::make_unique<comedi::Driver>(comedi::open_comedilib_board(a.device), a);
+  return builtin_drivers().open_board_daq(address);  // comedi:// (drivers/registry.cpp)
 }
 }  // namespace
 

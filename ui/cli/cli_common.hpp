@@ -56,6 +56,7 @@ class ProgressBar {
 void register_capture_commands(CLI::App& app, Context& ctx);
 void register_demo_command(CLI::App& app, Context& ctx);
 void register_measure_commands(CLI::App& app, Context& ctx);
+void register_instruments_command(CLI::App& app, Context& ctx);
 void register_model_commands(CLI::App& app, Context& ctx);
 void register_impedance_command(CLI::App& app, Context& ctx);
 void register_update_command(CLI::App& app, Context& ctx);
