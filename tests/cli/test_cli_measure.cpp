@@ -212,7 +212,7 @@ TEST(CliMeasure, UnknownDialectIsBadInput) {
 TEST(CliMeasure, ComediBoardOnTheEmbeddedBenchEqualsInProcess) {
   auto dir = tmp_dir() / "comedi";
   fs::create_directories(dir);
-  const std::string plan = " --adc-bits 12 --samples 4000 --pretrigger 0 --rate 5e6 --range 2 --shots 2 --noise 0.05 "
+  const std::string plan = " --adc-bits 12 --samples 20000 --pretrigger 0 --rate 5e6 --range 2 --shots 2 --noise 0.05 "
                            "--seed 17 --effect parallel_capacitance=100e-12 --overwrite --out ";
   auto com = test::run_cli("measure --json --instrument sim --daq 'comedi-sim:///dev/comedi0?trigger=pfi0&softcal=1'" +
                            plan + (dir / "comedi.h5").string());
@@ -229,6 +229,19 @@ TEST(CliMeasure, ComediBoardOnTheEmbeddedBenchEqualsInProcess) {
     EXPECT_EQ(a.shots[k].v1, b.shots[k].v1) << "shot " << k;
     EXPECT_EQ(a.shots[k].v2, b.shots[k].v2) << "shot " << k;
   }
+  // The demo's next step, the update, from each capture: the same result
+  // (all but the capture's name and the time taken), converged.
+  auto ua = test::run_cli("update --json " + (dir / "comedi.h5").string());
+  auto ub = test::run_cli("update --json " + (dir / "local.h5").string());
+  ASSERT_EQ(ua.exit_code, 0) << ua.err;
+  ASSERT_EQ(ub.exit_code, 0) << ub.err;
+  auto ja = nlohmann::json::parse(ua.out), jb = nlohmann::json::parse(ub.out);
+  EXPECT_TRUE(ja["converged"].get<bool>()) << ua.out;
+  for (auto* j : {&ja, &jb}) {
+    j->erase("capture");
+    j->erase("seconds");
+  }
+  EXPECT_EQ(ja, jb);
 }
 
 // The Tektronix twin with the Comedi board: the AWG at 10 MS/s (its
