@@ -199,7 +199,11 @@ DaqRecord Driver::fetch(double timeout_s) {
     if (r.error == ENODEV) fail("device gone after " + progress() + " (ENODEV: unplugged or driver unloaded)");
     fail("read failed after " + progress() + ": " + board_->error_text(r.error));
   }
-  running_ = false;  // TRIG_COUNT: the command has ended with the last scan
+  // TRIG_COUNT: the command ended with the last scan, but the kernel keeps the
+  // subdevice busy until a read() sees the end; comedi_cancel releases it, so
+  // the next shot's comedi_command does not meet EBUSY.
+  board_->cancel(subdev_);
+  running_ = false;
 
   DaqRecord rec;
   rec.v1.resize(scans);

@@ -156,6 +156,10 @@ comedi::ReadResult SimComediBoard::read(std::span<std::uint8_t> buf, double) {
 
 void SimComediBoard::cancel(unsigned) {
   running_ = false;
+  stream_.clear();  // what was not read is gone: a read now sees the end
+  read_pos_ = 0;
+  filled_ = true;
+  ++cancels_;
   std::lock_guard lock(bench_->mutex());
   bench_->daq().armed = false;
 }

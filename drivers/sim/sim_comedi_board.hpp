@@ -54,6 +54,7 @@ class SimComediBoard : public comedi::Board {
   }
 
   int commands() const { return commands_; }  // comedi_command calls accepted
+  int cancels() const { return cancels_; }    // comedi_cancel calls
 
  private:
   void fill_stream();  // the shot's interleaved raw samples (caller holds the bench mutex)
@@ -70,6 +71,7 @@ class SimComediBoard : public comedi::Board {
   std::size_t read_pos_ = 0;
   bool filled_ = false;
   int commands_ = 0;
+  int cancels_ = 0;
 };
 
 }  // namespace piezo::drivers::sim

@@ -146,6 +146,7 @@ TEST(ComediDriver, IdentityRangesAndTimerRounding) {
   EXPECT_EQ(r.pretrigger_samples, 0u);
   EXPECT_EQ(r.v1.size(), 500u);
   EXPECT_EQ(board->commands(), 1);
+  EXPECT_EQ(board->cancels(), 1);  // the finished command released (the kernel keeps it busy until then)
 }
 
 TEST(ComediDriver, WhatTheBoardCannotDoIsRefusedWithTheReason) {
