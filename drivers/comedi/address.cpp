@@ -47,7 +47,8 @@ Address parse_address(std::string_view text) {
     const std::string_view item = query.substr(0, amp);
     query = amp == std::string_view::npos ? std::string_view{} : query.substr(amp + 1);
     const auto eq = item.find('=');
-    if (eq == std::string_view::npos) bad(text, "option '" + std::string(item) + "' needs a value (NAME=VALUE)");
+    if (eq == std::string_view::npos)
+      bad(text, "option '" + std::string(item) + "' needs a value (NAME=VALUE)");
     const std::string_view key = item.substr(0, eq), value = item.substr(eq + 1);
     if (key == "trigger") {
       if (value == "software") {
@@ -62,10 +63,14 @@ Address parse_address(std::string_view text) {
       if (value != "rising" && value != "falling") bad(text, "edge must be rising or falling");
       a.falling = value == "falling";
     } else if (key == "aref") {
-      if (value == "diff") a.aref = Aref::Diff;
-      else if (value == "rse") a.aref = Aref::Ground;
-      else if (value == "nrse") a.aref = Aref::Common;
-      else bad(text, "aref must be diff, rse or nrse, not '" + std::string(value) + "'");
+      if (value == "diff")
+        a.aref = Aref::Diff;
+      else if (value == "rse")
+        a.aref = Aref::Ground;
+      else if (value == "nrse")
+        a.aref = Aref::Common;
+      else
+        bad(text, "aref must be diff, rse or nrse, not '" + std::string(value) + "'");
     } else if (key == "channels") {
       const auto comma = value.find(',');
       if (comma == std::string_view::npos) bad(text, "channels must be two channel numbers, C1,C2");
@@ -73,11 +78,13 @@ Address parse_address(std::string_view text) {
       a.channels[1] = parse_unsigned(text, value.substr(comma + 1), "channel");
       if (a.channels[0] == a.channels[1]) bad(text, "v1 and v2 need two different channels");
     } else if (key == "softcal") {
-      if (!a.simulated) bad(text, "softcal is an option of the simulated board (comedi-sim://) only");
+      if (!a.simulated)
+        bad(text, "softcal is an option of the simulated board (comedi-sim://) only");
       if (value != "0" && value != "1") bad(text, "softcal must be 0 or 1");
       a.sim_softcal = value == "1";
     } else {
-      bad(text, "unknown option '" + std::string(key) + "' (trigger, edge, aref, channels, softcal)");
+      bad(text,
+          "unknown option '" + std::string(key) + "' (trigger, edge, aref, channels, softcal)");
     }
   }
   return a;
@@ -87,7 +94,9 @@ std::string Address::to_string() const {
   std::string s = (simulated ? "comedi-sim://" : "comedi://") + device + "?trigger=";
   s += external_trigger ? "pfi" + std::to_string(pfi) : std::string("software");
   if (external_trigger && falling) s += "&edge=falling";
-  s += std::string("&aref=") + (aref == Aref::Diff ? "diff" : aref == Aref::Ground ? "rse" : "nrse");
+  s += std::string("&aref=") + (aref == Aref::Diff     ? "diff"
+                                : aref == Aref::Ground ? "rse"
+                                                       : "nrse");
   s += "&channels=" + std::to_string(channels[0]) + "," + std::to_string(channels[1]);
   if (sim_softcal) s += "&softcal=1";
   return s;

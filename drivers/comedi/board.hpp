@@ -52,10 +52,10 @@ struct ChanSpec {
 // stop after `scans` scans (TRIG_COUNT).
 struct Command {
   unsigned subdevice = 0;
-  bool external_start = false;  // TRIG_EXT (else TRIG_NOW)
-  unsigned start_pfi = 0;       // the PFI line of TRIG_EXT (NI numbering)
-  bool start_falling = false;   // CR_INVERT: trigger on the falling edge
-  unsigned scan_period_ns = 0;  // in: requested; out: what the board will do
+  bool external_start = false;     // TRIG_EXT (else TRIG_NOW)
+  unsigned start_pfi = 0;          // the PFI line of TRIG_EXT (NI numbering)
+  bool start_falling = false;      // CR_INVERT: trigger on the falling edge
+  unsigned scan_period_ns = 0;     // in: requested; out: what the board will do
   unsigned convert_period_ns = 0;  // out: 0 = simultaneous (TRIG_NOW)
   unsigned scans = 0;
   std::vector<ChanSpec> chanlist;
@@ -78,7 +78,7 @@ class Board {
   virtual int find_analog_input() = 0;
   virtual SubdeviceInfo subdevice(unsigned subdev) = 0;
   virtual std::vector<Range> ranges(unsigned subdev, unsigned channel) = 0;  // comedi_get_range
-  virtual std::uint32_t maxdata(unsigned subdev, unsigned channel) = 0;     // comedi_get_maxdata
+  virtual std::uint32_t maxdata(unsigned subdev, unsigned channel) = 0;      // comedi_get_maxdata
   // comedi_get_softcal_converter(COMEDI_TO_PHYSICAL) from the board's default
   // calibration file; nullopt when there is none (comedi_soft_calibrate not run).
   virtual std::optional<Polynomial> softcal(unsigned subdev, unsigned channel, unsigned range) = 0;
@@ -91,8 +91,8 @@ class Board {
   virtual int command(const Command& c) = 0;  // comedi_command: 0, or -1 (last_error())
   // Waits up to timeout_s for data (poll on comedi_fileno), then read()s.
   virtual ReadResult read(std::span<std::uint8_t> buf, double timeout_s) = 0;
-  virtual void cancel(unsigned subdev) = 0;  // comedi_cancel; best effort
-  virtual int last_error() const = 0;        // comedi_errno
+  virtual void cancel(unsigned subdev) = 0;             // comedi_cancel; best effort
+  virtual int last_error() const = 0;                   // comedi_errno
   virtual std::string error_text(int error) const = 0;  // comedi_strerror / strerror
   virtual double to_phys(std::uint32_t raw, const Range& r, std::uint32_t maxdata) const = 0;
   virtual double to_physical(std::uint32_t raw, const Polynomial& p) const = 0;

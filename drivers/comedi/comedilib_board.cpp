@@ -52,7 +52,9 @@ class ComedilibBoard final : public Board {
     const char* s = comedi_get_board_name(dev_);
     return s ? s : "";
   }
-  int find_analog_input() override { return comedi_find_subdevice_by_type(dev_, COMEDI_SUBD_AI, 0); }
+  int find_analog_input() override {
+    return comedi_find_subdevice_by_type(dev_, COMEDI_SUBD_AI, 0);
+  }
 
   SubdeviceInfo subdevice(unsigned subdev) override {
     SubdeviceInfo s;
@@ -93,7 +95,8 @@ class ComedilibBoard final : public Board {
     }
     if (!calibration_) return std::nullopt;
     comedi_polynomial_t poly{};
-    if (comedi_get_softcal_converter(subdev, channel, range, COMEDI_TO_PHYSICAL, calibration_, &poly) < 0)
+    if (comedi_get_softcal_converter(subdev, channel, range, COMEDI_TO_PHYSICAL, calibration_,
+                                     &poly) < 0)
       return std::nullopt;
     Polynomial out;
     out.expansion_origin = poly.expansion_origin;
@@ -150,7 +153,8 @@ class ComedilibBoard final : public Board {
     comedi_polynomial_t poly{};
     poly.expansion_origin = p.expansion_origin;
     poly.order = p.coefficients.empty() ? 0 : static_cast<unsigned>(p.coefficients.size() - 1);
-    for (std::size_t i = 0; i < p.coefficients.size() && i < COMEDI_MAX_NUM_POLYNOMIAL_COEFFICIENTS; ++i)
+    for (std::size_t i = 0; i < p.coefficients.size() && i < COMEDI_MAX_NUM_POLYNOMIAL_COEFFICIENTS;
+         ++i)
       poly.coefficients[i] = p.coefficients[i];
     return comedi_to_physical(raw, &poly);
   }
@@ -158,7 +162,8 @@ class ComedilibBoard final : public Board {
  private:
   void fill(comedi_cmd& cmd, const Command& c) {
     chanlist_.clear();
-    for (const auto& ch : c.chanlist) chanlist_.push_back(CR_PACK(ch.channel, ch.range, aref_bits(ch.aref)));
+    for (const auto& ch : c.chanlist)
+      chanlist_.push_back(CR_PACK(ch.channel, ch.range, aref_bits(ch.aref)));
     cmd.subdev = c.subdevice;
     if (c.external_start) {
       // NI E/M series: the PFI line as the trigger source, on its edge.
@@ -191,7 +196,8 @@ std::unique_ptr<Board> open_comedilib_board(const std::string& path) {
   if (!dev) {
     const int e = comedi_errno();
     const char* why = comedi_strerror(e);
-    throw InstrumentError("comedi://" + path + ": cannot open (" + std::string(why ? why : "unknown error") +
+    throw InstrumentError("comedi://" + path + ": cannot open (" +
+                          std::string(why ? why : "unknown error") +
                           "); is the board configured (comedi_config) and readable by you?");
   }
   return std::make_unique<ComedilibBoard>(dev, path);

@@ -37,7 +37,8 @@ Driver::Driver(std::unique_ptr<Board> board, const Address& address)
                             std::to_string(info_.n_channels) + " channels");
     ch_[k].channel = address_.channels[k];
     ch_[k].maxdata = board_->maxdata(subdev_, ch_[k].channel);
-    if (ch_[k].maxdata == 0) throw InstrumentError(who() + ": maxdata 0 on channel " + std::to_string(ch_[k].channel));
+    if (ch_[k].maxdata == 0)
+      throw InstrumentError(who() + ": maxdata 0 on channel " + std::to_string(ch_[k].channel));
   }
 }
 
@@ -47,7 +48,8 @@ Driver::~Driver() {
 
 std::string Driver::who() const {
   const std::string b = board_->board_name();
-  return address_.to_string().substr(0, address_.to_string().find('?')) + (b.empty() ? "" : " (" + b + ")");
+  return address_.to_string().substr(0, address_.to_string().find('?')) +
+         (b.empty() ? "" : " (" + b + ")");
 }
 
 std::string Driver::identity() const {
@@ -66,18 +68,21 @@ void Driver::configure(const DaqConfig& c) {
     throw std::invalid_argument(w + "sample rate must be positive");
   if (c.record_length < 2) throw std::invalid_argument(w + "record length must be >= 2");
   if (c.pretrigger_samples != 0)
-    throw std::invalid_argument(w + "a Comedi command starts at its trigger: no samples before it (pretrigger " +
-                                std::to_string(c.pretrigger_samples) + "; use 0)");
+    throw std::invalid_argument(
+        w + "a Comedi command starts at its trigger: no samples before it (pretrigger " +
+        std::to_string(c.pretrigger_samples) + "; use 0)");
   if (c.coupling != Coupling::Dc1M)
     throw std::invalid_argument(w + "the driver sets no coupling: DC only (the board's default)");
   if (c.external_trigger != address_.external_trigger)
-    throw std::invalid_argument(w + (c.external_trigger ? "the plan triggers on the AWG's marker but the address says "
-                                                          "trigger=software"
-                                                        : "the plan starts by software but the address names a PFI "
-                                                          "trigger"));
+    throw std::invalid_argument(
+        w + (c.external_trigger ? "the plan triggers on the AWG's marker but the address says "
+                                  "trigger=software"
+                                : "the plan starts by software but the address names a PFI "
+                                  "trigger"));
   const double period = 1e9 / c.sample_rate_hz;
   if (!(period >= 1.0 && period <= 4e9))
-    throw std::invalid_argument(w + "sample rate " + num(c.sample_rate_hz) + " S/s: the scan period must be 1 ns..4 s");
+    throw std::invalid_argument(w + "sample rate " + num(c.sample_rate_hz) +
+                                " S/s: the scan period must be 1 ns..4 s");
 
   if (running_) {  // the previous shot's command (a fault left it running)
     board_->cancel(subdev_);
@@ -100,13 +105,14 @@ void Driver::configure(const DaqConfig& c) {
           if (!offered.empty()) offered.append(", ");
           offered.append("[").append(num(r.min)).append(", ").append(num(r.max)).append("]");
         }
-      throw std::invalid_argument(w + "channel " + std::to_string(next[k].channel) + " (v" + std::to_string(k + 1) +
-                                  "): no range holds ±" + num(c.range_v[k]) + " V (the board offers " + offered +
-                                  " V)");
+      throw std::invalid_argument(w + "channel " + std::to_string(next[k].channel) + " (v" +
+                                  std::to_string(k + 1) + "): no range holds ±" +
+                                  num(c.range_v[k]) + " V (the board offers " + offered + " V)");
     }
     next[k].range = *best;
     next[k].r = table[*best];
-    next[k].softcal = info_.soft_calibrated ? board_->softcal(subdev_, next[k].channel, *best) : std::nullopt;
+    next[k].softcal =
+        info_.soft_calibrated ? board_->softcal(subdev_, next[k].channel, *best) : std::nullopt;
   }
 
   Command cmd;
@@ -116,7 +122,8 @@ void Driver::configure(const DaqConfig& c) {
   cmd.start_falling = address_.falling;
   cmd.scan_period_ns = static_cast<unsigned>(std::lround(period));
   cmd.scans = static_cast<unsigned>(c.record_length);
-  for (int k = 0; k < 2; ++k) cmd.chanlist.push_back({next[k].channel, next[k].range, address_.aref});
+  for (int k = 0; k < 2; ++k)
+    cmd.chanlist.push_back({next[k].channel, next[k].range, address_.aref});
   // comedi_command_test fixes arguments (3) and rounds timers (4): test
   // again until it accepts the command or refuses it outright.
   int ret = 0;
@@ -125,11 +132,15 @@ void Driver::configure(const DaqConfig& c) {
     if (ret != 3 && ret != 4) break;
   }
   if (ret != 0) {
-    static const char* stage[] = {"", "a trigger source is not supported", "the trigger sources do not go together",
-                                  "an argument is out of range", "the timer cannot be rounded",
+    static const char* stage[] = {"",
+                                  "a trigger source is not supported",
+                                  "the trigger sources do not go together",
+                                  "an argument is out of range",
+                                  "the timer cannot be rounded",
                                   "the channel list is not possible"};
-    std::string why = ret < 0 ? board_->error_text(board_->last_error())
-                              : ret <= 5 ? stage[ret] : "stage " + std::to_string(ret);
+    std::string why = ret < 0    ? board_->error_text(board_->last_error())
+                      : ret <= 5 ? stage[ret]
+                                 : "stage " + std::to_string(ret);
     throw InstrumentError(who() + ": comedi_command_test refused the acquisition (" +
                           (address_.external_trigger ? "start on PFI" + std::to_string(address_.pfi)
                                                      : std::string("software start")) +
@@ -137,8 +148,8 @@ void Driver::configure(const DaqConfig& c) {
                           std::to_string(cmd.scan_period_ns) + " ns): " + why);
   }
   if (cmd.scans != c.record_length)
-    throw InstrumentError(who() + ": the board would record " + std::to_string(cmd.scans) + " scans, not " +
-                          std::to_string(c.record_length));
+    throw InstrumentError(who() + ": the board would record " + std::to_string(cmd.scans) +
+                          " scans, not " + std::to_string(c.record_length));
   ch_[0] = next[0];
   ch_[1] = next[1];
   cmd_ = cmd;
@@ -160,11 +171,13 @@ void Driver::arm() {
 }
 
 double Driver::to_volts(const Channel& ch, std::uint32_t raw) const {
-  return ch.softcal ? board_->to_physical(raw, *ch.softcal) : board_->to_phys(raw, ch.r, ch.maxdata);
+  return ch.softcal ? board_->to_physical(raw, *ch.softcal)
+                    : board_->to_phys(raw, ch.r, ch.maxdata);
 }
 
 DaqRecord Driver::fetch(double timeout_s) {
-  if (!configured_ || !running_) throw std::logic_error(std::string(kWho) + "fetch: configure() and arm() first");
+  if (!configured_ || !running_)
+    throw std::logic_error(std::string(kWho) + "fetch: configure() and arm() first");
   const std::size_t scans = cmd_.scans, bytes_per_scan = 2 * info_.sample_bytes;
   std::vector<std::uint8_t> buf(scans * bytes_per_scan);
   std::size_t got = 0;
@@ -180,7 +193,8 @@ DaqRecord Driver::fetch(double timeout_s) {
   while (got < buf.size()) {
     const double left =
         std::chrono::duration<double>(deadline - std::chrono::steady_clock::now()).count();
-    const ReadResult r = board_->read(std::span<std::uint8_t>(buf.data() + got, buf.size() - got), std::max(0.0, left));
+    const ReadResult r = board_->read(std::span<std::uint8_t>(buf.data() + got, buf.size() - got),
+                                      std::max(0.0, left));
     using S = ReadResult::Status;
     if (r.status == S::Data) {
       got += r.bytes;
@@ -189,14 +203,17 @@ DaqRecord Driver::fetch(double timeout_s) {
     if (r.status == S::Timeout)
       fail("no samples for " + num(timeout_s) + " s after " + progress() +
            (got == 0 && address_.external_trigger
-                ? " (no trigger on PFI" + std::to_string(address_.pfi) + "? is the AWG's marker wired to it?)"
+                ? " (no trigger on PFI" + std::to_string(address_.pfi) +
+                      "? is the AWG's marker wired to it?)"
                 : ""));
     if (r.status == S::End) fail("the acquisition ended after " + progress());
     if (r.error == EPIPE)
       fail("buffer overrun after " + progress() +
-           " (EPIPE: the board's buffer overflowed before it was read; lower the rate or enlarge the "
+           " (EPIPE: the board's buffer overflowed before it was read; lower the rate or enlarge "
+           "the "
            "buffer with comedi_config --read-buffer)");
-    if (r.error == ENODEV) fail("device gone after " + progress() + " (ENODEV: unplugged or driver unloaded)");
+    if (r.error == ENODEV)
+      fail("device gone after " + progress() + " (ENODEV: unplugged or driver unloaded)");
     fail("read failed after " + progress() + ": " + board_->error_text(r.error));
   }
   // TRIG_COUNT: the command ended with the last scan, but the kernel keeps the
@@ -210,7 +227,8 @@ DaqRecord Driver::fetch(double timeout_s) {
   rec.v2.resize(scans);
   for (std::size_t i = 0; i < scans; ++i) {
     for (int k = 0; k < 2; ++k) {
-      const std::uint8_t* p = buf.data() + i * bytes_per_scan + static_cast<std::size_t>(k) * info_.sample_bytes;
+      const std::uint8_t* p =
+          buf.data() + i * bytes_per_scan + static_cast<std::size_t>(k) * info_.sample_bytes;
       std::uint32_t raw = 0;
       if (info_.sample_bytes == 2) {
         std::uint16_t s;

@@ -15,12 +15,14 @@ constexpr double kRanges[] = {50.0, 20.0, 10.0, 5.0, 2.0, 1.0, 0.5, 0.2};  // ni
 constexpr unsigned kNumRanges = sizeof kRanges / sizeof kRanges[0];
 }  // namespace
 
-SimComediBoard::SimComediBoard(std::shared_ptr<SimBench> bench, std::string path, bool soft_calibrated)
+SimComediBoard::SimComediBoard(std::shared_ptr<SimBench> bench, std::string path,
+                               bool soft_calibrated)
     : bench_(std::move(bench)), path_(std::move(path)), soft_calibrated_(soft_calibrated) {
   if (!bench_) throw std::invalid_argument("SimComediBoard: null bench");
   if (bench_->imperfections().adc_bits != static_cast<int>(kBits))
-    throw std::invalid_argument("SimComediBoard: the simulated PCI-6110 digitises with 12 bits; the bench has " +
-                                std::to_string(bench_->imperfections().adc_bits));
+    throw std::invalid_argument(
+        "SimComediBoard: the simulated PCI-6110 digitises with 12 bits; the bench has " +
+        std::to_string(bench_->imperfections().adc_bits));
 }
 
 comedi::SubdeviceInfo SimComediBoard::subdevice(unsigned subdev) {
@@ -44,8 +46,10 @@ std::uint32_t SimComediBoard::maxdata(unsigned subdev, unsigned channel) {
   return subdev == 0 && channel < kChannels ? kMaxData : 0;
 }
 
-std::optional<comedi::Polynomial> SimComediBoard::softcal(unsigned subdev, unsigned channel, unsigned range) {
-  if (!soft_calibrated_ || subdev != 0 || channel >= kChannels || range >= kNumRanges) return std::nullopt;
+std::optional<comedi::Polynomial> SimComediBoard::softcal(unsigned subdev, unsigned channel,
+                                                          unsigned range) {
+  if (!soft_calibrated_ || subdev != 0 || channel >= kChannels || range >= kNumRanges)
+    return std::nullopt;
   const double half = static_cast<double>(kMaxData + 1) / 2.0;  // 2048: code 0
   return comedi::Polynomial{{0.0, kRanges[range] / half}, half};
 }
@@ -66,7 +70,8 @@ int SimComediBoard::command_test(comedi::Command& c) {
     c.scan_period_ns = kMinScanNs;
     ret = std::max(ret, 3);
   }
-  const unsigned rounded = (c.scan_period_ns + kTimebaseNs / 2) / kTimebaseNs * kTimebaseNs;  // TRIG_ROUND_NEAREST
+  const unsigned rounded =
+      (c.scan_period_ns + kTimebaseNs / 2) / kTimebaseNs * kTimebaseNs;  // TRIG_ROUND_NEAREST
   if (ret == 0 && rounded != c.scan_period_ns) {
     c.scan_period_ns = rounded;
     ret = 4;
@@ -75,7 +80,8 @@ int SimComediBoard::command_test(comedi::Command& c) {
   if (ret != 0) return ret;
   if (c.chanlist.empty() || c.chanlist.size() > kChannels) return 5;
   for (const auto& ch : c.chanlist)
-    if (ch.channel >= kChannels || ch.range >= kNumRanges || ch.aref != comedi::Aref::Diff) return 5;
+    if (ch.channel >= kChannels || ch.range >= kNumRanges || ch.aref != comedi::Aref::Diff)
+      return 5;
   return 0;
 }
 
@@ -94,7 +100,8 @@ int SimComediBoard::command(const comedi::Command& c) {
   d.sample_rate_hz = 1e9 / static_cast<double>(c.scan_period_ns);
   d.points = c.scans;
   d.position_s = 0.0;  // the record starts at the trigger
-  for (int k = 0; k < 2; ++k) d.full_scale_v[k] = 2.0 * kRanges[c.chanlist[static_cast<std::size_t>(k)].range];
+  for (int k = 0; k < 2; ++k)
+    d.full_scale_v[k] = 2.0 * kRanges[c.chanlist[static_cast<std::size_t>(k)].range];
   d.aux_trigger = true;
   d.armed = true;
   d.done = false;
@@ -136,7 +143,8 @@ comedi::ReadResult SimComediBoard::read(std::span<std::uint8_t> buf, double) {
   using K = FaultPlan::Kind;
   if (fault_here && f.kind == K::ComediNoData) return {S::Timeout, 0, 0};
   const std::size_t third = stream_.size() / 3 / 4 * 4;  // whole scans
-  if (fault_here && (f.kind == K::ComediOverrun || f.kind == K::ComediDeviceGone) && read_pos_ >= third) {
+  if (fault_here && (f.kind == K::ComediOverrun || f.kind == K::ComediDeviceGone) &&
+      read_pos_ >= third) {
     running_ = false;
     if (f.kind == K::ComediDeviceGone) gone_ = true;
     return {S::Error, 0, f.kind == K::ComediOverrun ? EPIPE : ENODEV};

@@ -39,7 +39,8 @@ class SimComediBoard : public comedi::Board {
   comedi::SubdeviceInfo subdevice(unsigned subdev) override;
   std::vector<comedi::Range> ranges(unsigned subdev, unsigned channel) override;
   std::uint32_t maxdata(unsigned subdev, unsigned channel) override;
-  std::optional<comedi::Polynomial> softcal(unsigned subdev, unsigned channel, unsigned range) override;
+  std::optional<comedi::Polynomial> softcal(unsigned subdev, unsigned channel,
+                                            unsigned range) override;
   int command_test(comedi::Command& c) override;
   int command(const comedi::Command& c) override;
   comedi::ReadResult read(std::span<std::uint8_t> buf, double timeout_s) override;

@@ -22,8 +22,9 @@ namespace {
 constexpr double kR1 = 3140.0, kC = 2.1e-9;
 
 fs::path tmp_dir() {
-  auto d = fs::temp_directory_path() / ("piezobench-runner-comedi-" + std::to_string(::getpid()) + "-" +
-                                        ::testing::UnitTest::GetInstance()->current_test_info()->name());
+  auto d =
+      fs::temp_directory_path() / ("piezobench-runner-comedi-" + std::to_string(::getpid()) + "-" +
+                                   ::testing::UnitTest::GetInstance()->current_test_info()->name());
   fs::remove_all(d);
   fs::create_directories(d);
   return d;
@@ -34,7 +35,8 @@ std::shared_ptr<drivers::sim::SimBench> bench12(std::uint64_t seed, FaultPlan fa
   drivers::sim::DaqImperfections imp;
   imp.noise_rel[0] = imp.noise_rel[1] = 0.03;
   imp.adc_bits = 12;
-  return std::make_shared<drivers::sim::SimBench>(std::make_unique<test::RcPhysics>(kR1, kC), imp, seed, faults);
+  return std::make_shared<drivers::sim::SimBench>(std::make_unique<test::RcPhysics>(kR1, kC), imp,
+                                                  seed, faults);
 }
 
 // A plan the 6110E follows exactly: no pretrigger (a Comedi command starts
@@ -69,10 +71,13 @@ TEST(ComediRunner, KeysightWithComediEqualsTheEmbeddedBenchSampleForSample) {
   auto dir = tmp_dir();
   auto local = acq::open_bench({"sim", std::nullopt}, bench12(42));
   acq::run_measurement(local, comedi_plan(3), dir / "local.h5");
-  auto bench = acq::open_bench({"sim", "comedi-sim:///dev/comedi0?trigger=pfi0&softcal=1"}, bench12(42));
-  EXPECT_NE(bench.description.find("COMEDI,pci-6110,/dev/comedi0,ni_pcimio"), std::string::npos) << bench.description;
+  auto bench =
+      acq::open_bench({"sim", "comedi-sim:///dev/comedi0?trigger=pfi0&softcal=1"}, bench12(42));
+  EXPECT_NE(bench.description.find("COMEDI,pci-6110,/dev/comedi0,ni_pcimio"), std::string::npos)
+      << bench.description;
   acq::run_measurement(bench, comedi_plan(3), dir / "comedi.h5");
-  expect_equal_shots(acq::read_capture(dir / "comedi.h5"), acq::read_capture(dir / "local.h5"), "keysight+comedi");
+  expect_equal_shots(acq::read_capture(dir / "comedi.h5"), acq::read_capture(dir / "local.h5"),
+                     "keysight+comedi");
 }
 
 // Tektronix AWG5000 + Comedi board. The AWG5014C plays at 10 MS/s or faster
@@ -86,7 +91,8 @@ TEST(ComediRunner, TektronixWithComediEqualsTheEmbeddedBenchSampleForSample) {
   auto dir = tmp_dir();
   auto plan = comedi_plan(3);
   plan.sample_rate_hz = 1e7;
-  auto bench = acq::open_bench({"sim?awg=tektronix", "comedi-sim:///dev/comedi0?softcal=1"}, bench12(42));
+  auto bench =
+      acq::open_bench({"sim?awg=tektronix", "comedi-sim:///dev/comedi0?softcal=1"}, bench12(42));
   EXPECT_NE(bench.description.find("TEKTRONIX,AWG5014C"), std::string::npos) << bench.description;
   acq::run_measurement(bench, plan, dir / "tek.h5");
   const auto cap = acq::read_capture(dir / "tek.h5");
@@ -95,7 +101,8 @@ TEST(ComediRunner, TektronixWithComediEqualsTheEmbeddedBenchSampleForSample) {
 
   auto local = acq::open_bench({"sim", std::nullopt}, bench12(42));
   drivers::ArbWaveform w;
-  w.samples = acq::synthesize(plan.excitation, plan.sample_rate_hz, plan.samples - plan.pretrigger_samples);
+  w.samples =
+      acq::synthesize(plan.excitation, plan.sample_rate_hz, plan.samples - plan.pretrigger_samples);
   w.sample_rate_hz = plan.sample_rate_hz;
   w.peak_v = plan.excitation.amplitude_v;
   local.awg->load(w);
@@ -123,15 +130,19 @@ TEST(ComediRunner, TheSimulatedBoardNeedsTheEmbeddedBench) {
   } catch (const std::exception& e) {
     // The AWG's connection fails first or the board is refused: either names the problem.
     const std::string m = e.what();
-    EXPECT_TRUE(m.find("127.0.0.1:1") != std::string::npos || m.find("embedded simulated bench") != std::string::npos)
+    EXPECT_TRUE(m.find("127.0.0.1:1") != std::string::npos ||
+                m.find("embedded simulated bench") != std::string::npos)
         << m;
   }
   EXPECT_THROW(acq::open_bench({"sim", "tcp://127.0.0.1:5026"}, bench12(1)), std::invalid_argument);
-  EXPECT_THROW(acq::open_bench({"sim", "comedi-sim:///dev/comedi0"}, [] {
-                 drivers::sim::DaqImperfections imp;  // 14 bits: not the 6110E's converter
-                 return std::make_shared<drivers::sim::SimBench>(std::make_unique<test::RcPhysics>(kR1, kC), imp, 1);
-               }()),
-               std::invalid_argument);
+  EXPECT_THROW(
+      acq::open_bench({"sim", "comedi-sim:///dev/comedi0"},
+                      [] {
+                        drivers::sim::DaqImperfections imp;  // 14 bits: not the 6110E's converter
+                        return std::make_shared<drivers::sim::SimBench>(
+                            std::make_unique<test::RcPhysics>(kR1, kC), imp, 1);
+                      }()),
+      std::invalid_argument);
 }
 
 struct ComediFaultCase {
@@ -145,7 +156,8 @@ class ComediRunnerFaults : public ::testing::TestWithParam<ComediFaultCase> {};
 TEST_P(ComediRunnerFaults, ClearMessageNamingTheShotEarlierShotsKept) {
   const auto& c = GetParam();
   auto dir = tmp_dir();
-  auto bench = acq::open_bench({"sim", "comedi-sim:///dev/comedi0"}, bench12(3, FaultPlan{c.kind, 2}));
+  auto bench =
+      acq::open_bench({"sim", "comedi-sim:///dev/comedi0"}, bench12(3, FaultPlan{c.kind, 2}));
   acq::RunnerOptions ro;
   ro.fetch_timeout_s = 0.2;
   try {
@@ -166,7 +178,10 @@ TEST_P(ComediRunnerFaults, ClearMessageNamingTheShotEarlierShotsKept) {
 
 INSTANTIATE_TEST_SUITE_P(
     All, ComediRunnerFaults,
-    ::testing::Values(ComediFaultCase{"overrun", FaultPlan::Kind::ComediOverrun, "buffer overrun after 1333 of 4000 scans"},
-                      ComediFaultCase{"no_data", FaultPlan::Kind::ComediNoData, "no samples for 0.2 s"},
-                      ComediFaultCase{"device_gone", FaultPlan::Kind::ComediDeviceGone, "device gone after 1333 of 4000 scans"}),
+    ::testing::Values(ComediFaultCase{"overrun", FaultPlan::Kind::ComediOverrun,
+                                      "buffer overrun after 1333 of 4000 scans"},
+                      ComediFaultCase{"no_data", FaultPlan::Kind::ComediNoData,
+                                      "no samples for 0.2 s"},
+                      ComediFaultCase{"device_gone", FaultPlan::Kind::ComediDeviceGone,
+                                      "device gone after 1333 of 4000 scans"}),
     [](const auto& info) { return std::string(info.param.name); });

@@ -24,7 +24,8 @@ TEST(CliInstruments, JsonListsEveryFamilyWithRolesAndTwins) {
     EXPECT_TRUE(by == "*IDN?" || by == "address") << f;
     EXPECT_EQ(f.contains("address_form"), by == "address") << f;
   }
-  EXPECT_EQ(keys, (std::set<std::string>{"keysight33500", "tektronix_awg", "infiniium", "redpitaya", "comedi"}));
+  EXPECT_EQ(keys, (std::set<std::string>{"keysight33500", "tektronix_awg", "infiniium", "redpitaya",
+                                         "comedi"}));
   for (const auto& f : j["families"])
     if (f["key"] == "redpitaya") {
       EXPECT_EQ(f["roles"], nlohmann::json::array({"awg", "daq"}));
@@ -33,5 +34,6 @@ TEST(CliInstruments, JsonListsEveryFamilyWithRolesAndTwins) {
   auto text = test::run_cli("instruments");
   ASSERT_EQ(text.exit_code, 0) << text.err;
   EXPECT_NE(text.out.find("comedi [daq]"), std::string::npos) << text.out;
-  EXPECT_NE(text.out.find("chosen by its address: comedi:///dev/comediN?"), std::string::npos) << text.out;
+  EXPECT_NE(text.out.find("chosen by its address: comedi:///dev/comediN?"), std::string::npos)
+      << text.out;
 }

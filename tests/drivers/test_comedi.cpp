@@ -30,7 +30,9 @@ using sim::FaultPlan;
 
 namespace {
 
-bool contains(const std::string& s, const std::string& part) { return s.find(part) != std::string::npos; }
+bool contains(const std::string& s, const std::string& part) {
+  return s.find(part) != std::string::npos;
+}
 
 constexpr double kR1 = 3140.0, kC = 2.1e-9;
 
@@ -42,7 +44,8 @@ std::shared_ptr<sim::SimBench> bench12(std::uint64_t seed, double noise, FaultPl
 }
 
 // The AWG (Keysight twin over the loopback) of a bench, loaded and on.
-std::unique_ptr<keysight33500::Driver> awg_on(const std::shared_ptr<sim::SimBench>& b, const ArbWaveform& w) {
+std::unique_ptr<keysight33500::Driver> awg_on(const std::shared_ptr<sim::SimBench>& b,
+                                              const ArbWaveform& w) {
   auto awg = std::make_unique<keysight33500::Driver>(
       std::make_unique<sim::LoopbackTransport>(std::make_shared<sim::SimAwg>(b), "sim://awg"));
   awg->load(w);
@@ -50,8 +53,9 @@ std::unique_ptr<keysight33500::Driver> awg_on(const std::shared_ptr<sim::SimBenc
   return awg;
 }
 
-std::unique_ptr<comedi::Driver> comedi_on(const std::shared_ptr<sim::SimBench>& b, const std::string& address,
-                                          bool softcal = false, sim::SimComediBoard** board = nullptr) {
+std::unique_ptr<comedi::Driver> comedi_on(const std::shared_ptr<sim::SimBench>& b,
+                                          const std::string& address, bool softcal = false,
+                                          sim::SimComediBoard** board = nullptr) {
   const auto a = comedi::parse_address(address);
   auto fake = std::make_unique<sim::SimComediBoard>(b, a.device, softcal);
   if (board) *board = fake.get();
@@ -81,7 +85,8 @@ TEST(ComediAddress, DefaultsAndOptions) {
   EXPECT_EQ(a.channels[1], 1u);
   EXPECT_EQ(a.to_string(), "comedi:///dev/comedi0?trigger=pfi0&aref=diff&channels=0,1");
 
-  a = comedi::parse_address("comedi-sim:///dev/comedi2?trigger=pfi7&edge=falling&aref=rse&channels=3,1");
+  a = comedi::parse_address(
+      "comedi-sim:///dev/comedi2?trigger=pfi7&edge=falling&aref=rse&channels=3,1");
   EXPECT_TRUE(a.simulated);
   EXPECT_EQ(a.device, "/dev/comedi2");
   EXPECT_EQ(a.pfi, 7u);
@@ -103,15 +108,17 @@ TEST(ComediAddress, MistakesAreNamed) {
     const char* text;
     const char* why;
   };
-  for (const Case& c : {Case{"comedi://dev/comedi0", "/dev/comediN"}, Case{"comedi:///dev/comedi", "/dev/comediN"},
-                        Case{"comedi:///dev/comediX", "device number"},
-                        Case{"comedi:///dev/comedi0?trigger=pfi", "PFI line"},
-                        Case{"comedi:///dev/comedi0?trigger=ext", "pfiN or software"},
-                        Case{"comedi:///dev/comedi0?aref=single", "diff, rse or nrse"},
-                        Case{"comedi:///dev/comedi0?channels=1", "C1,C2"},
-                        Case{"comedi:///dev/comedi0?channels=2,2", "two different"},
-                        Case{"comedi:///dev/comedi0?speed=1", "unknown option 'speed'"},
-                        Case{"comedi:///dev/comedi0?trigger", "needs a value"}, Case{"daq://x", "expected comedi"}}) {
+  for (const Case& c :
+       {Case{"comedi://dev/comedi0", "/dev/comediN"}, Case{"comedi:///dev/comedi", "/dev/comediN"},
+        Case{"comedi:///dev/comediX", "device number"},
+        Case{"comedi:///dev/comedi0?trigger=pfi", "PFI line"},
+        Case{"comedi:///dev/comedi0?trigger=ext", "pfiN or software"},
+        Case{"comedi:///dev/comedi0?aref=single", "diff, rse or nrse"},
+        Case{"comedi:///dev/comedi0?channels=1", "C1,C2"},
+        Case{"comedi:///dev/comedi0?channels=2,2", "two different"},
+        Case{"comedi:///dev/comedi0?speed=1", "unknown option 'speed'"},
+        Case{"comedi:///dev/comedi0?trigger", "needs a value"},
+        Case{"daq://x", "expected comedi"}}) {
     try {
       comedi::parse_address(c.text);
       ADD_FAILURE() << c.text << " was accepted";
@@ -146,7 +153,8 @@ TEST(ComediDriver, IdentityRangesAndTimerRounding) {
   EXPECT_EQ(r.pretrigger_samples, 0u);
   EXPECT_EQ(r.v1.size(), 500u);
   EXPECT_EQ(board->commands(), 1);
-  EXPECT_EQ(board->cancels(), 1);  // the finished command released (the kernel keeps it busy until then)
+  EXPECT_EQ(board->cancels(),
+            1);  // the finished command released (the kernel keeps it busy until then)
 }
 
 TEST(ComediDriver, WhatTheBoardCannotDoIsRefusedWithTheReason) {
@@ -168,7 +176,8 @@ TEST(ComediDriver, WhatTheBoardCannotDoIsRefusedWithTheReason) {
   auto c = plan(1e6, 100, 1.0);
   c.pretrigger_samples = 10;
   expect_refusal(c, "no samples before it", false);
-  expect_refusal(plan(1e6, 100, 60.0), "no range holds ±60 V (the board offers [-50, 50], [-20, 20]", false);
+  expect_refusal(plan(1e6, 100, 60.0),
+                 "no range holds ±60 V (the board offers [-50, 50], [-20, 20]", false);
   c = plan(1e6, 100, 1.0);
   c.coupling = Coupling::Ac;
   expect_refusal(c, "DC only", false);
@@ -194,7 +203,8 @@ TEST(ComediDriver, WhatTheBoardCannotDoIsRefusedWithTheReason) {
     EXPECT_TRUE(contains(e.what(), "a trigger source is not supported")) << e.what();
   }
   EXPECT_THROW(comedi_on(b, "comedi-sim:///dev/comedi0?channels=0,4"), InstrumentError);
-  EXPECT_THROW(comedi_on(bench12(1, 0.0), "comedi-sim:///dev/comedi0?trigger=pfi12")->configure(plan(1e6, 10, 1)),
+  EXPECT_THROW(comedi_on(bench12(1, 0.0), "comedi-sim:///dev/comedi0?trigger=pfi12")
+                   ->configure(plan(1e6, 10, 1)),
                InstrumentError);
 }
 
@@ -210,12 +220,14 @@ void expect_same_shots_as_infiniium(bool softcal) {
   auto ref_bench = bench12(29, 0.02), com_bench = bench12(29, 0.02);
   auto ref_awg = awg_on(ref_bench, w);
   auto com_awg = awg_on(com_bench, w);
-  infiniium::Driver ref_daq(std::make_unique<sim::LoopbackTransport>(std::make_shared<sim::SimDaq>(ref_bench), "sim://daq"));
+  infiniium::Driver ref_daq(std::make_unique<sim::LoopbackTransport>(
+      std::make_shared<sim::SimDaq>(ref_bench), "sim://daq"));
   auto com_daq = comedi_on(com_bench, "comedi-sim:///dev/comedi0?trigger=pfi0", softcal);
   for (int shot = 0; shot < 2; ++shot) {
     ref_daq.configure(plan(rate, n, range));
     com_daq->configure(plan(rate, n, range));
-    EXPECT_EQ(com_daq->conversion(0), softcal ? "softcal polynomial" : "comedi_to_phys over [-2, 2] V");
+    EXPECT_EQ(com_daq->conversion(0),
+              softcal ? "softcal polynomial" : "comedi_to_phys over [-2, 2] V");
     ref_daq.arm();
     ref_awg->trigger();
     com_daq->arm();
@@ -234,15 +246,20 @@ void expect_same_shots_as_infiniium(bool softcal) {
       }
       for (std::size_t i = 0; i < ref.size(); ++i) {
         const double code = std::round(ref[i] / (range / 2048.0));  // the Infiniium's 12-bit code
-        ASSERT_EQ(got[i], comedi::linear_to_phys(static_cast<std::uint32_t>(code + 2048.0), {-range, range}, 4095))
+        ASSERT_EQ(got[i], comedi::linear_to_phys(static_cast<std::uint32_t>(code + 2048.0),
+                                                 {-range, range}, 4095))
             << "shot " << shot << " v" << ch + 1 << " sample " << i;
       }
     }
   }
 }
 
-TEST(ComediDriver, SoftCalibratedShotsEqualTheInfiniiumPathSampleForSample) { expect_same_shots_as_infiniium(true); }
-TEST(ComediDriver, HardCalibratedShotsAreTheSameCodesThroughComediToPhys) { expect_same_shots_as_infiniium(false); }
+TEST(ComediDriver, SoftCalibratedShotsEqualTheInfiniiumPathSampleForSample) {
+  expect_same_shots_as_infiniium(true);
+}
+TEST(ComediDriver, HardCalibratedShotsAreTheSameCodesThroughComediToPhys) {
+  expect_same_shots_as_infiniium(false);
+}
 
 TEST(ComediDriver, ComedilibFormulas) {
   // lib/range.c: min + (max − min) · raw / maxdata; the ends are the range's ends.
@@ -301,7 +318,8 @@ TEST_P(ComediFaults, ClearMessageNamingTheDevice) {
 
 INSTANTIATE_TEST_SUITE_P(
     All, ComediFaults,
-    ::testing::Values(FaultCase{"overrun", FaultPlan::Kind::ComediOverrun, "buffer overrun after 666 of 2000 scans (EPIPE"},
+    ::testing::Values(FaultCase{"overrun", FaultPlan::Kind::ComediOverrun,
+                                "buffer overrun after 666 of 2000 scans (EPIPE"},
                       FaultCase{"no_data", FaultPlan::Kind::ComediNoData,
                                 "no samples for 0.2 s after 0 of 2000 scans (no trigger on PFI0?"},
                       FaultCase{"device_gone", FaultPlan::Kind::ComediDeviceGone,
@@ -329,9 +347,11 @@ TEST(ComediDriver, NoTriggerIsATimeoutNotAHang) {
 TEST(ComediKernel, ComediTestDriverStreamsThroughTheRealSeam) {
   struct stat st {};
   if (::stat("/dev/comedi0", &st) != 0)
-    GTEST_SKIP() << "not run: no /dev/comedi0 on this machine (the kernel's comedi_test driver is not loaded: "
-                    "modprobe comedi_test and comedi_config /dev/comedi0 comedi_test need root and a kernel "
-                    "with Comedi; containers have neither)";
+    GTEST_SKIP()
+        << "not run: no /dev/comedi0 on this machine (the kernel's comedi_test driver is not "
+           "loaded: "
+           "modprobe comedi_test and comedi_config /dev/comedi0 comedi_test need root and a kernel "
+           "with Comedi; containers have neither)";
   std::unique_ptr<comedi::Board> board;
   try {
     board = comedi::open_comedilib_board("/dev/comedi0");
@@ -339,8 +359,9 @@ TEST(ComediKernel, ComediTestDriverStreamsThroughTheRealSeam) {
     GTEST_SKIP() << "not run: /dev/comedi0 exists but cannot be opened: " << e.what();
   }
   if (board->driver_name() != "comedi_test")
-    GTEST_SKIP() << "not run: /dev/comedi0 is a '" << board->driver_name()
-                 << "' board, not the kernel's comedi_test driver (this test drives no real hardware)";
+    GTEST_SKIP()
+        << "not run: /dev/comedi0 is a '" << board->driver_name()
+        << "' board, not the kernel's comedi_test driver (this test drives no real hardware)";
   auto a = comedi::parse_address("comedi:///dev/comedi0?trigger=software&aref=rse");
   comedi::Driver daq(std::move(board), a);
   auto c = plan(1e5, 2000, 1.0);

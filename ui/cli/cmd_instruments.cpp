@@ -33,9 +33,11 @@ void register_instruments_command(CLI::App& app, Context& ctx) {
         std::string roles;
         for (const auto& r : f.roles) roles += (roles.empty() ? "" : "+") + r;
         std::cout << f.key << " [" << roles << "] " << f.description << "\n    chosen by "
-                  << (f.chosen_by == "address" ? "its address: " + f.address_form : f.chosen_by + " at any SCPI address")
+                  << (f.chosen_by == "address" ? "its address: " + f.address_form
+                                               : f.chosen_by + " at any SCPI address")
                   << "\n";
-        if (!f.simulated_twin.empty()) std::cout << "    simulated twin: " << f.simulated_twin << "\n";
+        if (!f.simulated_twin.empty())
+          std::cout << "    simulated twin: " << f.simulated_twin << "\n";
       }
     });
   });

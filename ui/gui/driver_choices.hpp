@@ -10,9 +10,9 @@ namespace piezo::gui {
 
 struct DriverChoice {
   std::string key;
-  std::string label;   // "comedi [daq]: DAQ boards through Comedi (...)"
-  std::string how;     // how it is chosen, and its address form
-  std::string twin;    // how to run it against its simulated twin ("" if none)
+  std::string label;  // "comedi [daq]: DAQ boards through Comedi (...)"
+  std::string how;    // how it is chosen, and its address form
+  std::string twin;   // how to run it against its simulated twin ("" if none)
   // What "Use" fills in: the AWG field (empty: unchanged) and the DAQ field
   // (empty: unchanged). *IDN?-chosen families take any address, so they fill
   // the simulated twin where one runs in process; board DAQs their address.
