@@ -19,7 +19,7 @@ struct InstrumentUri {
   std::uint16_t port = 0;  // Tcp
   std::uint16_t vid = 0, pid = 0;  // UsbTmc
   std::optional<std::string> serial;  // UsbTmc
-  std::string sim_awg = "keysight";  // Sim: the AWG twin's dialect (keysight | tektronix)
+  std::string sim_awg = "keysight";   // Sim: the AWG twin's dialect (keysight | tektronix)
 
   std::string to_string() const;
 };
@@ -28,6 +28,8 @@ struct InstrumentUri {
 InstrumentUri parse_instrument_uri(std::string_view text);
 
 // "sim" or "sim?...": the embedded simulated bench (not checked further).
-inline bool is_sim_address(std::string_view text) { return text == "sim" || text.starts_with("sim?"); }
+inline bool is_sim_address(std::string_view text) {
+  return text == "sim" || text.starts_with("sim?");
+}
 
 }  // namespace piezo::drivers

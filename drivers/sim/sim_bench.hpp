@@ -27,7 +27,12 @@ struct DaqImperfections {
 // The Comedi* kinds are the simulated Comedi board's (drivers/sim/sim_comedi_board.*).
 struct FaultPlan {
   enum class Kind {
-    None, CloseMidFetch, NoReplyToFetch, MalformedBlock, TruncatedBlock, ErrorOnConfigure,
+    None,
+    CloseMidFetch,
+    NoReplyToFetch,
+    MalformedBlock,
+    TruncatedBlock,
+    ErrorOnConfigure,
     ComediOverrun,     // read() fails with EPIPE a third of the way through the shot
     ComediNoData,      // the board never delivers the shot's samples (read times out)
     ComediDeviceGone,  // read() fails with ENODEV a third of the way through, and so does all after

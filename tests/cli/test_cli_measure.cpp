@@ -212,12 +212,15 @@ TEST(CliMeasure, UnknownDialectIsBadInput) {
 TEST(CliMeasure, ComediBoardOnTheEmbeddedBenchEqualsInProcess) {
   auto dir = tmp_dir() / "comedi";
   fs::create_directories(dir);
-  const std::string plan = " --adc-bits 12 --samples 20000 --pretrigger 0 --rate 5e6 --range 2 --shots 2 --noise 0.05 "
-                           "--seed 17 --effect parallel_capacitance=100e-12 --overwrite --out ";
-  auto com = test::run_cli("measure --json --instrument sim --daq 'comedi-sim:///dev/comedi0?trigger=pfi0&softcal=1'" +
-                           plan + (dir / "comedi.h5").string());
+  const std::string plan =
+      " --adc-bits 12 --samples 20000 --pretrigger 0 --rate 5e6 --range 2 --shots 2 --noise 0.05 "
+      "--seed 17 --effect parallel_capacitance=100e-12 --overwrite --out ";
+  auto com = test::run_cli(
+      "measure --json --instrument sim --daq 'comedi-sim:///dev/comedi0?trigger=pfi0&softcal=1'" +
+      plan + (dir / "comedi.h5").string());
   ASSERT_EQ(com.exit_code, 0) << com.err;
-  EXPECT_NE(nlohmann::json::parse(com.out)["bench"].get<std::string>().find("COMEDI,pci-6110"), std::string::npos)
+  EXPECT_NE(nlohmann::json::parse(com.out)["bench"].get<std::string>().find("COMEDI,pci-6110"),
+            std::string::npos)
       << com.out;
   auto local = test::run_cli("measure --instrument sim" + plan + (dir / "local.h5").string());
   ASSERT_EQ(local.exit_code, 0) << local.err;
@@ -251,10 +254,14 @@ TEST(CliMeasure, ComediBoardOnTheEmbeddedBenchEqualsInProcess) {
 TEST(CliMeasure, TektronixWithComediBoardAndItsRefusals) {
   auto dir = tmp_dir() / "tek-comedi";
   fs::create_directories(dir);
-  const std::string daq = " --daq 'comedi-sim:///dev/comedi0' --adc-bits 12 --overwrite --out " + (dir / "t.h5").string();
-  auto r = test::run_cli("measure --json --instrument 'sim?awg=tektronix' --samples 3000 --pretrigger 0 --shots 2" + daq);
+  const std::string daq = " --daq 'comedi-sim:///dev/comedi0' --adc-bits 12 --overwrite --out " +
+                          (dir / "t.h5").string();
+  auto r = test::run_cli(
+      "measure --json --instrument 'sim?awg=tektronix' --samples 3000 --pretrigger 0 --shots 2" +
+      daq);
   ASSERT_EQ(r.exit_code, 0) << r.err;
-  EXPECT_NE(nlohmann::json::parse(r.out)["bench"].get<std::string>().find("TEKTRONIX,AWG5014C"), std::string::npos)
+  EXPECT_NE(nlohmann::json::parse(r.out)["bench"].get<std::string>().find("TEKTRONIX,AWG5014C"),
+            std::string::npos)
       << r.out;
   auto cap = acq::read_capture(dir / "t.h5");
   ASSERT_EQ(cap.shots.size(), 2u);
@@ -262,14 +269,19 @@ TEST(CliMeasure, TektronixWithComediBoardAndItsRefusals) {
   EXPECT_EQ(cap.shots[0].samples(), 3000u);
   r = test::run_cli("measure --instrument 'sim?awg=tektronix' --samples 3000" + daq);
   EXPECT_NE(r.exit_code, 0);
-  EXPECT_NE(r.err.find("a Comedi command starts at its trigger: no samples before it (pretrigger 200; use 0)"),
-            std::string::npos)
+  EXPECT_NE(
+      r.err.find(
+          "a Comedi command starts at its trigger: no samples before it (pretrigger 200; use 0)"),
+      std::string::npos)
       << r.err;
-  r = test::run_cli("measure --instrument sim --daq 'comedi-sim:///dev/comedi0' --overwrite --pretrigger 0 --out " +
-                    (dir / "b.h5").string());  // a 14-bit bench is not the 6110E's
+  r = test::run_cli(
+      "measure --instrument sim --daq 'comedi-sim:///dev/comedi0' --overwrite --pretrigger 0 "
+      "--out " +
+      (dir / "b.h5").string());  // a 14-bit bench is not the 6110E's
   EXPECT_EQ(r.exit_code, 2);
   EXPECT_NE(r.err.find("12 bits"), std::string::npos) << r.err;
-  r = test::run_cli("measure --instrument 'sim?awg=rigol' --overwrite --out " + (dir / "c.h5").string());
+  r = test::run_cli("measure --instrument 'sim?awg=rigol' --overwrite --out " +
+                    (dir / "c.h5").string());
   EXPECT_EQ(r.exit_code, 2);
   EXPECT_NE(r.err.find("awg=keysight or awg=tektronix"), std::string::npos) << r.err;
 }

@@ -185,11 +185,13 @@ TEST(DriverChoices, OneEntryPerRegistryFamilyWithUsableAddresses) {
     EXPECT_FALSE(c.twin.empty()) << c.key;
     EXPECT_EQ(c.label.rfind(c.key + " [", 0), 0u) << c.label;
   }
-  EXPECT_EQ(keys, (std::vector<std::string>{"keysight33500", "tektronix_awg", "infiniium", "redpitaya", "comedi"}));
+  EXPECT_EQ(keys, (std::vector<std::string>{"keysight33500", "tektronix_awg", "infiniium",
+                                            "redpitaya", "comedi"}));
   EXPECT_EQ(choices[1].awg_address, "sim?awg=tektronix");
   EXPECT_EQ(piezo::drivers::parse_instrument_uri(choices[1].awg_address).sim_awg, "tektronix");
   EXPECT_EQ(choices[4].daq_address, "comedi:///dev/comedi0?trigger=pfi0&aref=diff&channels=0,1");
   EXPECT_TRUE(choices[4].awg_address.empty());  // a DAQ: the AWG field stays
   EXPECT_NE(choices[4].how.find("comedi:///dev/comediN?"), std::string::npos) << choices[4].how;
-  EXPECT_TRUE(choices[3].awg_address.empty() && choices[3].daq_address.empty());  // no in-process twin
+  EXPECT_TRUE(choices[3].awg_address.empty() &&
+              choices[3].daq_address.empty());  // no in-process twin
 }

@@ -14,12 +14,12 @@
 #include "acquisition/calibration_plan.hpp"
 #include "acquisition/runner.hpp"
 #include "acquisition/sim_setup.hpp"
+#include "drivers/instrument_uri.hpp"
 #include "drivers/sim/sim_awg.hpp"
 #include "drivers/sim/sim_daq.hpp"
 #include "drivers/sim/sim_redpitaya.hpp"
 #include "drivers/sim/sim_tektronix_awg.hpp"
 #include "drivers/sim/tcp_server.hpp"
-#include "drivers/instrument_uri.hpp"
 #include "ui/cli/cli_common.hpp"
 
 namespace piezo::cli {
@@ -95,12 +95,15 @@ void register_measure_commands(CLI::App& app, Context& ctx) {
     SimOptions sim;
   };
   auto a = std::make_shared<MeasureArgs>();
-  m->add_option("--instrument", a->instrument, "sim | sim?awg=tektronix | tcp://HOST:PORT | usbtmc://VID:PID[/SERIAL] (the AWG)")
+  m->add_option("--instrument", a->instrument,
+                "sim | sim?awg=tektronix | tcp://HOST:PORT | usbtmc://VID:PID[/SERIAL] (the AWG)")
       ->capture_default_str();
-  m->add_option("--daq", a->daq,
-                "DAQ address (default: the instrument itself if it has both roles, e.g. a Red Pitaya; "
-                "else tcp PORT+1 on the same host), or a board through Comedi: "
-                "comedi:///dev/comediN?trigger=pfi0&aref=diff&channels=0,1 (comedi-sim:// on the embedded bench)");
+  m->add_option(
+      "--daq", a->daq,
+      "DAQ address (default: the instrument itself if it has both roles, e.g. a Red Pitaya; "
+      "else tcp PORT+1 on the same host), or a board through Comedi: "
+      "comedi:///dev/comediN?trigger=pfi0&aref=diff&channels=0,1 (comedi-sim:// on the embedded "
+      "bench)");
   auto* plan_opt = m->add_option("--plan", a->plan_file, "TOML measurement plan");
   m->add_option("--excitation", a->excitation, "exp_decay | sine | chirp | noise")->capture_default_str();
   m->add_option("--amplitude", a->amplitude, "Peak drive (V)")->capture_default_str();

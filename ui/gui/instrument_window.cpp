@@ -50,7 +50,8 @@ void render_instrument_window(AppState& s) {
   auto& in = s.instrument;
   const bool busy = s.job.running() || in.state == InstrumentForm::State::Connecting;
   ImGui::TextWrapped(
-      "'sim' (the simulated bench; sim?awg=tektronix), tcp://HOST:PORT or usbtmc://VID:PID[/SERIAL]; "
+      "'sim' (the simulated bench; sim?awg=tektronix), tcp://HOST:PORT or "
+      "usbtmc://VID:PID[/SERIAL]; "
       "DAQ also comedi:///dev/comediN?... (comedi-sim:// on the simulated bench).");
   ImGui::BeginDisabled(busy);
   // A changed address is a different bench: what was read from the old one goes.
@@ -59,12 +60,14 @@ void render_instrument_window(AppState& s) {
   // The driver registry's families (`piezobench instruments`): what each is
   // and how it is chosen; "Use" fills in its in-process twin or its address.
   const auto choices = driver_choices();
-  if (in.driver_choice < 0 || in.driver_choice >= static_cast<int>(choices.size())) in.driver_choice = 0;
+  if (in.driver_choice < 0 || in.driver_choice >= static_cast<int>(choices.size()))
+    in.driver_choice = 0;
   if (!choices.empty()) {
     const auto& current = choices[static_cast<std::size_t>(in.driver_choice)];
     if (ImGui::BeginCombo("Driver", current.label.c_str())) {
       for (int i = 0; i < static_cast<int>(choices.size()); ++i)
-        if (ImGui::Selectable(choices[static_cast<std::size_t>(i)].label.c_str(), i == in.driver_choice))
+        if (ImGui::Selectable(choices[static_cast<std::size_t>(i)].label.c_str(),
+                              i == in.driver_choice))
           in.driver_choice = i;
       ImGui::EndCombo();
     }
@@ -73,8 +76,10 @@ void render_instrument_window(AppState& s) {
     if (!current.awg_address.empty() || !current.daq_address.empty()) {
       ImGui::SameLine();
       if (tracked_button(s, "Use")) {
-        if (!current.awg_address.empty()) std::snprintf(in.awg, sizeof in.awg, "%s", current.awg_address.c_str());
-        if (!current.daq_address.empty()) std::snprintf(in.daq, sizeof in.daq, "%s", current.daq_address.c_str());
+        if (!current.awg_address.empty())
+          std::snprintf(in.awg, sizeof in.awg, "%s", current.awg_address.c_str());
+        if (!current.daq_address.empty())
+          std::snprintf(in.daq, sizeof in.daq, "%s", current.daq_address.c_str());
         edited = true;
       }
     }
