@@ -10,9 +10,11 @@
 #include <thread>
 
 #include "acquisition/capture.hpp"
+#include "drivers/instrument_uri.hpp"
 #include "drivers/scpi_client.hpp"
 #include "drivers/transport.hpp"
 #include "ui/gui/app_state.hpp"
+#include "ui/gui/driver_choices.hpp"
 #include "ui/gui/error_advice.hpp"
 #include "ui/gui/palette.hpp"
 #include "ui/gui/residual_plot.hpp"
@@ -169,4 +171,27 @@ TEST(TaskQueue, RunsInOrderOffTheCallerAndAppliesOnDrain) {
   for (int i = 0; i < 5; ++i)
     EXPECT_EQ(s.log[static_cast<std::size_t>(i)], "applied " + std::to_string(i));
   EXPECT_EQ(s.log[5], "throws failed: disk full");
+}
+
+// The instrument window's driver combo (issue 20 item 4): one entry per
+// registry family, each saying how it is chosen; "Use" fills addresses the
+// bench opener accepts.
+TEST(DriverChoices, OneEntryPerRegistryFamilyWithUsableAddresses) {
+  const auto choices = piezo::gui::driver_choices();
+  std::vector<std::string> keys;
+  for (const auto& c : choices) {
+    keys.push_back(c.key);
+    EXPECT_FALSE(c.how.empty()) << c.key;
+    EXPECT_FALSE(c.twin.empty()) << c.key;
+    EXPECT_EQ(c.label.rfind(c.key + " [", 0), 0u) << c.label;
+  }
+  EXPECT_EQ(keys, (std::vector<std::string>{"keysight33500", "tektronix_awg", "infiniium",
+                                            "redpitaya", "comedi"}));
+  EXPECT_EQ(choices[1].awg_address, "sim?awg=tektronix");
+  EXPECT_EQ(piezo::drivers::parse_instrument_uri(choices[1].awg_address).sim_awg, "tektronix");
+  EXPECT_EQ(choices[4].daq_address, "comedi:///dev/comedi0?trigger=pfi0&aref=diff&channels=0,1");
+  EXPECT_TRUE(choices[4].awg_address.empty());  // a DAQ: the AWG field stays
+  EXPECT_NE(choices[4].how.find("comedi:///dev/comediN?"), std::string::npos) << choices[4].how;
+  EXPECT_TRUE(choices[3].awg_address.empty() &&
+              choices[3].daq_address.empty());  // no in-process twin
 }
