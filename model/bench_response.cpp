@@ -21,13 +21,14 @@ cd port_capacitance(const ModalPortModel& port, const EffectSet& fx, double omeg
   return port.c_clamped * (1.0 + port.eps_t_over_s * (phi - 1.0)) + port.c_residual;
 }
 
-cd tube_admittance(const ModalPortModel& port, const RayleighDamping& d, const EffectSet& fx, double omega) {
+cd tube_admittance(const ModalPortModel& port, const RayleighDamping& d, const EffectSet& fx, double omega,
+                   double elastic_loss) {
   cd q = port_capacitance(port, fx, omega);
   for (const auto& m : port.modes) {
     const double ck = d.alpha + d.beta * m.kappa + 2.0 * fx.mechanical_damping * m.omega;
     // p²/(ω_k² − ω² + jωc_k), the real-over-complex division written out
     // (std::complex's general division is a libgcc call, a tenth of a fit).
-    const double re = m.omega * m.omega - omega * omega, im = omega * ck;
+    const double re = m.omega * m.omega - omega * omega, im = omega * ck + elastic_loss * m.kappa;
     const double s = m.participation * m.participation / (re * re + im * im);
     q += cd(s * re, -s * im);
   }
