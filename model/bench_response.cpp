@@ -52,11 +52,11 @@ cd reported_impedance(cd y_tube, const EffectSet& fx, double r1_nominal_ohm, dou
 }
 
 std::vector<cd> bench_impedance(const ModalPortModel& port, const RayleighDamping& d, const EffectSet& fx,
-                                double r1_nominal_ohm, std::span<const double> f_hz) {
+                                double r1_nominal_ohm, std::span<const double> f_hz, double elastic_loss) {
   std::vector<cd> z(f_hz.size());
   for (std::size_t i = 0; i < f_hz.size(); ++i) {
     const double w = 2 * M_PI * f_hz[i];
-    z[i] = reported_impedance(tube_admittance(port, d, fx, w), fx, r1_nominal_ohm, w);
+    z[i] = reported_impedance(tube_admittance(port, d, fx, w, elastic_loss), fx, r1_nominal_ohm, w);
   }
   return z;
 }

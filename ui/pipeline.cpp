@@ -653,11 +653,11 @@ void output_error_gap_curves(const acq::Capture& cap, const acq::Shot& shot, con
     var.push_back(dd * (s2 * s2 * std::norm(1.0 / x2[k] + 1.0 / xi) + s1 * s1 * std::norm(1.0 / xi)));
   }
   if (f.size() < 2) return;
-  auto curve = [&](const update::TubeParams& p, double beta_s, const model::EffectSet& fx) {
+  auto curve = [&](const update::TubeParams& p, const update::OeLoss& loss, const model::EffectSet& fx) {
     model::ModalOptions mo = oo.modal;
     mo.end_mass_fraction = fx.mass_loading;
     const auto port = cm.solver->port_model(cm.cls.e_form(p), mo);
-    const auto z = model::bench_impedance(port, {0.0, beta_s}, fx, r1, f);
+    const auto z = model::bench_impedance(port, {0.0, loss.beta_s}, fx, r1, f, loss.eta);
     update::GapCurve c;
     for (std::size_t i = 0; i < f.size(); ++i) {
       const auto l = std::log(zm[i] / z[i]);
@@ -671,11 +671,11 @@ void output_error_gap_curves(const acq::Capture& cap, const acq::Shot& shot, con
     }
     return c;
   };
-  d.before = curve(r.updated, r.damping.beta, r.effect_set);
+  d.before = curve(r.updated, r.loss(), r.effect_set);
   d.after = d.before;
   if (!d.steps.empty())
     for (const auto& e : r.effects)  // the fit with the verdict's effect: its constants, β and effects
-      if (e.name == d.steps.front().name && std::isfinite(e.value)) d.after = curve(e.material, e.beta_s, e.effect_set);
+      if (e.name == d.steps.front().name && std::isfinite(e.value)) d.after = curve(e.material, e.loss(), e.effect_set);
 }
 
 void diagnose_stage(const PipelineRequest& req, const acq::Capture& cap, const CaptureModel& cm,

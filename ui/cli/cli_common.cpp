@@ -3,6 +3,7 @@
 #include <unistd.h>
 
 #include <iomanip>
+#include <map>
 #include <cstdio>
 #include <iostream>
 
@@ -64,6 +65,14 @@ void add_chain_tolerance_options(CLI::App* cmd, update::OeOptions& o) {
   cmd->add_option("--skew-sigma", o.skew_sigma_s, "Standard uncertainty of the channels' skew, s")
       ->check(CLI::Range(0.0, 1e-3))
       ->capture_default_str();
+  // Issue 19: the damping model of the output-error fit.
+  static const std::map<std::string, update::OeDamping> damping_models = {
+      {"rayleigh", update::OeDamping::rayleigh}, {"complex", update::OeDamping::complex_constants}};
+  cmd->add_option("--damping", o.damping,
+                  "Damping model of the output-error fit: rayleigh (C = beta K) or complex (cE(1 + j/Qm), "
+                  "Qm fitted with its sigma)")
+      ->transform(CLI::CheckedTransformer(damping_models, CLI::ignore_case))
+      ->default_str(o.damping == update::OeDamping::rayleigh ? "rayleigh" : "complex");
 }
 
 void add_json_flag(CLI::App* cmd, Context& ctx) {

@@ -115,8 +115,8 @@ void register_demo_command(CLI::App& app, Context& ctx) {
                       t, oe, os, oee, p.oe_status.c_str(), cm, cme, lm, lme);
         }
         if (res.output_error)
-          std::printf("  corr(nu12, d31) of the output-error fit: %+.3f; fitted Rayleigh beta %.4g s\n",
-                      res.output_error->corr_nu12_d31, res.output_error->damping.beta);
+          std::printf("  corr(nu12, d31) of the output-error fit: %+.3f; fitted %s\n",
+                      res.output_error->corr_nu12_d31, update::damping_summary(*res.output_error).c_str());
       }
       if (res.diagnosis) print_diagnosis(std::cout, *res.diagnosis);
       for (const auto& w : res.warnings) std::cout << "  warning: " << w << "\n";
