@@ -312,20 +312,34 @@ double kappa_ratio_near(const model::ModalPortModel* port, double f_hz) {
 
 // Rayleigh damping of the model curves from the damping ratios of the zeros of
 // Z(s) at the first two resonances (the short-circuit modes; eqs 168-169 with
-// the model's κ/ω² of those modes); the seed's β = 1e-7 s when that fails.
+// the model's κ/ω² of those modes). Where the two-parameter fit is not
+// physical (α < 0 in every normal run), the one-parameter damping the two
+// modes support with its sigma, and their measured Qm (update::damping_from_modes,
+// issue 19); the seed's β = 1e-7 s only when the resonances give no damping.
 model::RayleighDamping damping_from_features(const dsp::ImpedanceResult& z, PipelineResult& out,
                                              const model::ModalPortModel* port) {
   model::RayleighDamping d{0.0, 1e-7};
   const auto& r = z.features.resonances;
   if (r.size() < 2 || !std::isfinite(r[0].damping_ratio) || !std::isfinite(r[1].damping_ratio)) return d;
-  auto fit = update::rayleigh_from_damping(r[0].f_hz, r[0].damping_ratio, r[1].f_hz, r[1].damping_ratio,
-                                           kappa_ratio_near(port, r[0].f_hz),
-                                           kappa_ratio_near(port, r[1].f_hz));
+  const auto fit = update::damping_from_modes(r[0].f_hz, r[0].damping_ratio, r[1].f_hz, r[1].damping_ratio,
+                                              kappa_ratio_near(port, r[0].f_hz), kappa_ratio_near(port, r[1].f_hz));
   if (!fit.ok) {
-    out.warnings.push_back("Rayleigh damping from the resonances refused (" + fit.message +
-                           "); model curves use beta = 1e-7 s");
+    out.warnings.push_back("damping from the resonances unusable (" + fit.message + "); model curves use beta = 1e-7 s");
     return d;
   }
+  char buf[320];
+  if (fit.model == "rayleigh (alpha, beta)")
+    std::snprintf(buf, sizeof buf, "%s: alpha %.4g 1/s, beta %.4g s", fit.model.c_str(), fit.damping.alpha,
+                  fit.damping.beta);
+  else if (fit.damping.alpha == 0)
+    std::snprintf(buf, sizeof buf, "%s: beta %.4g +- %.2g s", fit.model.c_str(), fit.damping.beta, fit.beta_sigma);
+  else
+    std::snprintf(buf, sizeof buf, "%s: alpha %.4g +- %.2g 1/s", fit.model.c_str(), fit.damping.alpha,
+                  fit.alpha_sigma);
+  char qm[160];
+  std::snprintf(qm, sizeof qm, "; measured Qm %.4g at %.4g kHz, %.4g at %.4g kHz", fit.qm1, r[0].f_hz / 1e3, fit.qm2,
+                r[1].f_hz / 1e3);
+  out.damping_from_resonances = std::string(buf) + qm + (fit.note.empty() ? "" : " (" + fit.note + ")");
   return fit.damping;
 }
 

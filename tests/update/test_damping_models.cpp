@@ -164,10 +164,11 @@ const char* better(const Scored& r, const Scored& c, bool heldout) {
   return a <= b ? "Rayleigh" : "complex";
 }
 
+// '*' after a χ²: that fit did not converge (max iterations).
 void print_row(const std::string& name, const std::string& truth, const Scored& r, const Scored& c) {
-  std::printf("| %-8s | %-22s | %7.3f | %7.3f | %-8s | %8.3f | %8.3f | %-8s | %.3g +- %.2g | %.4g +- %.2g |\n",
-              name.c_str(), truth.c_str(), r.chi2, c.chi2, better(r, c, false), r.heldout, c.heldout,
-              better(r, c, true), r.loss, r.loss_sigma, c.loss, c.loss_sigma);
+  std::printf("| %-8s | %-22s | %7.3f%s | %7.3f%s | %-8s | %8.3f | %8.3f | %-8s | %.3g +- %.2g | %.4g +- %.2g |\n",
+              name.c_str(), truth.c_str(), r.chi2, r.ok ? "" : "*", c.chi2, c.ok ? "" : "*", better(r, c, false),
+              r.heldout, c.heldout, better(r, c, true), r.loss, r.loss_sigma, c.loss, c.loss_sigma);
 }
 
 void print_header() {
@@ -277,7 +278,7 @@ TEST_F(DampingModels, CorpusStudy) {
   const auto corpus = std::filesystem::path(PIEZO_SOURCE_DIR) / "../shared/corpus/refsim-v1";
   if (!std::filesystem::exists(corpus / "01" / "fit.h5")) GTEST_SKIP() << "no corpus at " << corpus;
   print_header();
-  int rayleigh_fit = 0, rayleigh_ho = 0, n = 0;
+  int rayleigh_fit = 0, rayleigh_ho = 0, n = 0, controls = 0;
   double mean[4] = {0, 0, 0, 0};
   for (int k = 1; k <= 20; ++k) {
     char c[8];
@@ -293,8 +294,18 @@ TEST_F(DampingModels, CorpusStudy) {
     const auto r = score(*cm.solver, cm.cls, cm.p0, fd, hd, update::OeDamping::rayleigh);
     const auto x = score(*cm.solver, cm.cls, cm.p0, fd, hd, update::OeDamping::complex_constants);
     print_row(c, effect, r, x);
-    EXPECT_TRUE(r.ok) << c;
-    EXPECT_TRUE(x.ok) << c;
+    EXPECT_TRUE(r.ok) << c;  // Rayleigh: an estimate from every capture (as test_output_error_corpus)
+    if (effect == "none") {
+      // The controls: Rayleigh truth and nothing else. Both fits converge and
+      // Rayleigh is not worse, in the fit and held out (the simulated study's
+      // Δχ² < 2). The cases with an effect are printed, not asserted: there an
+      // effect outside both models decides (complex constants do not converge
+      // on the two channel-gain cases, chi2/dof 150-330 for either model).
+      ++controls;
+      EXPECT_TRUE(x.ok) << c;
+      EXPECT_LT((r.chi2 - x.chi2) * r.dof, 2.0) << c;
+      EXPECT_LT((r.heldout - x.heldout) * r.heldout_dof, 2.0) << c;
+    }
     ++n;
     rayleigh_fit += r.chi2 <= x.chi2;
     rayleigh_ho += r.heldout <= x.heldout;
@@ -303,6 +314,7 @@ TEST_F(DampingModels, CorpusStudy) {
   std::printf("corpus: Rayleigh better in the fit %d/%d, held out %d/%d; mean chi2/dof fit R %.3f C %.3f, "
               "held out R %.3f C %.3f\n",
               rayleigh_fit, n, rayleigh_ho, n, mean[0], mean[1], mean[2], mean[3]);
+  EXPECT_EQ(controls, 6);
 }
 #endif
 

@@ -119,6 +119,8 @@ void register_demo_command(CLI::App& app, Context& ctx) {
                       res.output_error->corr_nu12_d31, update::damping_summary(*res.output_error).c_str());
       }
       if (res.diagnosis) print_diagnosis(std::cout, *res.diagnosis);
+      if (!res.damping_from_resonances.empty())
+        std::cout << "  damping from the resonances: " << res.damping_from_resonances << "\n";
       for (const auto& w : res.warnings) std::cout << "  warning: " << w << "\n";
       std::cout << "\n  capture: " << res.capture_path << " (inspect: piezobench capture info " << res.capture_path
                 << ")\n";
