@@ -251,6 +251,32 @@ TEST_F(DampingModels, EachTruthPrefersItsOwnModelOnOneTube) {
   run_tube("sim C1", tc, 0.02, 502, r, c);
   check(tc, r, c);
 }
+
+// The complex-constant fit on two threads gives the same answer to the last
+// bit as on one (as OutputErrorSimulated.TwoThreadsGiveTheSameAnswerAsOne for
+// Rayleigh), and reports the model, Qm and its sigma.
+TEST_F(DampingModels, ComplexFitIsTheSameOnOneAndTwoThreads) {
+  std::mt19937_64 rng(23);
+  Truth t{tube_k(rng), update::OeDamping::complex_constants, 0, 80};
+  const auto rec = simulate(solver, cls, t, Drive::exp_decay, 0.02, 77);
+  update::OeOptions o1, o2;
+  o1.damping = o2.damping = update::OeDamping::complex_constants;
+  o1.threads = 1;
+  o2.threads = 2;
+  const auto a = update::fit_output_error(solver, cls, nominal, data_of(rec), o1);
+  const auto b = update::fit_output_error(solver, cls, nominal, data_of(rec), o2);
+  ASSERT_TRUE(a.ok()) << a.message;
+  EXPECT_EQ(a.damping_model, update::OeDamping::complex_constants);
+  EXPECT_EQ(a.damping.beta, 0.0);
+  EXPECT_EQ(a.parameters.at(4).name, "qm_inverse");
+  EXPECT_DOUBLE_EQ(a.qm, 1.0 / a.eta);
+  EXPECT_GT(a.qm_sigma, 0.0);
+  EXPECT_EQ(a.eta, b.eta);
+  EXPECT_EQ(a.qm_sigma, b.qm_sigma);
+  EXPECT_EQ(a.chi2_per_dof, b.chi2_per_dof);
+  EXPECT_EQ(a.updated.y_e11, b.updated.y_e11);
+  EXPECT_EQ(a.updated.d31, b.updated.d31);
+}
 #else
 // make validate: four tubes of each truth (1-3 % noise), then the corpus.
 TEST_F(DampingModels, SimulatedStudy) {
