@@ -21,8 +21,8 @@ cd port_capacitance(const ModalPortModel& port, const EffectSet& fx, double omeg
   return port.c_clamped * (1.0 + port.eps_t_over_s * (phi - 1.0)) + port.c_residual;
 }
 
-cd tube_admittance(const ModalPortModel& port, const RayleighDamping& d, const EffectSet& fx, double omega,
-                   double elastic_loss) {
+cd tube_admittance(const ModalPortModel& port, const RayleighDamping& d, const EffectSet& fx,
+                   double omega, double elastic_loss) {
   cd q = port_capacitance(port, fx, omega);
   for (const auto& m : port.modes) {
     const double ck = d.alpha + d.beta * m.kappa + 2.0 * fx.mechanical_damping * m.omega;
@@ -51,8 +51,9 @@ cd reported_impedance(cd y_tube, const EffectSet& fx, double r1_nominal_ohm, dou
   return r1_nominal_ohm * hm / (1.0 - hm);
 }
 
-std::vector<cd> bench_impedance(const ModalPortModel& port, const RayleighDamping& d, const EffectSet& fx,
-                                double r1_nominal_ohm, std::span<const double> f_hz, double elastic_loss) {
+std::vector<cd> bench_impedance(const ModalPortModel& port, const RayleighDamping& d,
+                                const EffectSet& fx, double r1_nominal_ohm,
+                                std::span<const double> f_hz, double elastic_loss) {
   std::vector<cd> z(f_hz.size());
   for (std::size_t i = 0; i < f_hz.size(); ++i) {
     const double w = 2 * M_PI * f_hz[i];

@@ -49,8 +49,8 @@ std::complex<double> port_capacitance(const ModalPortModel& port, const EffectSe
 // dielectric loss inside the wall (ModalPortModel::charge_per_volt, (ω_k² −
 // κ_k)·tanδ per mode) is left out here, as the simulated bench
 // (acquisition/divider_state_space.cpp) leaves it out: on the default tube it
-// is (1 − κ_k/ω_k²)·tanδ = 4e-6 to 1.2e-4 of the strongly coupled modes' stiffness at tanδ 0.01 (1.1e-3
-// on the weakly coupled ones with 11 % electrical stiffness).
+// is (1 − κ_k/ω_k²)·tanδ = 4e-6 to 1.2e-4 of the strongly coupled modes' stiffness at tanδ 0.01
+// (1.1e-3 on the weakly coupled ones with 11 % electrical stiffness).
 std::complex<double> tube_admittance(const ModalPortModel& port, const RayleighDamping& d,
                                      const EffectSet& fx, double omega, double elastic_loss = 0.0);
 
@@ -65,8 +65,10 @@ std::complex<double> reported_impedance(std::complex<double> y_tube, const Effec
                                         double r1_nominal_ohm, double omega);
 
 // Both steps on a frequency grid (Hz).
-std::vector<std::complex<double>> bench_impedance(const ModalPortModel& port, const RayleighDamping& d,
-                                                  const EffectSet& fx, double r1_nominal_ohm,
-                                                  std::span<const double> f_hz, double elastic_loss = 0.0);
+std::vector<std::complex<double>> bench_impedance(const ModalPortModel& port,
+                                                  const RayleighDamping& d, const EffectSet& fx,
+                                                  double r1_nominal_ohm,
+                                                  std::span<const double> f_hz,
+                                                  double elastic_loss = 0.0);
 
 }  // namespace piezo::model

@@ -321,25 +321,29 @@ model::RayleighDamping damping_from_features(const dsp::ImpedanceResult& z, Pipe
   model::RayleighDamping d{0.0, 1e-7};
   const auto& r = z.features.resonances;
   if (r.size() < 2 || !std::isfinite(r[0].damping_ratio) || !std::isfinite(r[1].damping_ratio)) return d;
-  const auto fit = update::damping_from_modes(r[0].f_hz, r[0].damping_ratio, r[1].f_hz, r[1].damping_ratio,
-                                              kappa_ratio_near(port, r[0].f_hz), kappa_ratio_near(port, r[1].f_hz));
+  const auto fit = update::damping_from_modes(r[0].f_hz, r[0].damping_ratio, r[1].f_hz,
+                                              r[1].damping_ratio, kappa_ratio_near(port, r[0].f_hz),
+                                              kappa_ratio_near(port, r[1].f_hz));
   if (!fit.ok) {
-    out.warnings.push_back("damping from the resonances unusable (" + fit.message + "); model curves use beta = 1e-7 s");
+    out.warnings.push_back("damping from the resonances unusable (" + fit.message +
+                           "); model curves use beta = 1e-7 s");
     return d;
   }
   char buf[320];
   if (fit.model == "rayleigh (alpha, beta)")
-    std::snprintf(buf, sizeof buf, "%s: alpha %.4g 1/s, beta %.4g s", fit.model.c_str(), fit.damping.alpha,
-                  fit.damping.beta);
+    std::snprintf(buf, sizeof buf, "%s: alpha %.4g 1/s, beta %.4g s", fit.model.c_str(),
+                  fit.damping.alpha, fit.damping.beta);
   else if (fit.damping.alpha == 0)
-    std::snprintf(buf, sizeof buf, "%s: beta %.4g +- %.2g s", fit.model.c_str(), fit.damping.beta, fit.beta_sigma);
+    std::snprintf(buf, sizeof buf, "%s: beta %.4g +- %.2g s", fit.model.c_str(), fit.damping.beta,
+                  fit.beta_sigma);
   else
-    std::snprintf(buf, sizeof buf, "%s: alpha %.4g +- %.2g 1/s", fit.model.c_str(), fit.damping.alpha,
-                  fit.alpha_sigma);
+    std::snprintf(buf, sizeof buf, "%s: alpha %.4g +- %.2g 1/s", fit.model.c_str(),
+                  fit.damping.alpha, fit.alpha_sigma);
   char qm[160];
-  std::snprintf(qm, sizeof qm, "; measured Qm %.4g at %.4g kHz, %.4g at %.4g kHz", fit.qm1, r[0].f_hz / 1e3, fit.qm2,
-                r[1].f_hz / 1e3);
-  out.damping_from_resonances = std::string(buf) + qm + (fit.note.empty() ? "" : " (" + fit.note + ")");
+  std::snprintf(qm, sizeof qm, "; measured Qm %.4g at %.4g kHz, %.4g at %.4g kHz", fit.qm1,
+                r[0].f_hz / 1e3, fit.qm2, r[1].f_hz / 1e3);
+  out.damping_from_resonances =
+      std::string(buf) + qm + (fit.note.empty() ? "" : " (" + fit.note + ")");
   return fit.damping;
 }
 
@@ -667,7 +671,8 @@ void output_error_gap_curves(const acq::Capture& cap, const acq::Shot& shot, con
     var.push_back(dd * (s2 * s2 * std::norm(1.0 / x2[k] + 1.0 / xi) + s1 * s1 * std::norm(1.0 / xi)));
   }
   if (f.size() < 2) return;
-  auto curve = [&](const update::TubeParams& p, const update::OeLoss& loss, const model::EffectSet& fx) {
+  auto curve = [&](const update::TubeParams& p, const update::OeLoss& loss,
+                   const model::EffectSet& fx) {
     model::ModalOptions mo = oo.modal;
     mo.end_mass_fraction = fx.mass_loading;
     const auto port = cm.solver->port_model(cm.cls.e_form(p), mo);
@@ -689,7 +694,8 @@ void output_error_gap_curves(const acq::Capture& cap, const acq::Shot& shot, con
   d.after = d.before;
   if (!d.steps.empty())
     for (const auto& e : r.effects)  // the fit with the verdict's effect: its constants, β and effects
-      if (e.name == d.steps.front().name && std::isfinite(e.value)) d.after = curve(e.material, e.loss(), e.effect_set);
+      if (e.name == d.steps.front().name && std::isfinite(e.value))
+        d.after = curve(e.material, e.loss(), e.effect_set);
 }
 
 void diagnose_stage(const PipelineRequest& req, const acq::Capture& cap, const CaptureModel& cm,

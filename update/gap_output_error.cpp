@@ -268,13 +268,14 @@ GapDiagnosis gap_from_output_error(const OeResult& r, const std::string& fit_des
   ho.description = heldout.description;
   ho.min_shrink = heldout.min_shrink;
   ho.dominant_shrink = heldout.dominant_shrink;
-  ho.base = predict_output_error(solver, cls, r.updated, r.loss(), r.effect_set, heldout.data, r.band_hz, options,
-                                 r.covariance_rel);
+  ho.base = predict_output_error(solver, cls, r.updated, r.loss(), r.effect_set, heldout.data,
+                                 r.band_hz, options, r.covariance_rel);
   for (const auto& e : r.effects) {
     if (!e.significant && !(weak_candidate(e) && ho.base.chi2_per_dof > ho.base.chi2_limit)) continue;
     try {
-      ho.with.emplace_back(e.name, predict_output_error(solver, cls, e.material, e.loss(), e.effect_set,
-                                                         heldout.data, r.band_hz, options, e.covariance_rel, e.name));
+      ho.with.emplace_back(
+          e.name, predict_output_error(solver, cls, e.material, e.loss(), e.effect_set,
+                                       heldout.data, r.band_hz, options, e.covariance_rel, e.name));
     } catch (const std::exception& ex) {
       // not simulable with it (an end mass the FE model refuses, a value that
       // makes the divider singular): no held-out number for it

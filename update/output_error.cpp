@@ -50,8 +50,12 @@ struct Coordinates5 {
     return p;
   }
   double loss(const Eigen::VectorXd& x) const { return beta0 * std::exp(x[4]); }
-  double beta(const Eigen::VectorXd& x) const { return damping == OeDamping::rayleigh ? loss(x) : 0.0; }
-  double eta(const Eigen::VectorXd& x) const { return damping == OeDamping::complex_constants ? loss(x) : 0.0; }
+  double beta(const Eigen::VectorXd& x) const {
+    return damping == OeDamping::rayleigh ? loss(x) : 0.0;
+  }
+  double eta(const Eigen::VectorXd& x) const {
+    return damping == OeDamping::complex_constants ? loss(x) : 0.0;
+  }
 };
 
 // Shots averaged per (length, pretrigger) group; the largest group is used.
@@ -1000,7 +1004,8 @@ const char* damping_name(OeDamping d) {
 std::string damping_summary(const OeResult& r) {
   char buf[160];
   if (r.damping_model == OeDamping::complex_constants)
-    std::snprintf(buf, sizeof buf, "complex constants Qm %.4g +- %.2g (1/Qm on cE)", r.qm, r.qm_sigma);
+    std::snprintf(buf, sizeof buf, "complex constants Qm %.4g +- %.2g (1/Qm on cE)", r.qm,
+                  r.qm_sigma);
   else
     std::snprintf(buf, sizeof buf, "Rayleigh beta %.4g s", r.damping.beta);
   return buf;
@@ -1008,7 +1013,8 @@ std::string damping_summary(const OeResult& r) {
 
 std::optional<OeDamping> parse_damping(const std::string& s) {
   if (s == "rayleigh") return OeDamping::rayleigh;
-  if (s == "complex" || s == "complex constants" || s == "complex_constants") return OeDamping::complex_constants;
+  if (s == "complex" || s == "complex constants" || s == "complex_constants")
+    return OeDamping::complex_constants;
   return std::nullopt;
 }
 
@@ -1070,7 +1076,8 @@ OeResult fit_output_error(model::ModalSolver& solver, const MaterialClass& cls,
   out.gain_rel_sigma = opt.gain_rel_sigma;
   out.skew_sigma_s = opt.skew_sigma_s;
   const bool complex_loss = opt.damping == OeDamping::complex_constants;
-  if (complex_loss && !(opt.eta0 > 0 && std::isfinite(opt.eta0))) fail("eta0 (1/Qm to start from) must be > 0");
+  if (complex_loss && !(opt.eta0 > 0 && std::isfinite(opt.eta0)))
+    fail("eta0 (1/Qm to start from) must be > 0");
   Coordinates5 co{nominal, complex_loss ? opt.eta0 : opt.beta0_s, opt.damping};
   try {
     out.band_hz = opt.band_hz > 0 ? opt.band_hz
@@ -1691,13 +1698,15 @@ OePrediction predict_output_error(model::ModalSolver& solver, const MaterialClas
                                   double beta_s, const model::EffectSet& effects, const OeData& data,
                                   double band_hz, const OeOptions& opt, const Eigen::MatrixXd& covariance_rel,
                                   const std::string& effect) {
-  return predict_output_error(solver, cls, params, OeLoss{OeDamping::rayleigh, beta_s, 0.0}, effects, data, band_hz,
-                              opt, covariance_rel, effect);
+  return predict_output_error(solver, cls, params, OeLoss{OeDamping::rayleigh, beta_s, 0.0},
+                              effects, data, band_hz, opt, covariance_rel, effect);
 }
 
-OePrediction predict_output_error(model::ModalSolver& solver, const MaterialClass& cls, const TubeParams& params,
-                                  const OeLoss& loss, const model::EffectSet& effects, const OeData& data,
-                                  double band_hz, const OeOptions& opt, const Eigen::MatrixXd& covariance_rel,
+OePrediction predict_output_error(model::ModalSolver& solver, const MaterialClass& cls,
+                                  const TubeParams& params, const OeLoss& loss,
+                                  const model::EffectSet& effects, const OeData& data,
+                                  double band_hz, const OeOptions& opt,
+                                  const Eigen::MatrixXd& covariance_rel,
                                   const std::string& effect) {
   const double fs = data.sample_rate_hz;
   if (!(fs > 0) || !std::isfinite(fs)) fail("sample rate must be positive");
@@ -1705,7 +1714,8 @@ OePrediction predict_output_error(model::ModalSolver& solver, const MaterialClas
   if (!(band_hz > 0) || !(band_hz < fs / 4)) fail("band above a quarter of the held-out capture's sample rate");
   const Averaged rec = average(data);
   if (rec.v1.size() < 256) fail("too short: " + std::to_string(rec.v1.size()) + " samples (need 256)");
-  const Coordinates5 co{params, loss.model == OeDamping::complex_constants ? loss.eta : loss.beta_s, loss.model};
+  const Coordinates5 co{params, loss.model == OeDamping::complex_constants ? loss.eta : loss.beta_s,
+                        loss.model};
   Problem prob(solver, cls, co, rec, data, band_hz, opt.modal);
   const Eigen::VectorXd x = Eigen::VectorXd::Zero(kParams);
   const auto t = prob.transfer(x, effects);

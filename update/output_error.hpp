@@ -206,13 +206,14 @@ struct OeResult {
   UpdateStatus status = UpdateStatus::bad_input;
   std::string message;
   TubeParams original, updated;
-  model::RayleighDamping damping;           // fitted β (α = 0); β = 0 with complex constants
+  model::RayleighDamping damping;  // fitted β (α = 0); β = 0 with complex constants
   // The damping model fitted (OeOptions::damping) and, with complex
   // constants, the fitted loss as Qm = 1/η with its sigma (statistical and
   // type B as the other parameters'; NaN/inf with Rayleigh).
   OeDamping damping_model = OeDamping::rayleigh;
-  double eta = 0;                           // 1/Qm (complex constants)
-  double qm = std::numeric_limits<double>::infinity(), qm_sigma = std::numeric_limits<double>::quiet_NaN();
+  double eta = 0;  // 1/Qm (complex constants)
+  double qm = std::numeric_limits<double>::infinity(),
+         qm_sigma = std::numeric_limits<double>::quiet_NaN();
   OeLoss loss() const { return {damping_model, damping.beta, eta}; }
   // YE11, nu12, d31, epsT33_rel, then "beta" (Rayleigh) or "qm_inverse" (1/Qm, complex constants)
   std::vector<OeParameter> parameters;
@@ -305,8 +306,9 @@ OePrediction predict_output_error(model::ModalSolver& solver, const MaterialClas
                                   const std::string& effect = "");
 // The same with the fit's damping model (OeResult/OeEffect::loss()): a held-out
 // prediction must use the damping model that was fitted.
-OePrediction predict_output_error(model::ModalSolver& solver, const MaterialClass& cls, const TubeParams& params,
-                                  const OeLoss& loss, const model::EffectSet& effects, const OeData& data,
+OePrediction predict_output_error(model::ModalSolver& solver, const MaterialClass& cls,
+                                  const TubeParams& params, const OeLoss& loss,
+                                  const model::EffectSet& effects, const OeData& data,
                                   double band_hz, const OeOptions& options = {},
                                   const Eigen::MatrixXd& covariance_rel = {},
                                   const std::string& effect = "");

@@ -49,10 +49,11 @@ RayleighFit rayleigh_from_damping(double f1_hz, double zeta1, double f2_hz, doub
   return r;
 }
 
-ModeDamping damping_from_modes(double f1_hz, double zeta1, double f2_hz, double zeta2, double kappa_ratio1,
-                               double kappa_ratio2) {
+ModeDamping damping_from_modes(double f1_hz, double zeta1, double f2_hz, double zeta2,
+                               double kappa_ratio1, double kappa_ratio2) {
   ModeDamping out;
-  const RayleighFit two = rayleigh_from_damping(f1_hz, zeta1, f2_hz, zeta2, kappa_ratio1, kappa_ratio2);
+  const RayleighFit two =
+      rayleigh_from_damping(f1_hz, zeta1, f2_hz, zeta2, kappa_ratio1, kappa_ratio2);
   if (two.ok) {
     out.ok = true;
     out.damping = two.damping;
@@ -65,7 +66,8 @@ ModeDamping damping_from_modes(double f1_hz, double zeta1, double f2_hz, double 
     const double w1 = 2 * M_PI * f1_hz, w2 = 2 * M_PI * f2_hz;
     const double y[2] = {2 * zeta1 * w1, 2 * zeta2 * w2};
     const bool beta_only = two.damping.alpha < 0;
-    const double x[2] = {beta_only ? kappa_ratio1 * w1 * w1 : 1.0, beta_only ? kappa_ratio2 * w2 * w2 : 1.0};
+    const double x[2] = {beta_only ? kappa_ratio1 * w1 * w1 : 1.0,
+                         beta_only ? kappa_ratio2 * w2 * w2 : 1.0};
     const double sxx = x[0] * x[0] + x[1] * x[1];
     const double a = (x[0] * y[0] + x[1] * y[1]) / sxx;
     const double r0 = y[0] - a * x[0], r1 = y[1] - a * x[1];

@@ -40,10 +40,12 @@ ModalPortModel* ComplexLosses::port_ = nullptr;
 
 // Today's (before issue 19) modal treatment: ω_k² + jκ_k/Qm, C0·(1 − j tanδ),
 // no loss inside the wall.
-std::complex<double> old_charge_per_volt(const ModalPortModel& p, double w, const MaterialLosses& l) {
+std::complex<double> old_charge_per_volt(const ModalPortModel& p, double w,
+                                         const MaterialLosses& l) {
   using cd = std::complex<double>;
   cd q = p.c_clamped * cd(1.0, -l.tan_delta) + p.c_residual;
-  for (const auto& m : p.modes) q += m.participation * m.participation / cd(m.omega * m.omega - w * w, m.kappa / l.qm);
+  for (const auto& m : p.modes)
+    q += m.participation * m.participation / cd(m.omega * m.omega - w * w, m.kappa / l.qm);
   return q;
 }
 
@@ -61,21 +63,25 @@ TEST_F(ComplexLosses, ModalTreatmentMatchesTheDirectComplexSolve) {
   for (std::size_t i = 0; i < f.size(); ++i) {
     const double w = 2 * M_PI * f[i];
     const double en = std::abs(ym[i] / yd[i] - 1.0);
-    const double eo = std::abs(std::complex<double>(0, w) * old_charge_per_volt(*port_, w, l) / yd[i] - 1.0);
+    const double eo =
+        std::abs(std::complex<double>(0, w) * old_charge_per_volt(*port_, w, l) / yd[i] - 1.0);
     if (en > worst_new) worst_new = en, f_new = f[i];
     if (eo > worst_old) worst_old = eo, f_old = f[i];
   }
-  std::printf("Qm 80, tan 0.01, 1-150 kHz (%zu pts): max |Ym/Yd - 1| with the in-wall dielectric loss %.3e "
-              "(at %.0f Hz), without (before) %.3e (at %.0f Hz)\n",
-              f.size(), worst_new, f_new, worst_old, f_old);
+  std::printf(
+      "Qm 80, tan 0.01, 1-150 kHz (%zu pts): max |Ym/Yd - 1| with the in-wall dielectric loss %.3e "
+      "(at %.0f Hz), without (before) %.3e (at %.0f Hz)\n",
+      f.size(), worst_new, f_new, worst_old, f_old);
   // Everywhere, peaks included, within the modal model's lossless accuracy
   // away from the peaks (0.1 %, Harmonic.ModalMatchesDirectAwayFromPeaks),
   // and at least ten times closer than the treatment without the wall's loss.
   EXPECT_LT(worst_new, 1e-3);
   EXPECT_LT(worst_new, 0.1 * worst_old);
   for (const auto& m : port_->modes)
-    std::printf("  mode %.0f Hz kappa/w2 %.6f p2/w2 %.3e%s\n", m.omega / 2 / M_PI, m.kappa / (m.omega * m.omega),
-                m.participation * m.participation / (m.omega * m.omega), m.residual ? " (residual)" : "");
+    std::printf("  mode %.0f Hz kappa/w2 %.6f p2/w2 %.3e%s\n", m.omega / 2 / M_PI,
+                m.kappa / (m.omega * m.omega),
+                m.participation * m.participation / (m.omega * m.omega),
+                m.residual ? " (residual)" : "");
 }
 
 TEST_F(ComplexLosses, PerModeQmIsTheElasticLossTimesTheElasticEnergyShare) {
@@ -85,7 +91,8 @@ TEST_F(ComplexLosses, PerModeQmIsTheElasticLossTimesTheElasticEnergyShare) {
   // The strongly coupled modes of the band (p_k²/ω_k² above 1e-10 F).
   std::vector<const PortMode*> strong;
   for (const auto& m : port_->modes)
-    if (!m.residual && m.omega < 2 * M_PI * 150e3 && m.participation * m.participation / (m.omega * m.omega) > 1e-10)
+    if (!m.residual && m.omega < 2 * M_PI * 150e3 &&
+        m.participation * m.participation / (m.omega * m.omega) > 1e-10)
       strong.push_back(&m);
   ASSERT_EQ(strong.size(), 3u);
   DirectHarmonicSolver ds(*tm_);
@@ -115,10 +122,11 @@ TEST_F(ComplexLosses, PerModeQmIsTheElasticLossTimesTheElasticEnergyShare) {
         if (std::abs(mf.fs_hz.value / fk - 1) < 2.0 / qm) hit = &mf;
       ASSERT_NE(hit, nullptr) << "no mode found near " << fk << " Hz at Qm " << qm;
       const double qb = hit->qm_branch.value, qw = hit->qm_bandwidth.value;
-      std::printf("Qm %.0f: mode %.0f Hz (fs %.1f Hz): predicted %.3f, BVD branch %.3f (%+.3f %%), "
-                  "3-dB width %.3f (%+.3f %%)\n",
-                  qm, fk, hit->fs_hz.value, predicted, qb, 100 * (qb / predicted - 1), qw,
-                  100 * (qw / predicted - 1));
+      std::printf(
+          "Qm %.0f: mode %.0f Hz (fs %.1f Hz): predicted %.3f, BVD branch %.3f (%+.3f %%), "
+          "3-dB width %.3f (%+.3f %%)\n",
+          qm, fk, hit->fs_hz.value, predicted, qb, 100 * (qb / predicted - 1), qw,
+          100 * (qw / predicted - 1));
       EXPECT_LT(std::abs(qb / predicted - 1), 0.01) << fk << " Hz, Qm " << qm;
       // Where the share differs from 1 by more than the tolerance (the 55 kHz
       // mode, κ/ω² = 0.9885), the reading must side with the share.

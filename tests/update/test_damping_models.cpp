@@ -58,7 +58,8 @@ std::vector<double> drive(Drive d) {
 }
 
 // v2 of the divider from v1 per DFT bin on a 4× zero-padded record: T = 1/(1 + R1·Y).
-std::vector<double> divider_frequency_domain(const model::ModalPortModel& port, const model::MaterialLosses& l,
+std::vector<double> divider_frequency_domain(const model::ModalPortModel& port,
+                                             const model::MaterialLosses& l,
                                              const std::vector<double>& v1) {
   const std::size_t nfft = dsp::good_fft_size(4 * v1.size());
   dsp::RealFft fft(nfft);
@@ -85,8 +86,8 @@ struct Record {
   std::vector<double> v1, v2;
 };
 
-Record simulate(model::ModalSolver& solver, const update::MaterialClass& cls, const Truth& t, Drive d,
-                double noise_rel, std::uint64_t seed) {
+Record simulate(model::ModalSolver& solver, const update::MaterialClass& cls, const Truth& t,
+                Drive d, double noise_rel, std::uint64_t seed) {
   Record r;
   r.v1 = drive(d);
   model::ModalOptions mo;
@@ -126,13 +127,13 @@ update::OeData data_of(const Record& r) {
 struct Scored {
   double chi2 = NAN, dof = 0, heldout = NAN, heldout_dof = 0;
   double loss = NAN, loss_sigma = NAN;  // β (s) or Qm
-  double loss_sigma_stat = NAN;          // its statistical part (noise, Birge-widened)
+  double loss_sigma_stat = NAN;         // its statistical part (noise, Birge-widened)
   bool ok = false;
 };
 
-Scored score(model::ModalSolver& solver, const update::MaterialClass& cls, const update::TubeParams& nominal,
-             const update::OeData& fit_data, const update::OeData& heldout, update::OeDamping dm,
-             update::OeOptions opt = {}) {
+Scored score(model::ModalSolver& solver, const update::MaterialClass& cls,
+             const update::TubeParams& nominal, const update::OeData& fit_data,
+             const update::OeData& heldout, update::OeDamping dm, update::OeOptions opt = {}) {
   opt.damping = dm;
   const auto r = update::fit_output_error(solver, cls, nominal, fit_data, opt);
   Scored s;
@@ -142,19 +143,22 @@ Scored score(model::ModalSolver& solver, const update::MaterialClass& cls, const
   if (dm == update::OeDamping::complex_constants) {
     s.loss = r.qm;
     s.loss_sigma = r.qm_sigma;
-    if (r.parameters.size() > 4) s.loss_sigma_stat = r.qm * r.parameters[4].sigma_statistical / r.eta;
+    if (r.parameters.size() > 4)
+      s.loss_sigma_stat = r.qm * r.parameters[4].sigma_statistical / r.eta;
   } else {
     s.loss = r.damping.beta;
     s.loss_sigma = r.parameters.size() > 4 ? r.parameters[4].sigma : NAN;
   }
-  const auto p = update::predict_output_error(solver, cls, r.updated, r.loss(), r.effect_set, heldout, r.band_hz, opt,
-                                              r.covariance_rel);
+  const auto p = update::predict_output_error(solver, cls, r.updated, r.loss(), r.effect_set,
+                                              heldout, r.band_hz, opt, r.covariance_rel);
   s.heldout = p.chi2_per_dof;
   if (std::getenv("PIEZO_DEBUG_DAMPING") && r.parameters.size() > 4)
-    std::printf("    [%s] %s %.4g sigma %.3g (statistical %.3g), chi2/dof %.3f, iterations %d, status %s %s\n",
-                update::damping_name(dm), r.parameters[4].name.c_str(), r.parameters[4].value, r.parameters[4].sigma,
-                r.parameters[4].sigma_statistical, r.chi2_per_dof, r.iterations, r.parameters[4].status.c_str(),
-                r.parameters[4].note.c_str());
+    std::printf(
+        "    [%s] %s %.4g sigma %.3g (statistical %.3g), chi2/dof %.3f, iterations %d, status %s "
+        "%s\n",
+        update::damping_name(dm), r.parameters[4].name.c_str(), r.parameters[4].value,
+        r.parameters[4].sigma, r.parameters[4].sigma_statistical, r.chi2_per_dof, r.iterations,
+        r.parameters[4].status.c_str(), r.parameters[4].note.c_str());
   s.heldout_dof = p.dof;
   return s;
 }
@@ -165,15 +169,21 @@ const char* better(const Scored& r, const Scored& c, bool heldout) {
 }
 
 // '*' after a χ²: that fit did not converge (max iterations).
-void print_row(const std::string& name, const std::string& truth, const Scored& r, const Scored& c) {
-  std::printf("| %-8s | %-22s | %7.3f%s | %7.3f%s | %-8s | %8.3f | %8.3f | %-8s | %.3g +- %.2g | %.4g +- %.2g |\n",
-              name.c_str(), truth.c_str(), r.chi2, r.ok ? "" : "*", c.chi2, c.ok ? "" : "*", better(r, c, false),
-              r.heldout, c.heldout, better(r, c, true), r.loss, r.loss_sigma, c.loss, c.loss_sigma);
+void print_row(const std::string& name, const std::string& truth, const Scored& r,
+               const Scored& c) {
+  std::printf(
+      "| %-8s | %-22s | %7.3f%s | %7.3f%s | %-8s | %8.3f | %8.3f | %-8s | %.3g +- %.2g | %.4g +- "
+      "%.2g |\n",
+      name.c_str(), truth.c_str(), r.chi2, r.ok ? "" : "*", c.chi2, c.ok ? "" : "*",
+      better(r, c, false), r.heldout, c.heldout, better(r, c, true), r.loss, r.loss_sigma, c.loss,
+      c.loss_sigma);
 }
 
 void print_header() {
-  std::printf("| capture  | truth                  | fit chi2/dof R | fit chi2/dof C | better | held-out R | "
-              "held-out C | better | beta (s) | Qm |\n");
+  std::printf(
+      "| capture  | truth                  | fit chi2/dof R | fit chi2/dof C | better | held-out R "
+      "| "
+      "held-out C | better | beta (s) | Qm |\n");
 }
 
 class DampingModels : public ::testing::Test {
@@ -181,10 +191,12 @@ class DampingModels : public ::testing::Test {
   model::TubeModel tube{model::TubeGeometry{}};
   model::ModalSolver solver{tube};
   update::MaterialClass cls = update::MaterialClass::isotropic();
-  update::TubeParams nominal = model::isotropic_params(model::resolve_material({"apc850", true, ""}).d);
+  update::TubeParams nominal =
+      model::isotropic_params(model::resolve_material({"apc850", true, ""}).d);
 
   // One simulated tube: the fit (exp-decay drive) and the held-out chirp.
-  void run_tube(const std::string& name, const Truth& t, double noise, std::uint64_t seed, Scored& r, Scored& c) {
+  void run_tube(const std::string& name, const Truth& t, double noise, std::uint64_t seed,
+                Scored& r, Scored& c) {
     const auto fit_rec = simulate(solver, cls, t, Drive::exp_decay, noise, seed);
     const auto ho_rec = simulate(solver, cls, t, Drive::chirp, noise, seed + 7919);
     const auto fd = data_of(fit_rec), hd = data_of(ho_rec);
@@ -208,13 +220,14 @@ class DampingModels : public ::testing::Test {
     // difference is 4; 2 is a one-parameter likelihood-ratio's 84 %).
     // "Better": by more than the significance the estimator uses for an extra
     // parameter (OeOptions::effect_significance, 25 = five sigma).
-    const double dchi2_fit = (r.chi2 - c.chi2) * r.dof;              // > 0: complex better
+    const double dchi2_fit = (r.chi2 - c.chi2) * r.dof;               // > 0: complex better
     const double dchi2_ho = (r.heldout - c.heldout) * r.heldout_dof;  // same on the held-out chirp
     if (t.model == update::OeDamping::rayleigh) {
       EXPECT_LT(dchi2_fit, 2.0) << "Rayleigh truth: complex constants fit better";
       EXPECT_LT(dchi2_ho, 2.0) << "Rayleigh truth: complex constants predict better";
     } else {
-      EXPECT_GT(dchi2_fit, 25.0) << "complex truth: complex constants not clearly better in the fit";
+      EXPECT_GT(dchi2_fit, 25.0)
+          << "complex truth: complex constants not clearly better in the fit";
       EXPECT_GT(dchi2_ho, 25.0) << "complex truth: complex constants not clearly better held out";
       // The measured loss: Qm within 3 of its sigmas — the statistical one,
       // as the simulation has no chain errors (the reported sigma adds the
@@ -222,8 +235,10 @@ class DampingModels : public ::testing::Test {
       // 0.5 % channel-gain tolerance alone moves ln(1/Qm) by ~0.5).
       EXPECT_LE(std::abs(c.loss - t.qm), 3.0 * c.loss_sigma_stat)
           << "Qm " << c.loss << " +- " << c.loss_sigma_stat << " (statistical)";
-      std::printf("    Qm %.4g +- %.2g (statistical; %.2g with the chain's type B) against truth %.4g: %+.2f sigma\n",
-                  c.loss, c.loss_sigma_stat, c.loss_sigma, t.qm, (c.loss - t.qm) / c.loss_sigma_stat);
+      std::printf(
+          "    Qm %.4g +- %.2g (statistical; %.2g with the chain's type B) against truth %.4g: "
+          "%+.2f sigma\n",
+          c.loss, c.loss_sigma_stat, c.loss_sigma, t.qm, (c.loss - t.qm) / c.loss_sigma_stat);
     }
   }
 
@@ -286,15 +301,16 @@ TEST_F(DampingModels, SimulatedStudy) {
   print_header();
   double sum[4] = {0, 0, 0, 0};
   for (int k = 0; k < 8; ++k) {
-    Truth t{tube_k(rng), k < 4 ? update::OeDamping::rayleigh : update::OeDamping::complex_constants, 0, 0};
+    Truth t{tube_k(rng), k < 4 ? update::OeDamping::rayleigh : update::OeDamping::complex_constants,
+            0, 0};
     const double nr = noise(rng);
     if (t.model == update::OeDamping::rayleigh)
       t.beta = std::exp(lbeta(rng));
     else
       t.qm = std::exp(lqm(rng));
     Scored r, c;
-    run_tube((k < 4 ? "sim R" : "sim C") + std::to_string(k % 4 + 1), t, nr, 600 + static_cast<std::uint64_t>(k), r,
-             c);
+    run_tube((k < 4 ? "sim R" : "sim C") + std::to_string(k % 4 + 1), t, nr,
+             600 + static_cast<std::uint64_t>(k), r, c);
     check(t, r, c);
     sum[0] += r.chi2, sum[1] += c.chi2, sum[2] += r.heldout, sum[3] += c.heldout;
   }
@@ -311,7 +327,8 @@ TEST_F(DampingModels, CorpusStudy) {
     std::snprintf(c, sizeof c, "%02d", k);
     std::ifstream is(corpus / c / "truth.json");
     const auto truth = nlohmann::json::parse(is);
-    const std::string effect = truth["effect"].is_null() ? "none" : truth["effect"]["name"].get<std::string>();
+    const std::string effect =
+        truth["effect"].is_null() ? "none" : truth["effect"]["name"].get<std::string>();
     const auto cap = acq::read_capture(corpus / c / "fit.h5");
     const auto ho_cap = acq::read_capture(corpus / c / "holdout.h5");
     const auto cm = ui::capture_model(cap, "apc850", true);
@@ -320,7 +337,8 @@ TEST_F(DampingModels, CorpusStudy) {
     const auto r = score(*cm.solver, cm.cls, cm.p0, fd, hd, update::OeDamping::rayleigh);
     const auto x = score(*cm.solver, cm.cls, cm.p0, fd, hd, update::OeDamping::complex_constants);
     print_row(c, effect, r, x);
-    EXPECT_TRUE(r.ok) << c;  // Rayleigh: an estimate from every capture (as test_output_error_corpus)
+    EXPECT_TRUE(r.ok)
+        << c;  // Rayleigh: an estimate from every capture (as test_output_error_corpus)
     if (effect == "none") {
       // The controls: Rayleigh truth and nothing else. Both fits converge and
       // Rayleigh is not worse, in the fit and held out (the simulated study's
@@ -335,11 +353,13 @@ TEST_F(DampingModels, CorpusStudy) {
     ++n;
     rayleigh_fit += r.chi2 <= x.chi2;
     rayleigh_ho += r.heldout <= x.heldout;
-    mean[0] += r.chi2 / 20, mean[1] += x.chi2 / 20, mean[2] += r.heldout / 20, mean[3] += x.heldout / 20;
+    mean[0] += r.chi2 / 20, mean[1] += x.chi2 / 20, mean[2] += r.heldout / 20,
+        mean[3] += x.heldout / 20;
   }
-  std::printf("corpus: Rayleigh better in the fit %d/%d, held out %d/%d; mean chi2/dof fit R %.3f C %.3f, "
-              "held out R %.3f C %.3f\n",
-              rayleigh_fit, n, rayleigh_ho, n, mean[0], mean[1], mean[2], mean[3]);
+  std::printf(
+      "corpus: Rayleigh better in the fit %d/%d, held out %d/%d; mean chi2/dof fit R %.3f C %.3f, "
+      "held out R %.3f C %.3f\n",
+      rayleigh_fit, n, rayleigh_ho, n, mean[0], mean[1], mean[2], mean[3]);
   EXPECT_EQ(controls, 6);
 }
 #endif

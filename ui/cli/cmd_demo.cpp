@@ -116,7 +116,8 @@ void register_demo_command(CLI::App& app, Context& ctx) {
         }
         if (res.output_error)
           std::printf("  corr(nu12, d31) of the output-error fit: %+.3f; fitted %s\n",
-                      res.output_error->corr_nu12_d31, update::damping_summary(*res.output_error).c_str());
+                      res.output_error->corr_nu12_d31,
+                      update::damping_summary(*res.output_error).c_str());
       }
       if (res.diagnosis) print_diagnosis(std::cout, *res.diagnosis);
       if (!res.damping_from_resonances.empty())

@@ -268,7 +268,9 @@ void run_update_features(Context& ctx, const UpdateArgs& a0, const std::string& 
     // The two-parameter fit where physical, else the one-parameter damping
     // the two modes support with its sigma (issue 19: no refusal).
     const auto fit = pu::damping_from_modes(fz[0].first, fz[0].second, fz[1].first, fz[1].second);
-    auto num = [](double x) { return std::isfinite(x) ? nlohmann::json(x) : nlohmann::json(nullptr); };
+    auto num = [](double x) {
+      return std::isfinite(x) ? nlohmann::json(x) : nlohmann::json(nullptr);
+    };
     out["rayleigh"] = {{"ok", fit.ok},
                        {"message", fit.ok ? fit.note : fit.message},
                        {"alpha", fit.damping.alpha},
