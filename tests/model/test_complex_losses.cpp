@@ -99,11 +99,11 @@ TEST_F(ComplexLosses, PerModeQmIsTheElasticLossTimesTheElasticEnergyShare) {
   for (double qm : {100.0, 300.0}) {
     MaterialLosses l;
     l.qm = qm;
-    // One grid over all of them: 40 points per half-power bandwidth, ±8 bandwidths.
+    // One grid over all of them: 25 points per half-power bandwidth, ±8 bandwidths.
     std::vector<double> f;
     for (const PortMode* m : strong) {
       const double fk = m->omega / (2 * M_PI), bw = fk / qm;
-      for (double x = fk - 8 * bw; x <= fk + 8 * bw; x += bw / 40)
+      for (double x = fk - 8 * bw; x <= fk + 8 * bw; x += bw / 25)
         if (f.empty() || x > f.back()) f.push_back(x);
     }
     const auto y = ds.admittance(iso_target(), f, {}, l);
