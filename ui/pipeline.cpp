@@ -797,6 +797,7 @@ PipelineResult run_pipeline(const PipelineRequest& req, const std::function<void
                   out.order, z->samples_used, out.shots_averaged, out.resonances_hz.size(), out.antiresonances_hz.size(),
                   z->features.capacitance_f);
     out.stages.push_back({"estimate", true, note});
+    out.mode_figures = capture_mode_figures(cap, *z);
   } catch (const std::exception& e) {
     out.stages.push_back({"estimate", false, std::string("failed: ") + e.what()});
     out.warnings.push_back(std::string("the impedance estimate failed (") + e.what() +

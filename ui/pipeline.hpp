@@ -14,6 +14,7 @@
 #include "acquisition/plan.hpp"
 #include "acquisition/sim_setup.hpp"
 #include "dsp/fixture_calibration.hpp"
+#include "ui/capture_mode_figures.hpp"
 #include "update/gap_diagnosis.hpp"
 #include "update/output_error.hpp"
 
@@ -111,6 +112,9 @@ struct PipelineResult {
   std::vector<Curve> curves;  // measured (Prony), FFT, cross-spectra, original model, updated model
   std::vector<double> resonances_hz, antiresonances_hz;
   std::vector<double> singular_values;  // normalised, for the order plot
+  // Per-mode figures (fs, fp, k_eff, Qm, BVD branch; C^T and tan δ at 1 kHz)
+  // of the Prony-SS estimate above, when it ran.
+  std::optional<CaptureModeFigures> mode_figures;
   int order = 0;
   std::vector<ParamRow> params;
   std::string update_method;  // "output-error" | "cmcm" | "lm": whose constants `updated` holds

@@ -1,4 +1,6 @@
 #include "ui/report_export.hpp"
+
+#include "ui/mode_figures_json.hpp"
 #include "ui/output_error_json.hpp"
 #include "ui/json_text.hpp"
 
@@ -76,6 +78,17 @@ nlohmann::json report_json(const PipelineResult& r) {
                     {"lead_resistance_ohm", o(f.lead_resistance_ohm)},
                     {"r1_error", o(f.r1_error)},
                     {"skew_s", o(f.skew_s)}};
+  }
+  if (r.mode_figures) {  // the per-mode figures of the Prony-SS estimate
+    const auto& m = *r.mode_figures;
+    if (m.error.empty()) {
+      j["modes"] = modes_json(m.figures);
+      j["mode_summary"] = mode_summary_json(m.figures, m.mean_diameter_m, m.mean_diameter_source);
+    } else {
+      j["modes"] = nlohmann::json::array();
+      j["mode_summary"] = {{"notes", {"no mode figures: " + m.error}}};
+    }
+    j["mode_summary"]["estimate"] = "Prony-SS (the pipeline's estimate, before any fixture correction)";
   }
   if (r.output_error) j["output_error"] = output_error_json(*r.output_error, r.output_error_excitation);
   if (r.diagnosis) j["diagnosis"] = diagnosis_json(*r.diagnosis);

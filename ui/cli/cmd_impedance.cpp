@@ -26,6 +26,7 @@
 #include "dsp/rayleigh.hpp"
 #include "dsp/stepped_sine.hpp"
 #include "ui/assessment_json.hpp"
+#include "ui/capture_mode_figures.hpp"
 #include "ui/cli/cli_common.hpp"
 #include "ui/json_text.hpp"
 #include "ui/mode_figures_json.hpp"
@@ -220,20 +221,14 @@ void print_text(const nlohmann::json& j) {
 // The figures of every mode on the estimate's grid, with the estimator's σ per point
 // when it has one; D_mean from the capture's geometry (or the project's default tube).
 void add_mode_figures(nlohmann::json& j, const dsp::ImpedanceResult& r, const acq::Capture& cap) {
-  const auto g = cap.setup.geometry();
-  const bool given = cap.setup.inner_diameter_m && cap.setup.outer_diameter_m;
-  dsp::ModeFigureOptions o;
-  o.mean_diameter_m = 0.5 * (g.inner_diameter_m + g.outer_diameter_m);
-  const Eigen::VectorXd sigma = r.z_sigma_ohm.size() == r.f_hz.size() ? r.z_sigma_ohm : Eigen::VectorXd();
-  try {
-    const auto m = dsp::mode_figures(r.f_hz, r.z_ohm, sigma, o);
-    j["modes"] = ui::modes_json(m);
-    j["mode_summary"] = ui::mode_summary_json(
-        m, o.mean_diameter_m, given ? "capture /setup" : "the project's default tube (not in the capture)");
-  } catch (const std::invalid_argument& e) {  // a grid too short for figures: the impedance stands
+  const auto m = ui::capture_mode_figures(cap, r);
+  if (!m.error.empty()) {
     j["modes"] = nlohmann::json::array();
-    j["mode_summary"] = {{"notes", {std::string("no mode figures: ") + e.what()}}};
+    j["mode_summary"] = {{"notes", {"no mode figures: " + m.error}}};
+    return;
   }
+  j["modes"] = ui::modes_json(m.figures);
+  j["mode_summary"] = ui::mode_summary_json(m.figures, m.mean_diameter_m, m.mean_diameter_source);
 }
 
 void run(const ImpedanceArgs& a, Context& ctx) {
