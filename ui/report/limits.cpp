@@ -55,13 +55,36 @@ std::vector<PathStep> parse_path(const std::string& path) {
     while (i < path.size() && path[i] == '[') {
       const std::size_t close = path.find(']', i);
       if (close == std::string::npos) bad("'[' without ']'");
-      const std::string num = path.substr(i + 1, close - i - 1);
-      if (num.empty() || !std::all_of(num.begin(), num.end(), [](char c) { return std::isdigit(static_cast<unsigned char>(c)); }))
-        bad("an index is a non-negative integer in brackets, e.g. modes[0]");
-      s.indices.push_back(std::stoul(num));
+      const std::string in = path.substr(i + 1, close - i - 1);
+      PathSelector sel;
+      const std::size_t eq = in.find('='), dots = in.find("..");
+      auto number = [&](const std::string& t) {
+        std::size_t used = 0;
+        double x = 0;
+        try {
+          x = std::stod(t, &used);
+        } catch (const std::exception&) {
+          used = 0;
+        }
+        if (t.empty() || used != t.size() || !std::isfinite(x)) bad("\"" + t + "\" is not a number in [" + in + "]");
+        return x;
+      };
+      if (eq != std::string::npos) {
+        sel.field = in.substr(0, eq);
+        if (sel.field.empty() || dots == std::string::npos || dots < eq)
+          bad("a selection is [field=lo..hi], e.g. modes[fs_hz=45e3..55e3]");
+        sel.lo = number(in.substr(eq + 1, dots - eq - 1));
+        sel.hi = number(in.substr(dots + 2));
+        if (sel.lo > sel.hi) bad("[" + in + "]: lo > hi");
+      } else {
+        if (in.empty() || !std::all_of(in.begin(), in.end(), [](char c) { return std::isdigit(static_cast<unsigned char>(c)); }))
+          bad("an index is a non-negative integer in brackets, e.g. modes[0], or a selection [field=lo..hi]");
+        sel.index = std::stoul(in);
+      }
+      s.selectors.push_back(std::move(sel));
       i = close + 1;
     }
-    if (s.key.empty() && (s.indices.empty() || !out.empty())) bad("empty key");
+    if (s.key.empty() && (s.selectors.empty() || !out.empty())) bad("empty key");
     out.push_back(std::move(s));
     if (i == path.size()) break;
     if (path[i] != '.') bad(std::string("expected '.' or '[' before '") + path[i] + "'");
@@ -92,9 +115,24 @@ const nlohmann::json* resolve(const nlohmann::json& result, const std::vector<Pa
         return nullptr;
       }
     }
-    for (std::size_t k : s.indices) {
-      if (!n->is_array() || k >= n->size()) return nullptr;
-      n = &(*n)[k];
+    for (const auto& sel : s.selectors) {
+      if (!n->is_array()) return nullptr;
+      if (sel.index) {
+        if (*sel.index >= n->size()) return nullptr;
+        n = &(*n)[*sel.index];
+        continue;
+      }
+      const nlohmann::json* hit = nullptr;
+      for (const auto& e : *n)
+        if (e.is_object() && e.contains(sel.field) && e[sel.field].is_number()) {
+          const double x = e[sel.field].get<double>();
+          if (x >= sel.lo && x <= sel.hi) {
+            hit = &e;
+            break;
+          }
+        }
+      if (!hit) return nullptr;
+      n = hit;
     }
   }
   if (n->is_object() && n->contains("updated") && (*n)["updated"].is_number()) n = &(*n)["updated"];

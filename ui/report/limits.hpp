@@ -30,7 +30,10 @@
 // objects with a "name" field an element is addressed by its name
 // ("parameters.YE11"), and an object with an "updated" number stands for that
 // number (so "parameters.YE11" is the updated YE11; "parameters.YE11.original"
-// and ".sigma" reach the rest).
+// and ".sigma" reach the rest). Which mode is modes[0] depends on how many the
+// estimate found below it; to hold a limit to one mode whatever else was
+// found, select it by frequency: "modes[fs_hz=45e3..55e3].k_eff" is the first
+// mode whose fs lies in 45…55 kHz (no such mode: "not measured").
 //
 // Evaluation: a capture passes when every limit passes. A quantity that is
 // absent, null (NaN) or of the wrong type is a FAIL with the reason "not
@@ -53,9 +56,17 @@ class LimitsError : public std::runtime_error {
   using std::runtime_error::runtime_error;
 };
 
+// One bracket after a key: an index [i], or a selection [field=lo..hi] (the
+// first element whose `field` is a number in [lo, hi]).
+struct PathSelector {
+  std::optional<std::size_t> index;
+  std::string field;
+  double lo = 0, hi = 0;
+};
+
 struct PathStep {
-  std::string key;                   // object key, or an element's "name"; empty: index only
-  std::vector<std::size_t> indices;  // [i][j]… after the key
+  std::string key;                      // object key, or an element's "name"; empty: brackets only
+  std::vector<PathSelector> selectors;  // [i][j]… after the key
 };
 
 struct Limit {
