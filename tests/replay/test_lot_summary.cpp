@@ -142,12 +142,12 @@ TEST(LotReport, WritesMarkdownJsonAndTheHistogramsAsSvgAndPng) {
   const auto& p = fig.panels[0];
   bool lo = false, hi = false;
   for (const auto& ser : p.series) {
-    lo |= ser.label == "min 9" && ser.x == std::vector<double>{9.0, 9.0};
-    hi |= ser.label == "max 13" && ser.x == std::vector<double>{13.0, 13.0};
+    lo |= ser.label == "limits" && ser.x == std::vector<double>{9.0, 9.0};
+    hi |= ser.colour == "#d62728" && ser.dashed && ser.x == std::vector<double>{13.0, 13.0};
   }
   EXPECT_TRUE(lo && hi);
   const std::string svg = render_svg(fig);
-  EXPECT_NE(svg.find("max 13"), std::string::npos);
+  EXPECT_NE(svg.find(">limits</text>"), std::string::npos);
 
   // The PNG: the limit lines' red is found in the plot near x = 9 and 13.
   const PngCanvas c = render_png(fig);

@@ -86,7 +86,7 @@ void render_panel(PngCanvas& c, const Panel& p, double x0, double y0, double w, 
   std::size_t entries = 0;
   for (const auto& s : p.series) entries += !s.label.empty();
   if (!entries) return;
-  const double lw = 230, lh = 15.0 * static_cast<double>(entries) + 6;
+  const double lw = 192, lh = 15.0 * static_cast<double>(entries) + 6;
   c.fill_rect(ax.px1 - lw - 4, ay.px1 + 3, ax.px1 - 4, ay.px1 + 3 + lh, {255, 255, 255, 220});
   double ly = ay.px1 + 6;
   for (const auto& s : p.series) {

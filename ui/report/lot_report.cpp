@@ -104,7 +104,7 @@ Figure lot_figure(const Limits& L, const LotSummary& s) {
     p.x_label = l.unit.empty() ? l.quantity : l.quantity + " [" + l.unit + "]";
     p.y_label = "captures";
     const auto& h = q.histogram;
-    Series bars{"histogram", {}, {}, "#1f77b4", 2.0, false, false};
+    Series bars{"", {}, {}, "#1f77b4", 2.0, false, false};
     double top = 0;
     for (std::size_t k = 0; k < h.counts.size(); ++k) {
       const double a = h.lo + h.width() * static_cast<double>(k), b = a + h.width(), c = static_cast<double>(h.counts[k]);
@@ -114,10 +114,11 @@ Figure lot_figure(const Limits& L, const LotSummary& s) {
     }
     p.series.push_back(std::move(bars));
     auto vline = [&](double x, const std::string& label, const char* colour, bool dashed) {
-      p.series.push_back({label, {x, x}, {0.0, top * 1.08 + 0.5}, colour, 1.5, dashed, false});
+      p.series.push_back({label, {x, x}, {0.0, top * 1.6 + 1.0}, colour, 1.5, dashed, false});
     };
-    if (l.min) vline(*l.min, "min " + fmt("%.6g", *l.min), "#d62728", true);
-    if (l.max) vline(*l.max, "max " + fmt("%.6g", *l.max), "#d62728", true);
+    // One legend entry for the limits (their values are in the report's table).
+    if (l.min) vline(*l.min, "limits", "#d62728", true);
+    if (l.max) vline(*l.max, l.min ? "" : "limits", "#d62728", true);
     vline(q.mean, "mean", "#555555", false);
     Series out{"outliers (robust)", {}, {}, "#d62728", 3.0, false, true};
     for (std::size_t i : q.outliers)
@@ -128,7 +129,7 @@ Figure lot_figure(const Limits& L, const LotSummary& s) {
         }
     if (!out.x.empty()) p.series.push_back(std::move(out));
     p.x_range = std::pair(h.lo, h.hi);
-    p.y_range = std::pair(0.0, top * 1.15 + 1.0);
+    p.y_range = std::pair(0.0, top * 1.6 + 1.0);  // headroom: the legend sits top right
     fig.panels.push_back(std::move(p));
   }
   return fig;

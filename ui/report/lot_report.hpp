@@ -14,8 +14,8 @@
 namespace piezo::report {
 
 std::string lot_markdown(const Limits& l, const LotSummary& s, const std::string& results_file);
-// One panel per numeric limit: the histogram (count per bin), the limits as
-// dashed red lines, the mean as a grey line, the robust outliers as red points.
+// One panel per numeric limit: the histogram (count per bin, outlined), the
+// limits as dashed red lines, the mean as a grey line, the robust outliers as red points.
 Figure lot_figure(const Limits& l, const LotSummary& s);
 // Writes DIR/lot.md, lot.json, lot_histograms.svg and .png; throws naming a file it cannot write.
 void write_lot_report(const Limits& l, const LotSummary& s, const std::string& results_file,
