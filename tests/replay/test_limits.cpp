@@ -54,10 +54,14 @@ nlohmann::json result(double ye11, double qm, double tan_delta, const std::strin
     "output_error": {"converged": true}
   })")
       .patch(nlohmann::json::parse(R"([
-    {"op": "replace", "path": "/parameters/0/updated", "value": )" + std::to_string(ye11) + R"(},
-    {"op": "replace", "path": "/modes/0/qm_branch", "value": )" + std::to_string(qm) + R"(},
-    {"op": "replace", "path": "/mode_summary/tan_delta", "value": )" + std::to_string(tan_delta) + R"(},
-    {"op": "replace", "path": "/diagnosis/verdict_effect", "value": ")" + verdict + R"("}])"));
+    {"op": "replace", "path": "/parameters/0/updated", "value": )" +
+                                   std::to_string(ye11) + R"(},
+    {"op": "replace", "path": "/modes/0/qm_branch", "value": )" +
+                                   std::to_string(qm) + R"(},
+    {"op": "replace", "path": "/mode_summary/tan_delta", "value": )" +
+                                   std::to_string(tan_delta) + R"(},
+    {"op": "replace", "path": "/diagnosis/verdict_effect", "value": ")" +
+                                   verdict + R"("}])"));
 }
 
 std::string error_of(const std::string& text) {
@@ -96,25 +100,33 @@ TEST(LimitsFile, ParsesEveryKey) {
 
 TEST(LimitsFile, MalformedFilesAreNamedByFileAndLine) {
   // TOML syntax: toml++'s message at the line.
-  EXPECT_EQ(error_of("[[limit]]\nquantity = \"a\"\nmin = \n").rfind("lot.toml:3: ", 0), 0u) << error_of("[[limit]]\nquantity = \"a\"\nmin = \n");
+  EXPECT_EQ(error_of("[[limit]]\nquantity = \"a\"\nmin = \n").rfind("lot.toml:3: ", 0), 0u)
+      << error_of("[[limit]]\nquantity = \"a\"\nmin = \n");
   const std::pair<std::string, std::string> cases[] = {
       {"[[limit]]\nquantity = \"a\"\nmni = 3\n", "lot.toml:3: mni: unknown key in [[limit]]"},
       {"[[limit]]\nquantity = \"a\"\nmin = \"3\"\n", "lot.toml:3: min: expected a finite number"},
       {"[[limit]]\nquantity = \"a\"\nmin = 3.0\nmax = 1.0\n", "lot.toml:1: a: min 3 > max 1"},
       {"\n[[limit]]\nquantity = \"a\"\n", "lot.toml:2: a: no limit (give min, max or allowed)"},
       {"[[limit]]\nmin = 1\n", "lot.toml:1: [[limit]] without a quantity"},
-      {"[[limit]]\nquantity = \"a\"\nmin = 1\nallowed = [\"x\"]\n", "lot.toml:1: a: give either min/max or allowed, not both"},
-      {"[[limit]]\nquantity = \"a\"\nallowed = [1, 2]\n", "lot.toml:3: allowed: strings or booleans only"},
-      {"[[limit]]\nquantity = \"a\"\nallowed = []\n", "lot.toml:3: allowed: expected a non-empty array"},
-      {"[[limit]]\nquantity = \"modes[x].fs_hz\"\nmin = 1\n", "lot.toml:2: quantity \"modes[x].fs_hz\": an index is"},
-      {"[[limit]]\nquantity = \"modes[fs_hz=5..1]\"\nmin = 1\n", "lot.toml:2: quantity \"modes[fs_hz=5..1]\": [fs_hz=5..1]: lo > hi"},
+      {"[[limit]]\nquantity = \"a\"\nmin = 1\nallowed = [\"x\"]\n",
+       "lot.toml:1: a: give either min/max or allowed, not both"},
+      {"[[limit]]\nquantity = \"a\"\nallowed = [1, 2]\n",
+       "lot.toml:3: allowed: strings or booleans only"},
+      {"[[limit]]\nquantity = \"a\"\nallowed = []\n",
+       "lot.toml:3: allowed: expected a non-empty array"},
+      {"[[limit]]\nquantity = \"modes[x].fs_hz\"\nmin = 1\n",
+       "lot.toml:2: quantity \"modes[x].fs_hz\": an index is"},
+      {"[[limit]]\nquantity = \"modes[fs_hz=5..1]\"\nmin = 1\n",
+       "lot.toml:2: quantity \"modes[fs_hz=5..1]\": [fs_hz=5..1]: lo > hi"},
       {"[[limit]]\nquantity = \"a..b\"\nmin = 1\n", "lot.toml:2: quantity \"a..b\": empty key"},
-      {"[lot]\nbins = 0\n[[limit]]\nquantity = \"a\"\nmin = 1\n", "lot.toml:2: lot.bins: expected an integer in 1..200"},
+      {"[lot]\nbins = 0\n[[limit]]\nquantity = \"a\"\nmin = 1\n",
+       "lot.toml:2: lot.bins: expected an integer in 1..200"},
       {"[lots]\nname = \"x\"\n", "lot.toml:1: lots: unknown section (lot, limit)"},
       {"[lot]\nname = \"x\"\n", "lot.toml: no [[limit]] in the file"},
   };
   for (const auto& [text, expected] : cases)
-    EXPECT_EQ(error_of(text).rfind(expected, 0), 0u) << "file:\n" << text << "\ngot: " << error_of(text);
+    EXPECT_EQ(error_of(text).rfind(expected, 0), 0u) << "file:\n"
+                                                     << text << "\ngot: " << error_of(text);
 }
 
 TEST(LimitsFile, ReadLimitsNamesAMissingFile) {
@@ -181,7 +193,8 @@ TEST(LimitsEvaluation, PassAndEachWayToFail) {
   EXPECT_EQ(verdict.status, "fail");
   EXPECT_EQ(verdict.checks[3].state, "not allowed");
   EXPECT_EQ(verdict.reasons[0],
-            "diagnosis.verdict_effect = \"mass_loading\" not in the allowed list [\"none\", \"channel_skew\"]");
+            "diagnosis.verdict_effect = \"mass_loading\" not in the allowed list [\"none\", "
+            "\"channel_skew\"]");
 
   auto r = result(6.5e10, 30, 0.01, "none");
   r["output_error"]["converged"] = false;
@@ -193,10 +206,10 @@ TEST(LimitsEvaluation, PassAndEachWayToFail) {
 TEST(LimitsEvaluation, AQuantityNotMeasuredFailsNeverPasses) {
   const Limits L = parse_limits(kValid, "lot.toml");
   auto r = result(6.5e10, 30, 0.01, "none");
-  r["modes"] = nlohmann::json::array();                 // no mode found
-  r["mode_summary"]["tan_delta"] = nullptr;             // NaN prints as null
-  r["parameters"][0]["updated"] = "6.5e10";             // wrong type: parameters.YE11 is the object then
-  r["diagnosis"].erase("verdict_effect");               // absent
+  r["modes"] = nlohmann::json::array();      // no mode found
+  r["mode_summary"]["tan_delta"] = nullptr;  // NaN prints as null
+  r["parameters"][0]["updated"] = "6.5e10";  // wrong type: parameters.YE11 is the object then
+  r["diagnosis"].erase("verdict_effect");    // absent
   const auto v = evaluate_result(L, r);
   EXPECT_EQ(v.status, "fail");
   for (std::size_t k : {0u, 1u, 2u, 3u}) {
@@ -212,15 +225,19 @@ TEST(LimitsEvaluation, AQuantityNotMeasuredFailsNeverPasses) {
 
 TEST(LimitsEvaluation, AFailedReplayIsAnErrorNotAFail) {
   const Limits L = parse_limits(kValid, "lot.toml");
-  const auto v = evaluate_record(L, {{"status", "failed"}, {"error", {{"kind", "bad capture"}, {"message", "x.h5: truncated"}}}});
+  const auto v = evaluate_record(
+      L,
+      {{"status", "failed"}, {"error", {{"kind", "bad capture"}, {"message", "x.h5: truncated"}}}});
   EXPECT_EQ(v.status, "error");
   EXPECT_TRUE(v.checks.empty());
   ASSERT_EQ(v.reasons.size(), 1u);
   EXPECT_EQ(v.reasons[0], "replay failed: x.h5: truncated");
-  const auto ok = evaluate_record(L, {{"status", "ok"}, {"result", result(6.5e10, 30, 0.01, "none")}});
+  const auto ok =
+      evaluate_record(L, {{"status", "ok"}, {"result", result(6.5e10, 30, 0.01, "none")}});
   EXPECT_EQ(ok.status, "pass");
 
-  const auto j = verdict_json(L, evaluate_record(L, {{"status", "ok"}, {"result", result(5e10, 30, 0.01, "none")}}));
+  const auto j = verdict_json(
+      L, evaluate_record(L, {{"status", "ok"}, {"result", result(5e10, 30, 0.01, "none")}}));
   EXPECT_EQ(j["file"], "lot.toml");
   EXPECT_EQ(j["status"], "fail");
   ASSERT_EQ(j["checks"].size(), 5u);
@@ -229,4 +246,18 @@ TEST(LimitsEvaluation, AFailedReplayIsAnErrorNotAFail) {
   EXPECT_EQ(j["checks"][0]["value"], 5e10);
   EXPECT_EQ(j["checks"][0]["min"], 6e10);
   EXPECT_EQ(j["checks"][3]["allowed"], nlohmann::json::array({"none", "channel_skew"}));
+}
+
+// The limits files shipped with the project parse (the README's example, the acceptance lot's).
+TEST(LimitsFile, ShippedExamplesParse) {
+  const Limits ex = read_limits(PIEZO_SOURCE_DIR "/docs/limits-example.toml");
+  EXPECT_EQ(ex.limits.size(), 8u);
+  EXPECT_EQ(ex.limits.back().quantity, "diagnosis.verdict_effect");
+  const Limits lot = read_limits(PIEZO_SOURCE_DIR "/scripts/lot-acceptance-limits.toml");
+  EXPECT_EQ(lot.limits.size(), 8u);
+  ASSERT_EQ(lot.limits[2].path.size(), 2u);
+  ASSERT_EQ(lot.limits[2].path[0].selectors.size(), 1u);
+  EXPECT_EQ(lot.limits[2].path[0].selectors[0].field, "fs_hz");
+  EXPECT_EQ(lot.limits[2].path[0].selectors[0].lo, 45e3);
+  EXPECT_EQ(lot.limits[2].path[0].selectors[0].hi, 56e3);
 }

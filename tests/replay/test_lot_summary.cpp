@@ -18,16 +18,18 @@ namespace fs = std::filesystem;
 
 namespace {
 
-LotRecord rec(const std::string& path, std::optional<double> x, const std::string& verdict = "none") {
+LotRecord rec(const std::string& path, std::optional<double> x,
+              const std::string& verdict = "none") {
   nlohmann::json r = {{"diagnosis", {{"verdict_effect", verdict}}}};
   if (x) r["x"] = *x;
   return {path, "k" + path, {{"status", "ok"}, {"result", r}}};
 }
 
 Limits limits(const std::string& x_range) {
-  return parse_limits("[[limit]]\nquantity = \"x\"\nunit = \"Hz\"\n" + x_range +
-                          "\n[[limit]]\nquantity = \"diagnosis.verdict_effect\"\nallowed = [\"none\"]\n",
-                      "lot.toml");
+  return parse_limits(
+      "[[limit]]\nquantity = \"x\"\nunit = \"Hz\"\n" + x_range +
+          "\n[[limit]]\nquantity = \"diagnosis.verdict_effect\"\nallowed = [\"none\"]\n",
+      "lot.toml");
 }
 
 }  // namespace
@@ -69,10 +71,15 @@ TEST(LotSummary, HistogramBinsIncludeTheTopEdge) {
 
 TEST(LotSummary, CountsStatisticsOutliersAndCategories) {
   const Limits L = limits("min = 9.0\nmax = 13.0");
-  std::vector<LotRecord> rs = {rec("a", 10.0), rec("b", 11.0), rec("c", 12.0), rec("d", 11.0), rec("e", 11.0),
-                               rec("f", 30.0, "mass_loading"),  // above max, an outlier, a verdict not allowed
-                               rec("g", std::nullopt),          // not measured
-                               {"h", "kh", {{"status", "failed"}, {"error", {{"message", "truncated"}}}}}};
+  std::vector<LotRecord> rs = {
+      rec("a", 10.0),
+      rec("b", 11.0),
+      rec("c", 12.0),
+      rec("d", 11.0),
+      rec("e", 11.0),
+      rec("f", 30.0, "mass_loading"),  // above max, an outlier, a verdict not allowed
+      rec("g", std::nullopt),          // not measured
+      {"h", "kh", {{"status", "failed"}, {"error", {{"message", "truncated"}}}}}};
   const auto s = summarize_lot(L, rs);
   EXPECT_EQ(s.captures.size(), 8u);
   EXPECT_EQ(s.pass, 5u);
@@ -121,7 +128,8 @@ TEST(LotReport, WritesMarkdownJsonAndTheHistogramsAsSvgAndPng) {
   std::vector<LotRecord> rs;
   for (int k = 0; k < 40; ++k) {
     char name[16];
-    std::snprintf(name, sizeof name, "t%03d", 100 + k);  // (GCC 12's -Wrestrict misfires on "t" + to_string)
+    std::snprintf(name, sizeof name, "t%03d",
+                  100 + k);  // (GCC 12's -Wrestrict misfires on "t" + to_string)
     rs.push_back(rec(name, 11.0 + 0.1 * ((k * 7) % 13 - 6)));
   }
   rs.push_back(rec("t999", 14.0));
@@ -135,7 +143,8 @@ TEST(LotReport, WritesMarkdownJsonAndTheHistogramsAsSvgAndPng) {
   std::stringstream text;
   text << md.rdbuf();
   EXPECT_NE(text.str().find("40 pass, 1 fail"), std::string::npos) << text.str();
-  EXPECT_NE(text.str().find("| t999 | fail | x = 14 Hz > max 13 Hz |"), std::string::npos) << text.str();
+  EXPECT_NE(text.str().find("| t999 | fail | x = 14 Hz > max 13 Hz |"), std::string::npos)
+      << text.str();
 
   const Figure fig = lot_figure(L, s);
   ASSERT_EQ(fig.panels.size(), 1u);  // the allowed list has no histogram

@@ -19,8 +19,9 @@ struct Axis {
   double lo, hi, px0, px1;
   Scale s;
   double to_px(double v) const {
-    const double t = s == Scale::Log ? (std::log10(v) - std::log10(lo)) / (std::log10(hi) - std::log10(lo))
-                                     : (v - lo) / (hi - lo);
+    const double t = s == Scale::Log
+                         ? (std::log10(v) - std::log10(lo)) / (std::log10(hi) - std::log10(lo))
+                         : (v - lo) / (hi - lo);
     return px0 + t * (px1 - px0);
   }
 };
@@ -41,12 +42,13 @@ void render_panel(PngCanvas& c, const Panel& p, double x0, double y0, double w, 
   for (double t : yt) {
     const double y = ay.to_px(t);
     c.line({ax.px0, y}, {ax.px1, y}, kGrid);
-    c.text(ax.px0 - 6, y - c.line_height() / 2, tick_label(t, p.y_scale), kInk, FontSize::Normal, Align::Right);
+    c.text(ax.px0 - 6, y - c.line_height() / 2, tick_label(t, p.y_scale), kInk, FontSize::Normal,
+           Align::Right);
   }
   c.text(x0 + w / 2, y0 + 6, p.title, kInk, FontSize::Normal, Align::Centre);
   c.text((ax.px0 + ax.px1) / 2, ay.px0 + 22, p.x_label, kInk, FontSize::Normal, Align::Centre);
-  c.text(x0 + 6, (ay.px0 + ay.px1) / 2 + c.text_width(p.y_label) / 2, p.y_label, kInk, FontSize::Normal,
-         Align::Left, /*vertical=*/true);
+  c.text(x0 + 6, (ay.px0 + ay.px1) / 2 + c.text_width(p.y_label) / 2, p.y_label, kInk,
+         FontSize::Normal, Align::Left, /*vertical=*/true);
   c.set_clip(ax.px0, ay.px1, ax.px1, ay.px0);
   for (const auto& m : p.markers)
     if (usable(m.x, p.x_scale)) {
@@ -57,7 +59,9 @@ void render_panel(PngCanvas& c, const Panel& p, double x0, double y0, double w, 
     if (usable(hl.y, p.y_scale)) {
       const double y = ay.to_px(hl.y);
       c.polyline({{ax.px0, y}, {ax.px1, y}}, parse_colour(hl.colour), 1.0, hl.dashed ? 5.0 : 0.0);
-      if (!hl.label.empty()) c.text(ax.px1 - 4, y - 4 - c.line_height(), hl.label, kLabel, FontSize::Normal, Align::Right);
+      if (!hl.label.empty())
+        c.text(ax.px1 - 4, y - 4 - c.line_height(), hl.label, kLabel, FontSize::Normal,
+               Align::Right);
     }
   for (const auto& s : p.series) {
     const std::size_t n = std::min(s.x.size(), s.y.size());
@@ -93,8 +97,11 @@ void render_panel(PngCanvas& c, const Panel& p, double x0, double y0, double w, 
     if (s.label.empty()) continue;
     const double lx = ax.px1 - lw;
     const Rgba col = parse_colour(s.colour);
-    if (s.points) c.fill_rect(lx + 8, ly + 3, lx + 14, ly + 9, col);
-    else c.polyline({{lx, ly + 6}, {lx + 22, ly + 6}}, col, std::min(s.width, 4.0), s.dashed ? 6.0 : 0.0);
+    if (s.points)
+      c.fill_rect(lx + 8, ly + 3, lx + 14, ly + 9, col);
+    else
+      c.polyline({{lx, ly + 6}, {lx + 22, ly + 6}}, col, std::min(s.width, 4.0),
+                 s.dashed ? 6.0 : 0.0);
     c.text(lx + 28, ly, s.label, kInk);
     ly += 15;
   }
@@ -104,21 +111,27 @@ void render_panel(PngCanvas& c, const Panel& p, double x0, double y0, double w, 
 
 Rgba parse_colour(const std::string& hex) {
   if (hex.size() != 7 || hex[0] != '#') return {136, 136, 136, 255};
-  auto byte = [&](int i) { return static_cast<std::uint8_t>(std::strtol(hex.substr(1 + 2 * i, 2).c_str(), nullptr, 16)); };
+  auto byte = [&](int i) {
+    return static_cast<std::uint8_t>(std::strtol(hex.substr(1 + 2 * i, 2).c_str(), nullptr, 16));
+  };
   return {byte(0), byte(1), byte(2), 255};
 }
 
 PngCanvas render_png(const Figure& fig) {
   const double title_h = fig.title.empty() ? 0 : 28;
-  const int h = static_cast<int>(std::ceil(title_h + fig.panel_height * static_cast<double>(fig.panels.size())));
+  const int h = static_cast<int>(
+      std::ceil(title_h + fig.panel_height * static_cast<double>(fig.panels.size())));
   PngCanvas c(fig.width, std::max(1, h), {250, 250, 250, 255});
-  if (!fig.title.empty()) c.text(fig.width / 2.0, 6, fig.title, kInk, FontSize::Normal, Align::Centre);
+  if (!fig.title.empty())
+    c.text(fig.width / 2.0, 6, fig.title, kInk, FontSize::Normal, Align::Centre);
   for (std::size_t k = 0; k < fig.panels.size(); ++k)
-    render_panel(c, fig.panels[k], 0, title_h + fig.panel_height * static_cast<double>(k), fig.width,
-                 fig.panel_height);
+    render_panel(c, fig.panels[k], 0, title_h + fig.panel_height * static_cast<double>(k),
+                 fig.width, fig.panel_height);
   return c;
 }
 
-void write_png(const Figure& fig, const std::filesystem::path& file) { render_png(fig).save_png(file); }
+void write_png(const Figure& fig, const std::filesystem::path& file) {
+  render_png(fig).save_png(file);
+}
 
 }  // namespace piezo::report

@@ -66,7 +66,8 @@ std::vector<PathStep> parse_path(const std::string& path) {
         } catch (const std::exception&) {
           used = 0;
         }
-        if (t.empty() || used != t.size() || !std::isfinite(x)) bad("\"" + t + "\" is not a number in [" + in + "]");
+        if (t.empty() || used != t.size() || !std::isfinite(x))
+          bad("\"" + t + "\" is not a number in [" + in + "]");
         return x;
       };
       if (eq != std::string::npos) {
@@ -77,8 +78,11 @@ std::vector<PathStep> parse_path(const std::string& path) {
         sel.hi = number(in.substr(dots + 2));
         if (sel.lo > sel.hi) bad("[" + in + "]: lo > hi");
       } else {
-        if (in.empty() || !std::all_of(in.begin(), in.end(), [](char c) { return std::isdigit(static_cast<unsigned char>(c)); }))
-          bad("an index is a non-negative integer in brackets, e.g. modes[0], or a selection [field=lo..hi]");
+        if (in.empty() || !std::all_of(in.begin(), in.end(), [](char c) {
+              return std::isdigit(static_cast<unsigned char>(c));
+            }))
+          bad("an index is a non-negative integer in brackets, e.g. modes[0], or a selection "
+              "[field=lo..hi]");
         sel.index = std::stoul(in);
       }
       s.selectors.push_back(std::move(sel));
@@ -105,7 +109,8 @@ const nlohmann::json* resolve(const nlohmann::json& result, const std::vector<Pa
       } else if (n->is_array()) {  // an element by its "name"
         const nlohmann::json* hit = nullptr;
         for (const auto& e : *n)
-          if (e.is_object() && e.contains("name") && e["name"].is_string() && e["name"].get<std::string>() == s.key) {
+          if (e.is_object() && e.contains("name") && e["name"].is_string() &&
+              e["name"].get<std::string>() == s.key) {
             hit = &e;
             break;
           }
@@ -144,7 +149,8 @@ Limits parse_limits(std::string_view text, const std::string& source) {
   try {
     t = toml::parse(text, source);
   } catch (const toml::parse_error& e) {
-    throw LimitsError(at(source, static_cast<int>(e.source().begin.line), std::string(e.description())));
+    throw LimitsError(
+        at(source, static_cast<int>(e.source().begin.line), std::string(e.description())));
   }
   Limits L;
   L.source = source;
@@ -166,10 +172,12 @@ Limits parse_limits(std::string_view text, const std::string& source) {
           L.bins = static_cast<int>(*b);
         } else if (name == "outlier_z") {
           const auto z = lv.value<double>();
-          if (!z || !(*z > 0)) throw LimitsError(at(source, ln, "lot.outlier_z: expected a number > 0"));
+          if (!z || !(*z > 0))
+            throw LimitsError(at(source, ln, "lot.outlier_z: expected a number > 0"));
           L.outlier_z = *z;
         } else {
-          throw LimitsError(at(source, ln, "lot." + name + ": unknown key (name, bins, outlier_z)"));
+          throw LimitsError(
+              at(source, ln, "lot." + name + ": unknown key (name, bins, outlier_z)"));
         }
       }
     } else if (key == "limit") {
@@ -212,23 +220,34 @@ Limits parse_limits(std::string_view text, const std::string& source) {
           } else if (name == "allowed") {
             has_allowed = true;
             const auto* a = lv.as_array();
-            if (!a || a->empty()) throw LimitsError(at(source, ln, "allowed: expected a non-empty array"));
+            if (!a || a->empty())
+              throw LimitsError(at(source, ln, "allowed: expected a non-empty array"));
             for (const auto& x : *a) {
-              if (x.is_string()) lim.allowed.emplace_back(*x.value<std::string>());
-              else if (x.is_boolean()) lim.allowed.emplace_back(*x.value<bool>());
-              else throw LimitsError(at(source, line_of(x) ? line_of(x) : ln, "allowed: strings or booleans only"));
+              if (x.is_string())
+                lim.allowed.emplace_back(*x.value<std::string>());
+              else if (x.is_boolean())
+                lim.allowed.emplace_back(*x.value<bool>());
+              else
+                throw LimitsError(
+                    at(source, line_of(x) ? line_of(x) : ln, "allowed: strings or booleans only"));
             }
           } else {
-            throw LimitsError(at(source, ln, name + ": unknown key in [[limit]] (quantity, label, unit, min, max, allowed)"));
+            throw LimitsError(
+                at(source, ln,
+                   name + ": unknown key in [[limit]] (quantity, label, unit, min, max, allowed)"));
           }
         }
-        if (lim.quantity.empty()) throw LimitsError(at(source, lim.line, "[[limit]] without a quantity"));
+        if (lim.quantity.empty())
+          throw LimitsError(at(source, lim.line, "[[limit]] without a quantity"));
         if (has_allowed && (lim.min || lim.max))
-          throw LimitsError(at(source, lim.line, lim.quantity + ": give either min/max or allowed, not both"));
+          throw LimitsError(
+              at(source, lim.line, lim.quantity + ": give either min/max or allowed, not both"));
         if (!has_allowed && !lim.min && !lim.max)
-          throw LimitsError(at(source, lim.line, lim.quantity + ": no limit (give min, max or allowed)"));
+          throw LimitsError(
+              at(source, lim.line, lim.quantity + ": no limit (give min, max or allowed)"));
         if (lim.min && lim.max && *lim.min > *lim.max)
-          throw LimitsError(at(source, lim.line, lim.quantity + ": min " + g6(*lim.min) + " > max " + g6(*lim.max)));
+          throw LimitsError(at(source, lim.line,
+                               lim.quantity + ": min " + g6(*lim.min) + " > max " + g6(*lim.max)));
         if (lim.label.empty()) lim.label = lim.quantity;
         L.limits.push_back(std::move(lim));
       }
@@ -279,10 +298,12 @@ LimitCheck check_limit(const Limits& L, std::size_t k, const nlohmann::json& res
   const double x = v->get<double>();
   if (lim.min && x < *lim.min) {
     c.state = "below min";
-    c.reason = lim.quantity + " = " + with_unit(x, lim.unit) + " < min " + with_unit(*lim.min, lim.unit);
+    c.reason =
+        lim.quantity + " = " + with_unit(x, lim.unit) + " < min " + with_unit(*lim.min, lim.unit);
   } else if (lim.max && x > *lim.max) {
     c.state = "above max";
-    c.reason = lim.quantity + " = " + with_unit(x, lim.unit) + " > max " + with_unit(*lim.max, lim.unit);
+    c.reason =
+        lim.quantity + " = " + with_unit(x, lim.unit) + " > max " + with_unit(*lim.max, lim.unit);
   } else {
     c.state = "pass";
   }
@@ -303,7 +324,8 @@ CaptureVerdict evaluate_result(const Limits& L, const nlohmann::json& result) {
 }
 
 CaptureVerdict evaluate_record(const Limits& L, const nlohmann::json& record) {
-  if (record.value("status", std::string()) != "ok" || !record.contains("result") || !record["result"].is_object()) {
+  if (record.value("status", std::string()) != "ok" || !record.contains("result") ||
+      !record["result"].is_object()) {
     CaptureVerdict v;
     v.status = "error";
     std::string msg = "replay failed";

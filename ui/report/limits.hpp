@@ -102,13 +102,13 @@ struct LimitCheck {
   // "pass" | "below min" | "above max" | "not allowed" | "not measured"
   std::string state;
   nlohmann::json value;  // what was found (null when not measured)
-  std::string reason;    // empty when it passed, else e.g. "modes[0].fs_hz = 48712 Hz < min 49000 Hz"
+  std::string reason;  // empty when it passed, else e.g. "modes[0].fs_hz = 48712 Hz < min 49000 Hz"
   bool passed() const { return state == "pass"; }
 };
 
 struct CaptureVerdict {
-  std::string status;  // "pass" | "fail" | "error"
-  std::vector<LimitCheck> checks;  // one per limit (none for "error")
+  std::string status;                // "pass" | "fail" | "error"
+  std::vector<LimitCheck> checks;    // one per limit (none for "error")
   std::vector<std::string> reasons;  // the failed checks' reasons, or the replay's error
 };
 

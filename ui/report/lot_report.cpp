@@ -14,12 +14,15 @@ namespace fs = std::filesystem;
 
 namespace {
 
-std::string opt_num(const std::optional<double>& v, const char* f = "%.3g") { return v ? fmt(f, *v) : "-"; }
+std::string opt_num(const std::optional<double>& v, const char* f = "%.3g") {
+  return v ? fmt(f, *v) : "-";
+}
 
 std::string range_text(const Limit& l) {
   if (!l.numeric()) {
     std::string s;
-    for (const auto& a : l.allowed) s += (s.empty() ? "" : ", ") + (a.is_string() ? a.get<std::string>() : a.dump());
+    for (const auto& a : l.allowed)
+      s += (s.empty() ? "" : ", ") + (a.is_string() ? a.get<std::string>() : a.dump());
     return "one of " + s;
   }
   const std::string u = l.unit.empty() ? "" : " " + l.unit;
@@ -35,28 +38,33 @@ std::string lot_markdown(const Limits& L, const LotSummary& s, const std::string
   o << "# Lot report" << (s.name.empty() ? "" : ": " + s.name) << "\n\n"
     << "- results: `" << results_file << "`\n"
     << "- limits: `" << s.limits_file << "`\n"
-    << "- captures: " << s.captures.size() << " — **" << s.pass << " pass, " << s.fail << " fail**, " << s.error
-    << " error (replay failed, not judged)\n\n"
-    << "A capture passes when every limit passes (bounds included); a quantity that was not measured "
-       "fails it. Cp = (USL − LSL)/6σ, Cpk = min(USL − μ, μ − LSL)/3σ (μ mean, σ sample sd); one-sided "
+    << "- captures: " << s.captures.size() << " — **" << s.pass << " pass, " << s.fail
+    << " fail**, " << s.error << " error (replay failed, not judged)\n\n"
+    << "A capture passes when every limit passes (bounds included); a quantity that was not "
+       "measured "
+       "fails it. Cp = (USL − LSL)/6σ, Cpk = min(USL − μ, μ − LSL)/3σ (μ mean, σ sample sd); "
+       "one-sided "
        "limits give Cpu or Cpl only. Outliers: modified z-score 0.6745·|x − median|/MAD above "
     << fmt("%.1f", L.outlier_z) << ".\n\n"
     << "## Quantities\n\n"
-    << "| quantity | limit | n | fail low | fail high | not measured | mean | sd | min | max | Cp | Cpk | "
-       "outliers |\n| --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- |\n";
+    << "| quantity | limit | n | fail low | fail high | not measured | mean | sd | min | max | Cp "
+       "| Cpk | "
+       "outliers |\n| --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- "
+       "|\n";
   for (const auto& q : s.quantities) {
     const Limit& l = L.limits[q.limit];
-    o << "| " << cell(l.label) << (l.label != l.quantity ? " (`" + cell(l.quantity) + "`)" : "") << " | "
-      << cell(range_text(l)) << " | " << q.n << " | ";
+    o << "| " << cell(l.label) << (l.label != l.quantity ? " (`" + cell(l.quantity) + "`)" : "")
+      << " | " << cell(range_text(l)) << " | " << q.n << " | ";
     if (l.numeric()) {
       const char* cap = q.capability.one_sided ? (l.max ? " (Cpu)" : " (Cpl)") : "";
-      o << q.below << " | " << q.above << " | " << q.not_measured << " | " << fmt("%.6g", q.mean) << " | "
-        << fmt("%.3g", q.sd) << " | " << fmt("%.6g", q.min) << " | " << fmt("%.6g", q.max) << " | "
-        << opt_num(q.capability.cp) << " | " << opt_num(q.capability.cpk) << cap << " | " << q.outliers.size()
-        << " |\n";
+      o << q.below << " | " << q.above << " | " << q.not_measured << " | " << fmt("%.6g", q.mean)
+        << " | " << fmt("%.3g", q.sd) << " | " << fmt("%.6g", q.min) << " | " << fmt("%.6g", q.max)
+        << " | " << opt_num(q.capability.cp) << " | " << opt_num(q.capability.cpk) << cap << " | "
+        << q.outliers.size() << " |\n";
     } else {
       std::string vals;
-      for (const auto& [v, c] : q.categories) vals += (vals.empty() ? "" : ", ") + v + " " + std::to_string(c);
+      for (const auto& [v, c] : q.categories)
+        vals += (vals.empty() ? "" : ", ") + v + " " + std::to_string(c);
       o << q.not_allowed << " not allowed | - | " << q.not_measured << " | " << cell(vals)
         << " | - | - | - | - | - | - |\n";
     }
@@ -65,17 +73,21 @@ std::string lot_markdown(const Limits& L, const LotSummary& s, const std::string
   bool any = false;
   for (const auto& q : s.quantities)
     for (std::size_t i : q.outliers) {
-      if (!any) o << "\n## Outliers\n\n| capture | quantity | value | median | modified z |\n| --- | --- | --- | --- | --- |\n";
+      if (!any)
+        o << "\n## Outliers\n\n| capture | quantity | value | median | modified z |\n| --- | --- | "
+             "--- | --- | --- |\n";
       any = true;
       double x = 0;
       for (const auto& [k, v] : q.values)
         if (k == i) x = v;
-      o << "| " << cell(s.captures[i].path) << " | " << cell(L.limits[q.limit].label) << " | " << fmt("%.6g", x)
-        << " | " << fmt("%.6g", q.robust.median) << " | " << fmt("%+.1f", modified_z(x, q.robust)) << " |\n";
+      o << "| " << cell(s.captures[i].path) << " | " << cell(L.limits[q.limit].label) << " | "
+        << fmt("%.6g", x) << " | " << fmt("%.6g", q.robust.median) << " | "
+        << fmt("%+.1f", modified_z(x, q.robust)) << " |\n";
     }
   if (!any) o << "\nNo outliers.\n";
   o << "\n## Failed and unjudged captures\n\n";
-  if (s.fail + s.error == 0) o << "None.\n";
+  if (s.fail + s.error == 0)
+    o << "None.\n";
   else {
     o << "| capture | status | reasons |\n| --- | --- | --- |\n";
     for (const auto& c : s.captures)
@@ -90,16 +102,17 @@ std::string lot_markdown(const Limits& L, const LotSummary& s, const std::string
 
 Figure lot_figure(const Limits& L, const LotSummary& s) {
   Figure fig;
-  fig.title = "Lot " + (s.name.empty() ? std::string() : s.name + " ") + "- " + std::to_string(s.pass) + " pass, " +
-              std::to_string(s.fail) + " fail, " + std::to_string(s.error) + " error of " +
-              std::to_string(s.captures.size());
+  fig.title = "Lot " + (s.name.empty() ? std::string() : s.name + " ") + "- " +
+              std::to_string(s.pass) + " pass, " + std::to_string(s.fail) + " fail, " +
+              std::to_string(s.error) + " error of " + std::to_string(s.captures.size());
   fig.width = 900;
   fig.panel_height = 240;
   for (const auto& q : s.quantities) {
     const Limit& l = L.limits[q.limit];
     if (!l.numeric() || q.histogram.counts.empty()) continue;
     Panel p;
-    p.title = l.label + ": n " + std::to_string(q.n) + ", mean " + fmt("%.5g", q.mean) + ", sd " + fmt("%.3g", q.sd) +
+    p.title = l.label + ": n " + std::to_string(q.n) + ", mean " + fmt("%.5g", q.mean) + ", sd " +
+              fmt("%.3g", q.sd) +
               (q.capability.cpk ? ", Cpk " + fmt("%.2f", *q.capability.cpk) : "");
     p.x_label = l.unit.empty() ? l.quantity : l.quantity + " [" + l.unit + "]";
     p.y_label = "captures";
@@ -107,7 +120,8 @@ Figure lot_figure(const Limits& L, const LotSummary& s) {
     Series bars{"", {}, {}, "#1f77b4", 2.0, false, false};
     double top = 0;
     for (std::size_t k = 0; k < h.counts.size(); ++k) {
-      const double a = h.lo + h.width() * static_cast<double>(k), b = a + h.width(), c = static_cast<double>(h.counts[k]);
+      const double a = h.lo + h.width() * static_cast<double>(k), b = a + h.width(),
+                   c = static_cast<double>(h.counts[k]);
       bars.x.insert(bars.x.end(), {a, a, b, b});
       bars.y.insert(bars.y.end(), {0.0, c, c, 0.0});
       top = std::max(top, c);
@@ -135,7 +149,8 @@ Figure lot_figure(const Limits& L, const LotSummary& s) {
   return fig;
 }
 
-void write_lot_report(const Limits& L, const LotSummary& s, const std::string& results_file, const fs::path& dir) {
+void write_lot_report(const Limits& L, const LotSummary& s, const std::string& results_file,
+                      const fs::path& dir) {
   std::error_code ec;
   fs::create_directories(dir, ec);
   if (ec) throw std::runtime_error("report: cannot create " + dir.string() + ": " + ec.message());
@@ -144,7 +159,8 @@ void write_lot_report(const Limits& L, const LotSummary& s, const std::string& r
   write_png(fig, dir / "lot_histograms.png");
   auto text = [](const fs::path& f, const std::string& body) {
     std::ofstream o(f);
-    if (!o || !(o << body) || !o.flush()) throw std::runtime_error("report: cannot write " + f.string());
+    if (!o || !(o << body) || !o.flush())
+      throw std::runtime_error("report: cannot write " + f.string());
   };
   text(dir / "lot.md", lot_markdown(L, s, results_file));
   text(dir / "lot.json", ui::json_text(lot_json(L, s)) + "\n");

@@ -109,18 +109,27 @@ LotSummary summarize_lot(const Limits& L, std::vector<LotRecord> records) {
 }
 
 namespace {
-nlohmann::json opt(const std::optional<double>& v) { return v ? nlohmann::json(*v) : nlohmann::json(nullptr); }
+nlohmann::json opt(const std::optional<double>& v) {
+  return v ? nlohmann::json(*v) : nlohmann::json(nullptr);
+}
 }  // namespace
 
 nlohmann::json lot_json(const Limits& L, const LotSummary& s) {
-  nlohmann::json j = {{"limits_file", s.limits_file}, {"name", s.name},
-                      {"captures", s.captures.size()}, {"pass", s.pass}, {"fail", s.fail},
-                      {"error", s.error}, {"outlier_z", L.outlier_z}};
+  nlohmann::json j = {{"limits_file", s.limits_file},
+                      {"name", s.name},
+                      {"captures", s.captures.size()},
+                      {"pass", s.pass},
+                      {"fail", s.fail},
+                      {"error", s.error},
+                      {"outlier_z", L.outlier_z}};
   j["quantities"] = nlohmann::json::array();
   for (const auto& q : s.quantities) {
     const Limit& lim = L.limits[q.limit];
-    nlohmann::json qj = {{"quantity", lim.quantity}, {"label", lim.label}, {"unit", lim.unit},
-                         {"n", q.n}, {"not_measured", q.not_measured}};
+    nlohmann::json qj = {{"quantity", lim.quantity},
+                         {"label", lim.label},
+                         {"unit", lim.unit},
+                         {"n", q.n},
+                         {"not_measured", q.not_measured}};
     if (lim.numeric()) {
       qj["min_limit"] = opt(lim.min);
       qj["max_limit"] = opt(lim.max);
@@ -132,11 +141,14 @@ nlohmann::json lot_json(const Limits& L, const LotSummary& s) {
       qj["max"] = q.max;
       qj["median"] = q.robust.median;
       qj["mad"] = q.robust.mad;
-      qj["histogram"] = {{"lo", q.histogram.lo}, {"hi", q.histogram.hi}, {"counts", q.histogram.counts}};
+      qj["histogram"] = {
+          {"lo", q.histogram.lo}, {"hi", q.histogram.hi}, {"counts", q.histogram.counts}};
       qj["outliers"] = nlohmann::json::array();
       for (std::size_t i : q.outliers) {
-        const auto it = std::find_if(q.values.begin(), q.values.end(), [&](const auto& p) { return p.first == i; });
-        qj["outliers"].push_back({{"path", s.captures[i].path}, {"value", it->second},
+        const auto it = std::find_if(q.values.begin(), q.values.end(),
+                                     [&](const auto& p) { return p.first == i; });
+        qj["outliers"].push_back({{"path", s.captures[i].path},
+                                  {"value", it->second},
                                   {"modified_z", modified_z(it->second, q.robust)}});
       }
       qj["cp"] = opt(q.capability.cp);
@@ -155,7 +167,8 @@ nlohmann::json lot_json(const Limits& L, const LotSummary& s) {
   j["failures"] = nlohmann::json::array();
   for (const auto& c : s.captures)
     if (c.verdict.status != "pass")
-      j["failures"].push_back({{"path", c.path}, {"status", c.verdict.status}, {"reasons", c.verdict.reasons}});
+      j["failures"].push_back(
+          {{"path", c.path}, {"status", c.verdict.status}, {"reasons", c.verdict.reasons}});
   return j;
 }
 

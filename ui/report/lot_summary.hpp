@@ -31,7 +31,9 @@ struct LotCapture {
 struct Histogram {
   double lo = 0, hi = 0;  // edges of the first and last bin
   std::vector<std::size_t> counts;
-  double width() const { return counts.empty() ? 0.0 : (hi - lo) / static_cast<double>(counts.size()); }
+  double width() const {
+    return counts.empty() ? 0.0 : (hi - lo) / static_cast<double>(counts.size());
+  }
 };
 
 struct Capability {
