@@ -23,6 +23,14 @@ std::uint16_t parse_u16(std::string_view text, std::string_view s, int base, con
 InstrumentUri parse_instrument_uri(std::string_view text) {
   InstrumentUri u;
   if (text == "sim") return u;
+  if (text.starts_with("sim?")) {
+    const std::string_view q = text.substr(4);
+    if (q == "awg=keysight" || q == "awg=tektronix") {
+      u.sim_awg = std::string(q.substr(4));
+      return u;
+    }
+    bad(text, "the simulated bench takes awg=keysight or awg=tektronix");
+  }
   if (text.starts_with("tcp://")) {
     u.kind = InstrumentUri::Kind::Tcp;
     std::string_view rest = text.substr(6);
@@ -59,7 +67,7 @@ InstrumentUri parse_instrument_uri(std::string_view text) {
 std::string InstrumentUri::to_string() const {
   switch (kind) {
     case Kind::Sim:
-      return "sim";
+      return sim_awg == "keysight" ? "sim" : "sim?awg=" + sim_awg;
     case Kind::Tcp:
       return "tcp://" + host + ":" + std::to_string(port);
     case Kind::UsbTmc: {

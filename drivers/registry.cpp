@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <stdexcept>
 
+#include "drivers/comedi/driver.hpp"
 #include "drivers/infiniium/driver.hpp"
 #include "drivers/keysight33500/driver.hpp"
 #include "drivers/redpitaya/driver.hpp"
@@ -28,17 +29,60 @@ void list_keys(const std::vector<Entry>& v, std::string& known) {
 }
 }  // namespace
 
+bool DriverRegistry::has_key(const std::string& key) const {
+  auto in = [&](const auto& v) {
+    return std::any_of(v.begin(), v.end(), [&](const auto& e) { return e.key == key; });
+  };
+  return in(awgs_) || in(daqs_) || in(duals_) || in(boards_);
+}
+
 void DriverRegistry::add_awg(DriverEntry<Awg> e) {
   for (const auto& d : duals_)
     if (d.key == e.key) throw std::invalid_argument("DriverRegistry: duplicate driver key '" + e.key + "'");
+  for (const auto& d : boards_)
+    if (d.key == e.key)
+      throw std::invalid_argument("DriverRegistry: duplicate driver key '" + e.key + "'");
   add_entry(awgs_, std::move(e));
 }
 void DriverRegistry::add_daq(DriverEntry<Daq> e) {
   for (const auto& d : duals_)
     if (d.key == e.key) throw std::invalid_argument("DriverRegistry: duplicate driver key '" + e.key + "'");
+  for (const auto& d : boards_)
+    if (d.key == e.key)
+      throw std::invalid_argument("DriverRegistry: duplicate driver key '" + e.key + "'");
   add_entry(daqs_, std::move(e));
 }
+void DriverRegistry::add_board_daq(BoardDaqEntry e) {
+  if (has_key(e.key))
+    throw std::invalid_argument("DriverRegistry: duplicate driver key '" + e.key + "'");
+  add_entry(boards_, std::move(e));
+}
+
+std::unique_ptr<Daq> DriverRegistry::open_board_daq(const std::string& address) const {
+  for (const auto& e : boards_)
+    if (e.accepts(address)) return e.open(address);
+  return nullptr;
+}
+
+void DriverRegistry::set_simulated_twin(const std::string& key, std::string how) {
+  if (!has_key(key)) throw std::invalid_argument("DriverRegistry: no driver '" + key + "'");
+  for (auto& t : twins_)
+    if (t.first == key) {
+      t.second = std::move(how);
+      return;
+    }
+  twins_.emplace_back(key, std::move(how));
+}
+
+std::string DriverRegistry::simulated_twin(const std::string& key) const {
+  for (const auto& t : twins_)
+    if (t.first == key) return t.second;
+  return {};
+}
 void DriverRegistry::add_dual(DualRoleEntry e) {
+  for (const auto& a : boards_)
+    if (a.key == e.key)
+      throw std::invalid_argument("DriverRegistry: duplicate driver key '" + e.key + "'");
   for (const auto& a : awgs_)
     if (a.key == e.key) throw std::invalid_argument("DriverRegistry: duplicate driver key '" + e.key + "'");
   for (const auto& a : daqs_)
@@ -117,6 +161,39 @@ void register_builtin_drivers(DriverRegistry& r) {
                 auto roles = redpitaya::open(std::move(t));
                 return InstrumentRoles{std::move(roles.awg), std::move(roles.daq)};
               }});
+  r.add_board_daq(
+      {"comedi", "DAQ boards through Comedi (analog input streaming; written for the NI PCI-6110E)",
+       "comedi:///dev/"
+       "comediN?trigger=pfiN|software&edge=rising|falling&aref=diff|rse|nrse&channels=C1,C2",
+       [](const std::string& a) { return a.starts_with("comedi://"); },
+       [](const std::string& a) -> std::unique_ptr<Daq> {
+         const auto addr = comedi::parse_address(a);
+         return std::make_unique<comedi::Driver>(comedi::open_comedilib_board(addr.device), addr);
+       }});
+  r.set_simulated_twin("keysight33500",
+                       "measure --instrument sim; sim-instrument --dialect keysight");
+  r.set_simulated_twin(
+      "tektronix_awg",
+      "measure --instrument 'sim?awg=tektronix'; sim-instrument --dialect tektronix");
+  r.set_simulated_twin("infiniium", "measure --instrument sim; sim-instrument (the DAQ on PORT+1)");
+  r.set_simulated_twin("redpitaya", "sim-instrument --dialect redpitaya");
+  r.set_simulated_twin(
+      "comedi",
+      "measure --instrument sim --adc-bits 12 --daq 'comedi-sim:///dev/comedi0' (a PCI-6110 twin)");
+}
+
+std::vector<DriverFamily> list_families(const DriverRegistry& r) {
+  std::vector<DriverFamily> out;
+  for (const auto& e : r.awgs())
+    out.push_back({e.key, e.description, {"awg"}, "*IDN?", "", r.simulated_twin(e.key)});
+  for (const auto& e : r.daqs())
+    out.push_back({e.key, e.description, {"daq"}, "*IDN?", "", r.simulated_twin(e.key)});
+  for (const auto& e : r.duals())
+    out.push_back({e.key, e.description, {"awg", "daq"}, "*IDN?", "", r.simulated_twin(e.key)});
+  for (const auto& e : r.board_daqs())
+    out.push_back(
+        {e.key, e.description, {"daq"}, "address", e.address_form, r.simulated_twin(e.key)});
+  return out;
 }
 
 const DriverRegistry& builtin_drivers() {

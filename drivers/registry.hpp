@@ -38,12 +38,30 @@ struct DualRoleEntry {
   std::function<InstrumentRoles(std::unique_ptr<Transport>)> open;  // both set
 };
 
+// A DAQ opened from an address of its own rather than over a Transport and
+// *IDN? (a board inside the PC, through a kernel interface such as Comedi).
+struct BoardDaqEntry {
+  std::string key;           // "comedi"
+  std::string description;   // "DAQ boards through Comedi (NI PCI-6110E, ...)"
+  std::string address_form;  // "comedi:///dev/comediN?trigger=pfiN&..."
+  std::function<bool(const std::string& address)> accepts;
+  std::function<std::unique_ptr<Daq>(const std::string& address)> open;
+};
+
 class DriverRegistry {
  public:
   // Throws std::invalid_argument on an empty or duplicate key, or a missing function.
   void add_awg(DriverEntry<Awg> e);
   void add_daq(DriverEntry<Daq> e);
   void add_dual(DualRoleEntry e);
+  void add_board_daq(BoardDaqEntry e);
+  const std::vector<BoardDaqEntry>& board_daqs() const { return boards_; }
+  // The board DAQ whose entry accepts the address, opened; nullptr if none accepts it.
+  std::unique_ptr<Daq> open_board_daq(const std::string& address) const;
+  // How to run a family against its simulated twin, for listings ("" if it has none).
+  // Throws std::invalid_argument for a key no entry has.
+  void set_simulated_twin(const std::string& key, std::string how);
+  std::string simulated_twin(const std::string& key) const;
   const std::vector<DriverEntry<Awg>>& awgs() const { return awgs_; }
   const std::vector<DriverEntry<Daq>>& daqs() const { return daqs_; }
   const std::vector<DualRoleEntry>& duals() const { return duals_; }
@@ -65,10 +83,24 @@ class DriverRegistry {
   std::vector<DriverEntry<Awg>> awgs_;
   std::vector<DriverEntry<Daq>> daqs_;
   std::vector<DualRoleEntry> duals_;
+  std::vector<BoardDaqEntry> boards_;
+  std::vector<std::pair<std::string, std::string>> twins_;  // key, how
+  bool has_key(const std::string& key) const;
 };
 
-// AWGs: keysight33500, tektronix_awg. DAQs: infiniium. Both: redpitaya.
+// AWGs: keysight33500, tektronix_awg. DAQs: infiniium; by address: comedi. Both: redpitaya.
 void register_builtin_drivers(DriverRegistry& r);
+
+// One family as the CLI (`piezobench instruments`) and the GUI list it.
+struct DriverFamily {
+  std::string key, description;
+  std::vector<std::string> roles;  // "awg", "daq"
+  std::string chosen_by;           // "*IDN?" (any SCPI address) or "address"
+  std::string address_form;        // for chosen_by == "address"
+  std::string simulated_twin;      // how to run it against its twin ("" if none)
+};
+// In registration order: AWGs, DAQs, dual-role instruments, board DAQs.
+std::vector<DriverFamily> list_families(const DriverRegistry& r);
 
 // The registry filled by register_builtin_drivers() (built once, never changed).
 const DriverRegistry& builtin_drivers();

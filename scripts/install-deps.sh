@@ -11,12 +11,12 @@ PACKAGES=(
   build-essential cmake pkg-config
   libeigen3-dev libspectra-dev libfftw3-dev
   libhdf5-dev hdf5-tools
-  libusb-1.0-0-dev
+  libusb-1.0-0-dev libcomedi-dev
   libglfw3-dev libimgui-dev libstb-dev libgl-dev
   libcli11-dev nlohmann-json3-dev libtomlplusplus-dev libssl-dev
   libgtest-dev libgmock-dev libbenchmark-dev
   xvfb xauth libgl1-mesa-dri
-  python3-numpy python3-h5py
+  python3-numpy python3-h5py python3-pyvisa python3-pyvisa-py
 )
 # `make fuzz` only: clang, its compiler-rt (Debian 12 ships libFuzzer and the
 # sanitizer runtimes for clang 14 in libclang-rt-14-dev) and llvm (for

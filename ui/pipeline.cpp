@@ -7,11 +7,12 @@
 #include <filesystem>
 #include <map>
 
-#include "acquisition/contained_read.hpp"
 #include "acquisition/capture_calibration.hpp"
 #include "acquisition/capture_file.hpp"
+#include "acquisition/contained_read.hpp"
 #include "acquisition/divider_record.hpp"
 #include "acquisition/runner.hpp"
+#include "drivers/instrument_uri.hpp"
 #include "dsp/cross_spectra.hpp"
 #include "dsp/fft.hpp"
 #include "dsp/fft_ratio.hpp"
@@ -24,10 +25,10 @@
 #include "model/material_spec.hpp"
 #include "model/modal.hpp"
 #include "model/tube_model.hpp"
+#include "ui/capture_fit.hpp"
 #include "update/gap_output_error.hpp"
 #include "update/least_squares.hpp"
 #include "update/port_fit.hpp"
-#include "ui/capture_fit.hpp"
 #include "update/rayleigh.hpp"
 #include "update/updater.hpp"
 
@@ -58,7 +59,8 @@ acq::Capture acquire(const PipelineRequest& req, PipelineResult& out, const Stag
     out.stages.push_back({"acquire", false, "replay of " + req.replay_capture});
     return cap;
   }
-  if (req.instrument == "sim") sim = acq::make_sim_bench(req.sim, req.plan.setup.divider_r1_ohm);
+  if (drivers::is_sim_address(req.instrument))
+    sim = acq::make_sim_bench(req.sim, req.plan.setup.divider_r1_ohm);
   acq::Bench bench = acq::open_bench({req.instrument, req.daq.empty() ? std::nullopt : std::optional(req.daq)}, sim);
   out.awg_idn = bench.awg->identity();
   out.daq_idn = bench.daq->identity();

@@ -255,6 +255,16 @@ class Problem {
       xp[c] += h;
       const model::ModalPortModel* p = port_of(xp, mass);
       if (!p || !same_structure(*p, b)) return;
+      // The largest relative slope of an active mode's ω or |p| in this constant.
+      double slope = 0;
+      for (std::size_t i = 0; i < b.modes.size(); ++i) {
+        const auto &mb = b.modes[i], &mp = p->modes[i];
+        const double pa = std::abs(mb.participation);
+        if (!(mb.omega > 0) || pa * pa < kActiveCoupling * mb.omega * mb.omega * b.c_clamped) continue;
+        slope = std::max({slope, std::abs(std::abs(mp.participation) - pa) / (pa * h),
+                          std::abs(mp.omega - mb.omega) / (mb.omega * h)});
+      }
+      tangent_.slope[static_cast<std::size_t>(c)] = slope;
       tangent_.plus[static_cast<std::size_t>(c)] = *p;
     }
     tangent_.base = b;
@@ -296,6 +306,13 @@ class Problem {
     if (!tangent_near(anchor, fx.mass_loading) || effects_at(anchor).mass_loading != fx.mass_loading ||
         (x.head<4>() - anchor.head<4>()).cwiseAbs().maxCoeff() > kTangentReach)
       return std::nullopt;
+    // … and only as far as its slopes say the modes move by a few percent:
+    // near a veering a participation changes by 6 % per 1e-4 of a constant
+    // (refsim-like tube, dielectric loss 0.03), and a screen extrapolated to a
+    // 1 % step refused every good step of the loss's run.
+    double change = 0;
+    for (int c = 0; c < 4; ++c) change += std::abs(x[c] - anchor[c]) * tangent_.slope[static_cast<std::size_t>(c)];
+    if (!(change <= kScreenChange)) return std::nullopt;
     const model::ModalPortModel* at = port_of(anchor, fx.mass_loading);
     if (!at || !same_structure(*at, tangent_.base)) return std::nullopt;
     model::ModalPortModel p = *at;
@@ -527,12 +544,14 @@ class Problem {
   static constexpr double kTangentTolerance = 0.01;        // participation
   static constexpr double kTangentOmegaTolerance = 1e-3;   // frequency
   static constexpr double kActiveCoupling = 1e-4;          // p²/(ω²C0) of a mode it looks at
+  static constexpr double kScreenChange = 0.05;            // tangent_model: Σ|Δx_c|·slope_c at most
   struct Tangent {
     bool valid = false;
     Eigen::Vector4d x_ref;
     double mass = 0, h = 0;
     model::ModalPortModel base;
     std::array<model::ModalPortModel, 4> plus;
+    std::array<double, 4> slope{};  // largest relative slope of an active mode's ω or |p| per unit x_c
   } tangent_;
   std::vector<Cached> cache_;
   unsigned long clock_ = 0;
@@ -849,6 +868,8 @@ class Fitter {
       bool strict = false;
       for (int it = 1; it <= opt.max_iterations; ++it) {
         o.iterations = it;
+        const double mu_it = mu;
+        int exact_tries = 0;  // none: every try was refused by the tangent's screen
         const bool have_j0 = j0 && j0->rows() == r->size() && j0->cols() == x.size();
         bool j_ok = true;
         if (strict) {
@@ -884,9 +905,12 @@ class Fitter {
           const Eigen::VectorXd trial = x + step;
           if (screen(x, trial) >= cost) {
             mu *= 4.0;
-            if (step.cwiseAbs().maxCoeff() < opt.step_tolerance) accepted = done = true;
+            // The screen alone never ends a run (its slopes are x_ref's): the
+            // exact J decides (strict, below).
+            if (step.cwiseAbs().maxCoeff() < opt.step_tolerance) break;
             continue;
           }
+          ++exact_tries;
           const auto rt = weighted(trial);
           const double ct = rt ? 0.5 * rt->squaredNorm() : INFINITY;
           if (ct < cost) {
@@ -931,6 +955,7 @@ class Fitter {
         if (!accepted) {
           if (!strict) {
             strict = true;
+            if (exact_tries == 0) mu = mu_it;  // (the screen's refusals grew mu, not the data)
             --it;
             continue;
           }

@@ -21,6 +21,8 @@ Reply ScpiDevice::handle(const scpi::ProgramMessage& msg) {
       append(r, "1\n");
     } else if (c.header == "*CLS") {
       errors_.clear();
+    } else if (c.header == "*WAI" && !c.query) {
+      // IEEE 488.2's wait-to-continue: every simulated command completes before the next.
     } else if (scpi::match("SYSTem:ERRor[:NEXT]", c.header) && c.query) {
       if (errors_.empty()) {
         append(r, "+0,\"No error\"\n");

@@ -24,8 +24,19 @@ struct DaqImperfections {
 };
 
 // Faults injected on purpose, for the fault tests (same over TCP and in-process).
+// The Comedi* kinds are the simulated Comedi board's (drivers/sim/sim_comedi_board.*).
 struct FaultPlan {
-  enum class Kind { None, CloseMidFetch, NoReplyToFetch, MalformedBlock, TruncatedBlock, ErrorOnConfigure };
+  enum class Kind {
+    None,
+    CloseMidFetch,
+    NoReplyToFetch,
+    MalformedBlock,
+    TruncatedBlock,
+    ErrorOnConfigure,
+    ComediOverrun,     // read() fails with EPIPE a third of the way through the shot
+    ComediNoData,      // the board never delivers the shot's samples (read times out)
+    ComediDeviceGone,  // read() fails with ENODEV a third of the way through, and so does all after
+  };
   Kind kind = Kind::None;
   int at_shot = 0;  // 0-based index of the acquisition that fails
 };

@@ -202,3 +202,86 @@ TEST(CliMeasure, UnknownDialectIsBadInput) {
   EXPECT_EQ(r.exit_code, 2);
   EXPECT_NE(r.err.find("dialect"), std::string::npos) << r.err;
 }
+
+// Issue 20 item 2: `measure --daq comedi-sim:///dev/comediN` runs the Comedi
+// driver against the simulated PCI-6110 on the embedded bench. A plan the
+// board follows exactly (no pretrigger: a Comedi command starts at its
+// trigger; 5 MS/s; ±2 V, one of its ranges), a 12-bit bench (its
+// converter), the soft calibration's ideal polynomial: the capture equals
+// the embedded Keysight + Infiniium bench's sample for sample.
+TEST(CliMeasure, ComediBoardOnTheEmbeddedBenchEqualsInProcess) {
+  auto dir = tmp_dir() / "comedi";
+  fs::create_directories(dir);
+  const std::string plan =
+      " --adc-bits 12 --samples 20000 --pretrigger 0 --rate 5e6 --range 2 --shots 2 --noise 0.05 "
+      "--seed 17 --effect parallel_capacitance=100e-12 --overwrite --out ";
+  auto com = test::run_cli(
+      "measure --json --instrument sim --daq 'comedi-sim:///dev/comedi0?trigger=pfi0&softcal=1'" +
+      plan + (dir / "comedi.h5").string());
+  ASSERT_EQ(com.exit_code, 0) << com.err;
+  EXPECT_NE(nlohmann::json::parse(com.out)["bench"].get<std::string>().find("COMEDI,pci-6110"),
+            std::string::npos)
+      << com.out;
+  auto local = test::run_cli("measure --instrument sim" + plan + (dir / "local.h5").string());
+  ASSERT_EQ(local.exit_code, 0) << local.err;
+  auto a = acq::read_capture(dir / "comedi.h5");
+  auto b = acq::read_capture(dir / "local.h5");
+  ASSERT_EQ(a.shots.size(), 2u);
+  ASSERT_EQ(b.shots.size(), 2u);
+  for (std::size_t k = 0; k < 2; ++k) {
+    EXPECT_EQ(a.shots[k].v1, b.shots[k].v1) << "shot " << k;
+    EXPECT_EQ(a.shots[k].v2, b.shots[k].v2) << "shot " << k;
+  }
+  // The demo's next step, the update, from each capture: the same result
+  // (all but the capture's name and the time taken), converged.
+  auto ua = test::run_cli("update --json " + (dir / "comedi.h5").string());
+  auto ub = test::run_cli("update --json " + (dir / "local.h5").string());
+  ASSERT_EQ(ua.exit_code, 0) << ua.err;
+  ASSERT_EQ(ub.exit_code, 0) << ub.err;
+  auto ja = nlohmann::json::parse(ua.out), jb = nlohmann::json::parse(ub.out);
+  EXPECT_TRUE(ja["converged"].get<bool>()) << ua.out;
+  for (auto* j : {&ja, &jb}) {
+    j->erase("capture");
+    j->erase("seconds");
+  }
+  EXPECT_EQ(ja, jb);
+}
+
+// The Tektronix twin with the Comedi board: the AWG at 10 MS/s (its
+// minimum), the board at 5 MS/s (its maximum; command_test rounds the scan
+// period and the capture states the rate). The default plan's pretrigger is
+// refused with the reason; a plan the 6110E cannot range is refused too.
+TEST(CliMeasure, TektronixWithComediBoardAndItsRefusals) {
+  auto dir = tmp_dir() / "tek-comedi";
+  fs::create_directories(dir);
+  const std::string daq = " --daq 'comedi-sim:///dev/comedi0' --adc-bits 12 --overwrite --out " +
+                          (dir / "t.h5").string();
+  auto r = test::run_cli(
+      "measure --json --instrument 'sim?awg=tektronix' --samples 3000 --pretrigger 0 --shots 2" +
+      daq);
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_NE(nlohmann::json::parse(r.out)["bench"].get<std::string>().find("TEKTRONIX,AWG5014C"),
+            std::string::npos)
+      << r.out;
+  auto cap = acq::read_capture(dir / "t.h5");
+  ASSERT_EQ(cap.shots.size(), 2u);
+  EXPECT_EQ(cap.shots[0].sample_rate_hz, 5e6);
+  EXPECT_EQ(cap.shots[0].samples(), 3000u);
+  r = test::run_cli("measure --instrument 'sim?awg=tektronix' --samples 3000" + daq);
+  EXPECT_NE(r.exit_code, 0);
+  EXPECT_NE(
+      r.err.find(
+          "a Comedi command starts at its trigger: no samples before it (pretrigger 200; use 0)"),
+      std::string::npos)
+      << r.err;
+  r = test::run_cli(
+      "measure --instrument sim --daq 'comedi-sim:///dev/comedi0' --overwrite --pretrigger 0 "
+      "--out " +
+      (dir / "b.h5").string());  // a 14-bit bench is not the 6110E's
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_NE(r.err.find("12 bits"), std::string::npos) << r.err;
+  r = test::run_cli("measure --instrument 'sim?awg=rigol' --overwrite --out " +
+                    (dir / "c.h5").string());
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_NE(r.err.find("awg=keysight or awg=tektronix"), std::string::npos) << r.err;
+}

@@ -121,4 +121,51 @@ TEST(DriverRegistry, KeysMustBeUniqueAndEntriesComplete) {
                std::invalid_argument);
 }
 
+// Board DAQs (issue 20 items 2 and 4): chosen by their address, not *IDN?;
+// listed with the others for `piezobench instruments` and the GUI.
+TEST(DriverRegistry, BoardDaqsAreChosenByAddressAndListed) {
+  const auto& r = builtin_drivers();
+  ASSERT_EQ(r.board_daqs().size(), 1u);
+  EXPECT_EQ(r.board_daqs()[0].key, "comedi");
+  EXPECT_TRUE(r.board_daqs()[0].accepts("comedi:///dev/comedi0?trigger=pfi0"));
+  EXPECT_FALSE(r.board_daqs()[0].accepts(
+      "comedi-sim:///dev/comedi0"));  // the embedded bench's, not the registry's
+  EXPECT_FALSE(r.board_daqs()[0].accepts("tcp://127.0.0.1:5025"));
+  EXPECT_EQ(r.open_board_daq("tcp://127.0.0.1:5025"), nullptr);
+  // No /dev/comedi99 anywhere: the real board's open fails naming the device.
+  try {
+    r.open_board_daq("comedi:///dev/comedi99");
+    FAIL() << "opened /dev/comedi99";
+  } catch (const InstrumentError& e) {
+    EXPECT_NE(std::string(e.what()).find("comedi:///dev/comedi99: cannot open"), std::string::npos)
+        << e.what();
+  }
+
+  const auto families = list_families(r);
+  std::vector<std::string> keys;
+  for (const auto& f : families) keys.push_back(f.key);
+  EXPECT_EQ(keys, (std::vector<std::string>{"keysight33500", "tektronix_awg", "infiniium",
+                                            "redpitaya", "comedi"}));
+  for (const auto& f : families) {
+    EXPECT_FALSE(f.description.empty()) << f.key;
+    EXPECT_FALSE(f.simulated_twin.empty()) << f.key;  // every family has a twin
+  }
+  EXPECT_EQ(families[3].roles, (std::vector<std::string>{"awg", "daq"}));
+  EXPECT_EQ(families[4].chosen_by, "address");
+  EXPECT_EQ(families[4].address_form.rfind("comedi:///dev/comediN?", 0), 0u);
+  EXPECT_EQ(families[0].chosen_by, "*IDN?");
+
+  DriverRegistry x;
+  register_builtin_drivers(x);
+  EXPECT_THROW(
+      x.add_board_daq({"infiniium", "clash", "", [](const std::string&) { return true; },
+                       [](const std::string&) -> std::unique_ptr<Daq> { return nullptr; }}),
+      std::invalid_argument);
+  EXPECT_THROW(
+      x.add_awg({"comedi", "clash", [](const std::string&) { return true; },
+                 [](std::unique_ptr<Transport>) -> std::unique_ptr<Awg> { return nullptr; }}),
+      std::invalid_argument);
+  EXPECT_THROW(x.set_simulated_twin("no_such_driver", "x"), std::invalid_argument);
+}
+
 }  // namespace

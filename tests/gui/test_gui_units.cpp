@@ -10,9 +10,11 @@
 #include <thread>
 
 #include "acquisition/capture.hpp"
+#include "drivers/instrument_uri.hpp"
 #include "drivers/scpi_client.hpp"
 #include "drivers/transport.hpp"
 #include "ui/gui/app_state.hpp"
+#include "ui/gui/driver_choices.hpp"
 #include "ui/gui/error_advice.hpp"
 #include "ui/gui/palette.hpp"
 #include "ui/gui/residual_plot.hpp"
@@ -169,6 +171,53 @@ TEST(TaskQueue, RunsInOrderOffTheCallerAndAppliesOnDrain) {
   for (int i = 0; i < 5; ++i)
     EXPECT_EQ(s.log[static_cast<std::size_t>(i)], "applied " + std::to_string(i));
   EXPECT_EQ(s.log[5], "throws failed: disk full");
+}
+
+// The instrument window's driver combo (issue 20 item 4): one entry per
+// registry family, each saying how it is chosen; "Use" fills addresses the
+// bench opener accepts.
+TEST(DriverChoices, OneEntryPerRegistryFamilyWithUsableAddresses) {
+  const auto choices = piezo::gui::driver_choices();
+  std::vector<std::string> keys;
+  for (const auto& c : choices) {
+    keys.push_back(c.key);
+    EXPECT_FALSE(c.how.empty()) << c.key;
+    EXPECT_FALSE(c.twin.empty()) << c.key;
+    EXPECT_EQ(c.label.rfind(c.key + " [", 0), 0u) << c.label;
+  }
+  EXPECT_EQ(keys, (std::vector<std::string>{"keysight33500", "tektronix_awg", "infiniium",
+                                            "redpitaya", "comedi"}));
+  EXPECT_EQ(choices[1].awg_address, "sim?awg=tektronix");
+  EXPECT_EQ(piezo::drivers::parse_instrument_uri(choices[1].awg_address).sim_awg, "tektronix");
+  EXPECT_EQ(choices[4].daq_address, "comedi:///dev/comedi0?trigger=pfi0&aref=diff&channels=0,1");
+  EXPECT_TRUE(choices[4].awg_address.empty());  // a DAQ: the AWG field stays
+  EXPECT_NE(choices[4].how.find("comedi:///dev/comediN?"), std::string::npos) << choices[4].how;
+  EXPECT_TRUE(choices[3].awg_address.empty() &&
+              choices[3].daq_address.empty());  // no in-process twin
+}
+
+// The marker read-out (issue 19): the cursor snaps to the nearest snapping
+// marker within the radius (never to one that does not ask for it), and the
+// read-out gives the marker's label and each curve's own text at that x.
+TEST(PlotReadout, SnapsToTheNearestResonanceAndReadsEachCurve) {
+  using piezo::gui::Marker;
+  std::vector<Marker> markers = {{50e3, 0, "fr 50 kHz", true}, {50.5e3, 0, "plain", false}, {52e3, 0, "fa 52 kHz", true}};
+  auto to_px = [](double f) { return static_cast<float>(f / 100.0); };  // 100 Hz per pixel
+  EXPECT_EQ(piezo::gui::snap_marker(markers, 503.0f, to_px), &markers[0]);   // 3 px from fr
+  EXPECT_EQ(piezo::gui::snap_marker(markers, 505.0f, to_px), &markers[0]);   // "plain" is nearer but does not snap
+  EXPECT_EQ(piezo::gui::snap_marker(markers, 515.0f, to_px), &markers[2]);   // 5 px from fa
+  EXPECT_EQ(piezo::gui::snap_marker(markers, 510.0f, to_px), nullptr);       // 10 px from both
+  piezo::gui::PlotSpec spec;
+  std::vector<std::complex<double>> z = {{100, -100}, {1000, 0}, {0, 2000}};
+  piezo::gui::Series s{"Z", {49e3, 50e3, 51e3}, {0, 0, 0}, 0, 1.0f, false};
+  s.readout = [z](std::size_t i) { return piezo::gui::impedance_readout(z[i]); };
+  spec.series.push_back(s);
+  const auto lines = piezo::gui::readout_at(spec, 50.2e3, &markers[0]);
+  ASSERT_EQ(lines.size(), 2u);
+  EXPECT_EQ(lines[0].second, "fr 50 kHz");
+  EXPECT_EQ(lines[1].second, "Z: |Z| 1 kohm  phase 0.0 deg  R 1 kohm  X 0 ohm");
+  EXPECT_EQ(piezo::gui::impedance_readout({100, -100}), "|Z| 141.4 ohm  phase -45.0 deg  R 100 ohm  X -100 ohm");
+  EXPECT_TRUE(piezo::gui::readout_at(spec, 60e3, nullptr).empty());  // outside the curve's range
 }
 
 // The result of a job judged against the loaded limits (actions.cpp's

@@ -56,6 +56,7 @@ class ProgressBar {
 void register_capture_commands(CLI::App& app, Context& ctx);
 void register_demo_command(CLI::App& app, Context& ctx);
 void register_measure_commands(CLI::App& app, Context& ctx);
+void register_instruments_command(CLI::App& app, Context& ctx);
 void register_model_commands(CLI::App& app, Context& ctx);
 // `model mode-shape-cmcm` (cmd_model_mode_shape.cpp), under the `model` command.
 void register_mode_shape_command(CLI::App* model, Context& ctx);

@@ -14,6 +14,7 @@
 #include "acquisition/calibration_plan.hpp"
 #include "acquisition/runner.hpp"
 #include "acquisition/sim_setup.hpp"
+#include "drivers/instrument_uri.hpp"
 #include "drivers/sim/sim_awg.hpp"
 #include "drivers/sim/sim_daq.hpp"
 #include "drivers/sim/sim_redpitaya.hpp"
@@ -94,11 +95,15 @@ void register_measure_commands(CLI::App& app, Context& ctx) {
     SimOptions sim;
   };
   auto a = std::make_shared<MeasureArgs>();
-  m->add_option("--instrument", a->instrument, "sim | tcp://HOST:PORT | usbtmc://VID:PID[/SERIAL] (the AWG)")
+  m->add_option("--instrument", a->instrument,
+                "sim | sim?awg=tektronix | tcp://HOST:PORT | usbtmc://VID:PID[/SERIAL] (the AWG)")
       ->capture_default_str();
-  m->add_option("--daq", a->daq,
-                "DAQ address (default: the instrument itself if it has both roles, e.g. a Red Pitaya; "
-                "else tcp PORT+1 on the same host)");
+  m->add_option(
+      "--daq", a->daq,
+      "DAQ address (default: the instrument itself if it has both roles, e.g. a Red Pitaya; "
+      "else tcp PORT+1 on the same host), or a board through Comedi: "
+      "comedi:///dev/comediN?trigger=pfi0&aref=diff&channels=0,1 (comedi-sim:// on the embedded "
+      "bench)");
   auto* plan_opt = m->add_option("--plan", a->plan_file, "TOML measurement plan");
   m->add_option("--excitation", a->excitation, "exp_decay | sine | chirp | noise")->capture_default_str();
   m->add_option("--amplitude", a->amplitude, "Peak drive (V)")->capture_default_str();
@@ -149,7 +154,7 @@ void register_measure_commands(CLI::App& app, Context& ctx) {
       plan.validate();
       acq::BenchAddress addr{a->instrument, a->daq.empty() ? std::nullopt : std::optional(a->daq)};
       std::shared_ptr<drivers::sim::SimBench> sim;
-      if (a->instrument == "sim") {
+      if (drivers::is_sim_address(a->instrument)) {
         sim = acq::make_sim_bench(sim_spec(a->sim, plan.setup.geometry()), plan.setup.divider_r1_ohm);
         if (!plan.setup.material) plan.setup.material = a->sim.material;
       } else if (!a->sim.effects.empty()) {

@@ -16,6 +16,7 @@ int main(int argc, char** argv) {
   register_capture_commands(app, ctx);
   register_demo_command(app, ctx);
   register_measure_commands(app, ctx);
+  register_instruments_command(app, ctx);
   register_model_commands(app, ctx);
   register_impedance_command(app, ctx);
   register_update_command(app, ctx);

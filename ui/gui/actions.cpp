@@ -3,6 +3,7 @@
 // once; outcomes come back into the AppState on the UI thread.
 #include <sstream>
 
+#include "drivers/instrument_uri.hpp"
 #include "model/effects.hpp"
 #include "model/material_presets.hpp"
 #include "ui/bench_probe.hpp"
@@ -55,7 +56,7 @@ void start_job(AppState& s, bool replay) {
       return;
     }
     req.heldout_capture = s.heldout_path;  // optional; read (contained) by the pipeline
-  } else if (req.instrument == "sim") {
+  } else if (drivers::is_sim_address(req.instrument)) {
     try {
       req.sim = sim_spec(s);
     } catch (...) {
@@ -150,7 +151,7 @@ void connect_instruments(AppState& s) {
   const double r1 = s.request.plan.setup.divider_r1_ohm;
   acq::SimSpec sim;
   try {
-    if (awg == "sim") sim = sim_spec(s);
+    if (drivers::is_sim_address(awg)) sim = sim_spec(s);
   } catch (...) {
     s.instrument.state = InstrumentForm::State::Error;
     s.instrument.problem = problem_from_current_exception("simulated effects");

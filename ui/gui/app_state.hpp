@@ -52,6 +52,7 @@ struct InstrumentForm {
   // Bench effects the simulated bench adds (NAME=VALUE, comma separated), so
   // that the gap diagnosis has something to find; see model/effects.hpp.
   char sim_effects[256] = "";
+  int driver_choice = 0;  // the driver combo's entry (ui/gui/driver_choices.hpp)
   // (The order is the frame statistics' numbering; tests/gui relies on it.)
   enum class State {
     NotConnected,

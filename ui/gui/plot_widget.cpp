@@ -42,6 +42,59 @@ std::string fmt(double v) {
 }
 }  // namespace
 
+namespace {
+std::string ohms(double v) {
+  char b[32];
+  const double a = std::fabs(v);
+  if (a >= 1e6)
+    std::snprintf(b, sizeof b, "%.4g Mohm", v / 1e6);
+  else if (a >= 1e3)
+    std::snprintf(b, sizeof b, "%.4g kohm", v / 1e3);
+  else
+    std::snprintf(b, sizeof b, "%.4g ohm", v);
+  return b;
+}
+}  // namespace
+
+std::string impedance_readout(std::complex<double> z) {
+  char ph[32];
+  std::snprintf(ph, sizeof ph, "%.1f deg", std::arg(z) * 180.0 / M_PI);
+  return "|Z| " + ohms(std::abs(z)) + "  phase " + ph + "  R " + ohms(z.real()) + "  X " + ohms(z.imag());
+}
+
+const Marker* snap_marker(const std::vector<Marker>& markers, float mouse_px,
+                          const std::function<float(double)>& to_px, float radius_px) {
+  const Marker* best = nullptr;
+  float best_d = radius_px;
+  for (const auto& m : markers) {
+    if (!m.snap) continue;
+    const float d = std::fabs(to_px(m.x) - mouse_px);
+    if (d <= best_d) {
+      best_d = d;
+      best = &m;
+    }
+  }
+  return best;
+}
+
+std::vector<std::pair<ImU32, std::string>> readout_at(const PlotSpec& spec, double x, const Marker* snapped) {
+  std::vector<std::pair<ImU32, std::string>> lines;
+  if (snapped && !snapped->label.empty()) lines.emplace_back(IM_COL32(255, 255, 255, 255), snapped->label);
+  for (const auto& s : spec.series) {
+    // The nearest sample in x, and only inside the series' own x range (a
+    // curve that ends at 120 kHz has no value to read at 200 kHz).
+    if (!s.listed || s.x.empty() || s.y.size() < s.x.size() || x < s.x.front() || x > s.x.back()) continue;
+    auto it = std::lower_bound(s.x.begin(), s.x.end(), x);
+    std::size_t i = std::min<std::size_t>(static_cast<std::size_t>(it - s.x.begin()), s.x.size() - 1);
+    if (i > 0 && x - s.x[i - 1] < s.x[i] - x) --i;
+    lines.emplace_back(s.color, s.label + ": " + (s.readout ? s.readout(i) : fmt(s.y[i])));
+  }
+  for (const auto& band : spec.bands)
+    if (!band.detail.empty() && x >= std::min(band.x0, band.x1) && x <= std::max(band.x0, band.x1))
+      lines.emplace_back(IM_COL32(255, 255, 255, 255), band.detail);
+  return lines;
+}
+
 void fit_view(const PlotSpec& spec, PlotView& view) {
   double xmin = INFINITY, xmax = -INFINITY, ymin = INFINITY, ymax = -INFINITY;
   for (const auto& s : spec.series)
@@ -237,31 +290,44 @@ bool plot(const char* id, const PlotSpec& spec, PlotView& view, ImVec2 size) {
     ly += 16;
   }
 
-  // Hover read-out: cursor position and the nearest point of each series.
+  // Hover read-out: cursor position (snapped to a resonance marker within a
+  // few pixels) and the nearest point of each series; a right click pins it.
+  const std::function<float(double)> to_px = [&](double x) { return sx(x); };
+  if (view.pinned) {
+    const float px = sx(*view.pinned);
+    if (px >= a.x && px <= b.x) {
+      dl->AddLine(ImVec2(px, a.y), ImVec2(px, b.y), IM_COL32(255, 220, 0, 160), 1.5f);
+      const Marker* m = snap_marker(spec.markers, px, to_px, 0.5f);
+      float ty = a.y + 4;
+      std::string head = spec.x_label + " = " + fmt(*view.pinned);
+      auto lines = readout_at(spec, *view.pinned, m);
+      lines.insert(lines.begin(), {IM_COL32(255, 220, 0, 255), head});
+      float w = 0;
+      for (const auto& l : lines) w = std::max(w, ImGui::CalcTextSize(l.second.c_str()).x);
+      dl->AddRectFilled(ImVec2(a.x + 4, ty - 2), ImVec2(a.x + w + 12, ty + 16.0f * lines.size() + 2),
+                        IM_COL32(0, 0, 0, 200));
+      for (const auto& l : lines) {
+        dl->AddText(ImVec2(a.x + 8, ty), l.first, l.second.c_str());
+        ty += 16;
+      }
+    }
+  }
   if (hovered && io.MousePos.x >= a.x && io.MousePos.x <= b.x && io.MousePos.y >= a.y &&
       io.MousePos.y <= b.y) {
-    double cx = inv(X0 + (io.MousePos.x - a.x) / (b.x - a.x) * (X1 - X0), view.log_x);
-    dl->AddLine(ImVec2(io.MousePos.x, a.y), ImVec2(io.MousePos.x, b.y),
-                IM_COL32(255, 255, 255, 60));
+    const Marker* snapped = snap_marker(spec.markers, io.MousePos.x, to_px);
+    double cx = snapped ? snapped->x : inv(X0 + (io.MousePos.x - a.x) / (b.x - a.x) * (X1 - X0), view.log_x);
+    const float line_x = snapped ? sx(snapped->x) : io.MousePos.x;
+    dl->AddLine(ImVec2(line_x, a.y), ImVec2(line_x, b.y), IM_COL32(255, 255, 255, snapped ? 140 : 60));
+    if (ImGui::IsMouseClicked(ImGuiMouseButton_Right)) {
+      if (view.pinned && std::fabs(sx(*view.pinned) - io.MousePos.x) <= kSnapPixels)
+        view.pinned.reset();
+      else
+        view.pinned = cx;
+    }
     ImGui::BeginTooltip();
     ImGui::Text("%s = %s", spec.x_label.c_str(), fmt(cx).c_str());
-    for (const auto& s : spec.series) {
-      // The nearest sample in x, and only inside the series' own x range (a
-      // curve that ends at 120 kHz has no value to read at 200 kHz).
-      if (!s.listed || s.x.empty() || s.y.size() < s.x.size() || cx < s.x.front() ||
-          cx > s.x.back())
-        continue;
-      auto it = std::lower_bound(s.x.begin(), s.x.end(), cx);
-      std::size_t i =
-          std::min<std::size_t>(static_cast<std::size_t>(it - s.x.begin()), s.x.size() - 1);
-      if (i > 0 && cx - s.x[i - 1] < s.x[i] - cx) --i;
-      ImGui::TextColored(ImGui::ColorConvertU32ToFloat4(s.color), "%s: %s", s.label.c_str(),
-                         fmt(s.y[i]).c_str());
-    }
-    for (const auto& band : spec.bands)
-      if (!band.detail.empty() && cx >= std::min(band.x0, band.x1) &&
-          cx <= std::max(band.x0, band.x1))
-        ImGui::TextUnformatted(band.detail.c_str());
+    for (const auto& [col, text] : readout_at(spec, cx, snapped))
+      ImGui::TextColored(ImGui::ColorConvertU32ToFloat4(col), "%s", text.c_str());
     ImGui::EndTooltip();
   }
   ImGui::EndChild();

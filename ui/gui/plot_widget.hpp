@@ -2,10 +2,14 @@
 // A small plot widget on ImGui's draw lists (no plotting library is packaged
 // for ImGui on Debian): linear or logarithmic axes, several series, vertical
 // markers, shaded bands, mouse-wheel zoom, drag to pan, double-click to fit,
-// a hover read-out and a legend. The view state lives in PlotView (owned by
+// a hover read-out that snaps to the markers that ask for it (resonances), a
+// read-out pinned by a right click, and a legend. The view state lives in PlotView (owned by
 // the caller's window state, not in function statics).
 #include <imgui.h>
 
+#include <complex>
+#include <functional>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -19,12 +23,18 @@ struct Series {
   bool points = false;  // draw markers instead of a line
   bool listed =
       true;  // in the legend and the hover read-out (false: e.g. the lower half of a ±band)
+  // The read-out of sample i (hover and pinned marker); empty: the y value.
+  // E.g. the impedance curves: |Z|, phase, R and X.
+  std::function<std::string(std::size_t)> readout{};
 };
 
 struct Marker {
   double x = 0;
   ImU32 color = IM_COL32(255, 255, 255, 120);
+  std::string label{};  // heads the read-out when the cursor snaps to it (e.g. "fr 51.59 kHz")
+  bool snap = false;  // the read-out cursor jumps to it within kSnapPixels
 };
+inline constexpr float kSnapPixels = 8.0f;
 
 struct Band {
   double x0 = 0, x1 = 0;
@@ -38,6 +48,9 @@ struct PlotView {
   double x0 = 1, x1 = 10, y0 = 0, y1 = 1;  // visible range (data units)
   bool fitted = false;                     // fit to data on the next draw
   ImVec4 frame{0, 0, 0, 0};  // where plot() drew the data area last (x0, y0, x1, y1; screen pixels)
+  // A read-out pinned by a right click (snapped like the hover one); a right
+  // click near it removes it.
+  std::optional<double> pinned{};
 };
 
 struct PlotSpec {
@@ -52,5 +65,18 @@ bool plot(const char* id, const PlotSpec& spec, PlotView& view, ImVec2 size);
 
 // Fit the view to the data (used by plot() when !view.fitted).
 void fit_view(const PlotSpec& spec, PlotView& view);
+
+// The snapping marker nearest to the cursor at screen x `mouse_px` within
+// `radius_px`, `to_px` mapping data x to screen x; nullptr when none.
+const Marker* snap_marker(const std::vector<Marker>& markers, float mouse_px,
+                          const std::function<float(double)>& to_px, float radius_px = kSnapPixels);
+
+// "|Z| 1.23 kohm  phase -45.1 deg  R 869 ohm  X -869 ohm" (the marker read-out
+// of an impedance curve; ASCII units: ImGui's default font has no omega).
+std::string impedance_readout(std::complex<double> z);
+
+// The read-out lines at data x: the marker's label (when snapped) and each
+// listed series' nearest sample inside its own x range.
+std::vector<std::pair<ImU32, std::string>> readout_at(const PlotSpec& spec, double x, const Marker* snapped);
 
 }  // namespace piezo::gui

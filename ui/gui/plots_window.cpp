@@ -5,6 +5,7 @@
 // order.
 #include <cmath>
 #include <complex>
+#include <cstdio>
 
 #include "ui/gui/residual_plot.hpp"
 #include "ui/gui/windows.hpp"
@@ -12,6 +13,12 @@
 namespace piezo::gui {
 
 namespace {
+std::string khz(double f) {
+  char b[32];
+  std::snprintf(b, sizeof b, "%.3f kHz", f / 1e3);
+  return b;
+}
+
 ImU32 colour_for(const std::string& label) {
   if (label.find("original") != std::string::npos) return kColOriginal;
   if (label.find("updated") != std::string::npos) return kColUpdated;
@@ -40,12 +47,16 @@ void impedance_specs(const AppState& s, PlotSpec& mag, PlotSpec& ph) {
       m.y.push_back(std::abs(z));
       p.y.push_back(std::arg(z) * 180.0 / M_PI);
     }
+    // The marker read-out: |Z|, phase, R and X of the curve there.
+    m.readout = [z = c.z_ohm](std::size_t i) { return impedance_readout(z[i]); };
     mag.series.push_back(std::move(m));
     ph.series.push_back(std::move(p));
   }
-  for (double f : s.result->resonances_hz) mag.markers.push_back({f, IM_COL32(255, 255, 255, 90)});
+  // The read-out snaps to the estimate's resonances and anti-resonances.
+  for (double f : s.result->resonances_hz)
+    mag.markers.push_back({f, IM_COL32(255, 255, 255, 90), "resonance fr " + khz(f), true});
   for (double f : s.result->antiresonances_hz)
-    mag.markers.push_back({f, IM_COL32(255, 160, 160, 90)});
+    mag.markers.push_back({f, IM_COL32(255, 160, 160, 90), "anti-resonance fa " + khz(f), true});
 }
 }  // namespace
 
