@@ -65,4 +65,18 @@ done
 
 # ------------------------------------------------------------ 3. the independent check
 python3 "$HERE/check_lot_limits.py" "$LIMITS" results.jsonl replay.json
+# ... and the check can fail: one passing capture's stored verdict flipped to "fail" must be caught.
+python3 - <<'PY'
+import json
+lines = [json.loads(l) for l in open("results.jsonl")]
+for l in lines:
+    if l.get("limits", {}).get("status") == "pass":
+        l["limits"]["status"] = "fail"
+        break
+open("tampered.jsonl", "w").write("".join(json.dumps(l) + "\n" for l in lines))
+PY
+if python3 "$HERE/check_lot_limits.py" "$LIMITS" tampered.jsonl replay.json >tampered.out; then
+  echo "the independent check did not notice a flipped verdict"; exit 1
+fi
+echo "lot-acceptance: a flipped verdict is caught ($(grep -c 'piezobench says' tampered.out) mismatch)"
 echo "lot-acceptance: report in $WORK/report/lot.md"
