@@ -64,7 +64,7 @@ void print_lot(const report::Limits& l, const report::LotSummary& s,
   for (const auto& q : s.quantities) {
     const auto& lim = l.limits[q.limit];
     if (!lim.numeric()) continue;
-    std::printf("  %-28s n %zu  mean %.6g  sd %.3g  fail low %zu high %zu  not measured %zu", lim.label.c_str(),
+    std::printf("  %-36s n %zu  mean %.6g  sd %.3g  fail low %zu high %zu  not measured %zu", lim.label.c_str(),
                 q.n, q.mean, q.sd, q.below, q.above, q.not_measured);
     if (q.capability.cpk) std::printf("  Cpk %.2f", *q.capability.cpk);
     std::printf("\n");
