@@ -1,10 +1,14 @@
 #include "update/gap_output_error.hpp"
 
 #include <algorithm>
+#include <atomic>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <exception>
+#include <optional>
+#include <thread>
 
 #include "model/effects.hpp"
 
@@ -268,19 +272,68 @@ GapDiagnosis gap_from_output_error(const OeResult& r, const std::string& fit_des
   ho.description = heldout.description;
   ho.min_shrink = heldout.min_shrink;
   ho.dominant_shrink = heldout.dominant_shrink;
-  ho.base = predict_output_error(solver, cls, r.updated, r.damping.beta, r.effect_set, heldout.data, r.band_hz, options,
-                                 r.covariance_rel);
-  for (const auto& e : r.effects) {
-    if (!e.significant && !(weak_candidate(e) && ho.base.chi2_per_dof > ho.base.chi2_limit)) continue;
+  // The predictions: without an effect, and with each candidate. They are
+  // independent (each its own Problem; an FE model is a function of its
+  // parameters alone), so with options.threads > 1 they run on two threads,
+  // the second with its own solver on the same tube: the same numbers.
+  std::vector<const OeEffect*> candidates;
+  for (const auto& e : r.effects) candidates.push_back(&e);
+  std::optional<OePrediction> base;
+  std::exception_ptr base_error;
+  std::vector<std::optional<OePrediction>> with(candidates.size());
+  std::vector<bool> wanted(candidates.size(), false);
+  auto predict_base = [&](model::ModalSolver& s) {
     try {
-      ho.with.emplace_back(e.name, predict_output_error(solver, cls, e.material, e.beta_s, e.effect_set,
-                                                         heldout.data, r.band_hz, options, e.covariance_rel, e.name));
+      base = predict_output_error(s, cls, r.updated, r.damping.beta, r.effect_set, heldout.data, r.band_hz, options,
+                                  r.covariance_rel);
+    } catch (...) {
+      base_error = std::current_exception();
+    }
+  };
+  auto predict_with = [&](model::ModalSolver& s, std::size_t i) {
+    const OeEffect& e = *candidates[i];
+    try {
+      with[i] = predict_output_error(s, cls, e.material, e.beta_s, e.effect_set, heldout.data, r.band_hz, options,
+                                     e.covariance_rel, e.name);
     } catch (const std::exception& ex) {
       // not simulable with it (an end mass the FE model refuses, a value that
       // makes the divider singular): no held-out number for it
       if (std::getenv("PIEZO_DEBUG_HELDOUT")) std::fprintf(stderr, "held-out %s: %s\n", e.name.c_str(), ex.what());
     }
-  }
+  };
+  // Which effects need a prediction depends on the base's (weak candidates
+  // only when it shows a gap): the significant ones start beside it.
+  for (std::size_t i = 0; i < candidates.size(); ++i) wanted[i] = candidates[i]->significant;
+  auto run_tasks = [&](const std::vector<std::size_t>& tasks, bool with_base) {
+    std::atomic<std::size_t> next{0};
+    const std::size_t n = tasks.size() + (with_base ? 1 : 0);
+    auto work = [&](model::ModalSolver& s) {
+      for (std::size_t k = next++; k < n; k = next++) {
+        if (with_base && k == 0) predict_base(s);
+        else predict_with(s, tasks[k - (with_base ? 1 : 0)]);
+      }
+    };
+    if (options.threads > 1 && n > 1) {
+      model::ModalSolver second(solver.model());
+      std::thread t([&] { work(second); });
+      work(solver);
+      t.join();
+    } else {
+      work(solver);
+    }
+  };
+  std::vector<std::size_t> first;
+  for (std::size_t i = 0; i < candidates.size(); ++i)
+    if (wanted[i]) first.push_back(i);
+  run_tasks(first, true);
+  if (base_error) std::rethrow_exception(base_error);
+  ho.base = std::move(*base);
+  std::vector<std::size_t> weak;
+  for (std::size_t i = 0; i < candidates.size(); ++i)
+    if (!wanted[i] && weak_candidate(*candidates[i]) && ho.base.chi2_per_dof > ho.base.chi2_limit) weak.push_back(i);
+  if (!weak.empty()) run_tasks(weak, false);
+  for (std::size_t i = 0; i < candidates.size(); ++i)
+    if (with[i]) ho.with.emplace_back(candidates[i]->name, std::move(*with[i]));
   GapDiagnosis d = build(r, fit_description, &ho);
   d.seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   return d;

@@ -42,6 +42,17 @@ def free_port_pair():
     raise RuntimeError("no two consecutive free ports")
 
 
+def poll(ask, done, what, seconds=30.0):
+    """Ask until the answer is `done` (a twin simulates the shot when fired: on
+    a loaded machine that takes more than a second); a deadline, not a count."""
+    deadline = time.monotonic() + seconds
+    while time.monotonic() < deadline:
+        if ask().strip() in done:
+            return
+        time.sleep(0.005)
+    raise AssertionError(f"{what} after {seconds} s")
+
+
 def seeded_waveform(seed, n):
     rng = random.Random(seed)
     w = [rng.gauss(0.0, 1.0) for _ in range(n)]
@@ -115,12 +126,7 @@ def infiniium_acquire(rm, port, rate, rng_v, fire):
     daq.query(":ADER?")
     daq.write(":SINGle")
     fire()
-    for _ in range(500):
-        if daq.query(":ADER?").strip() in ("1", "+1"):
-            break
-        time.sleep(0.002)
-    else:
-        raise AssertionError(":ADER? never 1 after the burst")
+    poll(lambda: daq.query(":ADER?"), ("1", "+1"), ":ADER? never 1 after the burst")
     channels = []
     for ch in (1, 2):
         configure(daq, f":WAVeform:SOURce CHANnel{ch}")
@@ -170,12 +176,7 @@ def tektronix(rm, twin, wave):
                 "SOURce1:MARKer1:VOLTage:HIGH 1", f"SOURce1:VOLTage:AMPLitude {peak}", "SOURce1:VOLTage:OFFSet 0",
                 "AWGControl:RUN"):
         configure(awg, cmd)
-    for _ in range(500):
-        if awg.query("AWGControl:RSTate?").strip() == "1":
-            break
-        time.sleep(0.01)
-    else:
-        raise AssertionError("AWGControl:RSTate? never 1 (waiting for trigger)")
+    poll(lambda: awg.query("AWGControl:RSTate?"), ("1",), "AWGControl:RSTate? never 1 (waiting for trigger)")
     configure(awg, "OUTPut1:STATe ON")
     (v1, v2), lsb = infiniium_acquire(rm, twin.ports["daq_port"], rate, 1.25, lambda: awg.write("*TRG"))
     check_v1("tektronix + infiniium", v1, wave, peak, lsb)
@@ -203,12 +204,7 @@ def redpitaya(rm, twin, wave):
         configure(rp, cmd)
     rp.write("SOUR1:TRig:INT")
     for query, done in (("ACQ:TRig:STAT?", "TD"), ("ACQ:TRig:FILL?", "1")):
-        for _ in range(500):
-            if rp.query(query).strip() == done:
-                break
-            time.sleep(0.002)
-        else:
-            raise AssertionError(f"{query} never {done}")
+        poll(lambda: rp.query(query), (done,), f"{query} never {done}")
     rp.read_termination = "\r\n"  # the data blocks are the server's own replies
     v = [rp.query_binary_values(f"ACQ:SOUR{ch}:DATA?", datatype="f", is_big_endian=True) for ch in (1, 2)]
     rp.read_termination = "\n"

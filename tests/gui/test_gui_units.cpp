@@ -10,6 +10,9 @@
 #include <thread>
 
 #include "acquisition/capture.hpp"
+#include "dsp/mode_figures.hpp"
+#include "tests/dsp/bvd_model.hpp"
+#include "ui/mode_nyquist.hpp"
 #include "drivers/instrument_uri.hpp"
 #include "drivers/scpi_client.hpp"
 #include "drivers/transport.hpp"
@@ -218,6 +221,43 @@ TEST(PlotReadout, SnapsToTheNearestResonanceAndReadsEachCurve) {
   EXPECT_EQ(lines[1].second, "Z: |Z| 1 kohm  phase 0.0 deg  R 1 kohm  X 0 ohm");
   EXPECT_EQ(piezo::gui::impedance_readout({100, -100}), "|Z| 141.4 ohm  phase -45.0 deg  R 100 ohm  X -100 ohm");
   EXPECT_TRUE(piezo::gui::readout_at(spec, 60e3, nullptr).empty());  // outside the curve's range
+}
+
+// The admittance view of each mode (ui/mode_nyquist.hpp) on an exact
+// two-branch BVD network: the fitted network traced across the window is the
+// network's own admittance (the fit is exact and the neighbour is included),
+// and the estimate's points near fs lie on the motional circle (diameter 1/R1)
+// — up to the change of ωC0 and of the neighbour across half a bandwidth.
+TEST(ModeNyquist, ExactBvdPointsOnTheFittedCircle) {
+  const auto m = bvd::make_bvd({50e3, 56e3}, {52e3, 57e3}, 2.5e-9, {1.0 / 400, 1.0 / 300});
+  const Eigen::VectorXd f = piezo::dsp::make_grid(1e3, 120e3, 20);
+  Eigen::VectorXcd z(f.size());
+  for (Eigen::Index k = 0; k < f.size(); ++k) z[k] = m.impedance_at(f[k]);
+  const auto figs = piezo::dsp::mode_figures(f, z, {}, {});
+  ASSERT_EQ(figs.modes.size(), 2u);
+  const std::vector<double> fv(f.data(), f.data() + f.size());
+  const std::vector<std::complex<double>> zv(z.data(), z.data() + z.size());
+  const auto ny = piezo::ui::mode_nyquist(fv, zv, figs);
+  ASSERT_EQ(ny.size(), 2u);
+  for (std::size_t i = 0; i < 2; ++i) {
+    const auto& n = ny[i];
+    const auto& b = m.branches[i];
+    SCOPED_TRACE("mode " + std::to_string(i));
+    EXPECT_NEAR(n.radius_s * 2.0 * b.R, 1.0, 1e-6);
+    const double lo = figs.modes[i].window_lo_hz, hi = figs.modes[i].window_hi_hz;
+    const std::complex<double> y_lo = 1.0 / m.impedance_at(lo), y_hi = 1.0 / m.impedance_at(hi);
+    EXPECT_LT(std::abs(std::complex<double>(n.fit_g_s.front(), n.fit_b_s.front()) - y_lo), 1e-6 * std::abs(y_lo));
+    EXPECT_LT(std::abs(std::complex<double>(n.fit_g_s.back(), n.fit_b_s.back()) - y_hi), 1e-6 * std::abs(y_hi));
+    const double q = 1.0 / (2 * M_PI * n.fs_hz * b.R * b.C);
+    int near = 0;
+    for (std::size_t k = 0; k < n.f_hz.size(); ++k) {
+      if (std::abs(n.f_hz[k] - n.fs_hz) > 0.5 * n.fs_hz / q) continue;
+      ++near;
+      const double d = std::hypot(n.g_s[k] - n.centre_g_s, n.b_s[k] - n.centre_b_s);
+      EXPECT_NEAR(d / n.radius_s, 1.0, 0.02) << n.f_hz[k];
+    }
+    EXPECT_GE(near, 5);
+  }
 }
 
 // The result of a job judged against the loaded limits (actions.cpp's

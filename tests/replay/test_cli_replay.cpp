@@ -113,6 +113,14 @@ TEST(CliReplay, BatchReportsAndSkipsACorruptedCaptureWritesReportsAndResumes) {
     if (e.path().filename().string().rfind("T-bad", 0) == 0) continue;
     for (const char* f : {"impedance.svg", "impedance.csv", "impedance.s1p", "result.json"})
       EXPECT_GT(fs::file_size(e.path() / f), 100u) << e.path() / f;
+    // The per-mode figures (issue 19): the table, and the admittance plane it links.
+    std::ifstream cmd_md(e.path() / "summary.md");
+    std::stringstream cs;
+    cs << cmd_md.rdbuf();
+    EXPECT_NE(cs.str().find("| mode | fs [kHz] | fp [kHz] | k_eff | Qm (branch) |"), std::string::npos) << cs.str();
+    if (cs.str().find("(nyquist.svg)") != std::string::npos) {
+      EXPECT_GT(fs::file_size(e.path() / "nyquist.svg"), 1000u) << e.path();
+    }
   }
   EXPECT_EQ(folders, 5u);
   std::ifstream md(rep / "summary.md");

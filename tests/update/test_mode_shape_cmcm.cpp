@@ -12,6 +12,7 @@
 #include "model/material_presets.hpp"
 #include "tests/support/tube_fixture.hpp"
 #include "update/condensed_stiffness.hpp"
+#include "update/appendix_d_study.hpp"
 #include "update/mode_shape_cmcm.hpp"
 
 namespace piezo::update {
@@ -20,35 +21,8 @@ namespace {
 using model::Electrodes;
 using model::kEps0;
 
-// Table D.1 (the seed's absolute e-form numbers; εS11 = 0 as D.2 assumes).
-model::PiezoMaterialE table_d1_original() {
-  model::PiezoMaterialE m;
-  m.c_e11 = 9.2e10;
-  m.c_e12 = 4.4e10;
-  m.c_e13 = 4.2e10;
-  m.c_e33 = 8e10;
-  m.c_e44 = 2.2e10;
-  m.eps_s33 = 538 * kEps0;
-  m.eps_s11 = 0;
-  m.e33 = 17.3;
-  m.e31 = -5.363;
-  m.e15 = 12.8;
-  return m;
-}
-model::PiezoMaterialE table_d1_target() {
-  model::PiezoMaterialE m;
-  m.c_e11 = 11.04e10;
-  m.c_e12 = 5.104e10;
-  m.c_e13 = 4.62e10;
-  m.c_e33 = 8.48e10;
-  m.c_e44 = 2.53e10;
-  m.eps_s33 = 800 * kEps0;
-  m.eps_s11 = 0;
-  m.e33 = 30;
-  m.e31 = -10;
-  m.e15 = 15;
-  return m;
-}
+// Table D.1: table_d1_original() / table_d1_target() (update/appendix_d_study.hpp,
+// the seed's absolute e-form numbers; εS11 = 0 as D.2 assumes).
 
 // The exact α of the target against the base, in the unknowns' order.
 std::array<double, kModeShapeUnknowns> exact_alpha(const model::PiezoMaterialE& b,

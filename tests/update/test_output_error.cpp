@@ -200,6 +200,28 @@ TEST_F(OutputErrorSimulated, TwoThreadsGiveTheSameAnswerAsOne) {
     EXPECT_EQ(r1.effects[i].fe_models, r2.effects[i].fe_models) << r1.effects[i].name;
   }
   EXPECT_TRUE(r1.lack_of_fit);  // (the path under test)
+  // The held-out predictions (update/gap_output_error.hpp: without and with
+  // each candidate, side by side on two threads) — here on the fit's own data.
+  update::OeHeldout ho;
+  ho.data = d;
+  ho.description = "the fit capture";
+  const auto d1 = update::gap_from_output_error(r1, "fit", solver, cls, ho, o1);
+  const auto d2 = update::gap_from_output_error(r2, "fit", solver, cls, ho, o2);
+  EXPECT_EQ(d1.verdict_effect, d2.verdict_effect);
+  ASSERT_TRUE(d1.chi2_heldout && d2.chi2_heldout);
+  EXPECT_EQ(*d1.chi2_heldout, *d2.chi2_heldout);
+  EXPECT_EQ(d1.heldout_shrink.has_value(), d2.heldout_shrink.has_value());
+  if (d1.heldout_shrink && d2.heldout_shrink) {
+    EXPECT_EQ(*d1.heldout_shrink, *d2.heldout_shrink);
+  }
+  ASSERT_EQ(d1.effects.size(), d2.effects.size());
+  for (std::size_t i = 0; i < d1.effects.size(); ++i) {
+    EXPECT_EQ(d1.effects[i].name, d2.effects[i].name);
+    EXPECT_EQ(d1.effects[i].heldout_shrink.has_value(), d2.effects[i].heldout_shrink.has_value()) << d1.effects[i].name;
+    if (d1.effects[i].heldout_shrink && d2.effects[i].heldout_shrink) {
+      EXPECT_EQ(*d1.effects[i].heldout_shrink, *d2.effects[i].heldout_shrink) << d1.effects[i].name;
+    }
+  }
 }
 #endif  // PIEZO_OE_VALIDATE
 

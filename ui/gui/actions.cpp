@@ -84,6 +84,13 @@ bool collect_job(AppState& s) {
   s.error = std::move(problem);
   s.warnings.clear();
   s.mag_view.fitted = s.phase_view.fitted = s.sv_view.fitted = s.residual_view.fitted = false;
+  s.nyquist_view.fitted = false;
+  s.nyquist.clear();
+  s.nyquist_mode = 0;
+  if (s.result && s.result->mode_figures && s.result->mode_figures->error.empty())
+    for (const auto& c : s.result->curves)
+      if (c.label == "measured (Prony-SS)")  // the estimate the figures were computed on
+        s.nyquist = ui::mode_nyquist(c.f_hz, c.z_ohm, s.result->mode_figures->figures);
   auto& in = s.instrument;
   if (s.error) {
     s.log.push_back("job failed at " + s.error->stage + ": " + s.error->message);

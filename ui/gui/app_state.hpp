@@ -16,6 +16,7 @@
 #include "ui/gui/error_advice.hpp"
 #include "ui/gui/plot_widget.hpp"
 #include "ui/gui/task_queue.hpp"
+#include "ui/mode_nyquist.hpp"
 #include "ui/pipeline.hpp"
 #include "ui/report/limits.hpp"
 
@@ -105,6 +106,13 @@ struct AppState {
   PlotView mag_view{true, true}, phase_view{true, false}, sv_view{false, true},
       residual_view{false, false};
   bool show_fft = false, show_xspec = false;
+  // The per-mode figures and the admittance (Nyquist) view of one mode, in
+  // place of the residual/phase/SV row (ui/mode_nyquist.hpp; computed when a
+  // result arrives, collect_job).
+  bool show_modes = false;
+  int nyquist_mode = 0;  // index into `nyquist`
+  std::vector<ui::ModeNyquist> nyquist;
+  PlotView nyquist_view{false, false};
   bool residual_phase = false;  // the residual plot shows phase (deg) instead of |Z| (dB)
   DiagnosisShown diagnosis_shown;
   // Screen rectangles of named buttons, for scripted input in tests.

@@ -83,7 +83,8 @@ std::vector<std::pair<ImU32, std::string>> readout_at(const PlotSpec& spec, doub
   for (const auto& s : spec.series) {
     // The nearest sample in x, and only inside the series' own x range (a
     // curve that ends at 120 kHz has no value to read at 200 kHz).
-    if (!s.listed || s.x.empty() || s.y.size() < s.x.size() || x < s.x.front() || x > s.x.back()) continue;
+    if (!s.listed || !s.hover || s.x.empty() || s.y.size() < s.x.size() || x < s.x.front() || x > s.x.back())
+      continue;
     auto it = std::lower_bound(s.x.begin(), s.x.end(), x);
     std::size_t i = std::min<std::size_t>(static_cast<std::size_t>(it - s.x.begin()), s.x.size() - 1);
     if (i > 0 && x - s.x[i - 1] < s.x[i] - x) --i;

@@ -26,6 +26,7 @@ struct Series {
   // The read-out of sample i (hover and pinned marker); empty: the y value.
   // E.g. the impedance curves: |Z|, phase, R and X.
   std::function<std::string(std::size_t)> readout{};
+  bool hover = true;  // in the hover read-out (which looks samples up by x: x must rise)
 };
 
 struct Marker {

@@ -3,6 +3,7 @@
 // estimates as optional overlays — then the gap diagnosis' residual with its
 // regions shaded, the phase, and the Hankel singular values with the chosen
 // order.
+#include <algorithm>
 #include <cmath>
 #include <complex>
 #include <cstdio>
@@ -58,6 +59,100 @@ void impedance_specs(const AppState& s, PlotSpec& mag, PlotSpec& ph) {
   for (double f : s.result->antiresonances_hz)
     mag.markers.push_back({f, IM_COL32(255, 160, 160, 90), "anti-resonance fa " + khz(f), true});
 }
+std::string pm(const dsp::Uncertain& u, double scale, const char* f) {
+  if (!std::isfinite(u.value)) return "-";
+  char b[64];
+  std::snprintf(b, sizeof b, f, u.value * scale);
+  std::string out = b;
+  if (std::isfinite(u.sigma)) {
+    std::snprintf(b, sizeof b, f, u.sigma * scale);
+    out += std::string(" +- ") + b;
+  }
+  return out;
+}
+
+// A table cell: the value; its sigma on hover.
+void cell(const dsp::Uncertain& u, double scale, const char* f) {
+  ImGui::TableNextColumn();
+  if (!std::isfinite(u.value)) {
+    ImGui::TextDisabled("-");
+    return;
+  }
+  char b[48];
+  std::snprintf(b, sizeof b, f, u.value * scale);
+  ImGui::TextUnformatted(b);
+  if (ImGui::IsItemHovered()) ImGui::SetTooltip("%s", pm(u, scale, "%.4g").c_str());
+}
+
+// The per-mode figures as a table (a row selects the mode of the admittance
+// plot beside it) and that mode's admittance plane: the estimate's points in
+// the fit window, the fitted network and the motional circle.
+void render_modes_row(AppState& s, float width, float height) {
+  PlotSpec ny{"admittance (mode)", "G [mS]", "B [mS]", {}, {}, {}};
+  if (!s.nyquist.empty()) {
+    s.nyquist_mode = std::clamp(s.nyquist_mode, 0, static_cast<int>(s.nyquist.size()) - 1);
+    const auto& n = s.nyquist[static_cast<std::size_t>(s.nyquist_mode)];
+    char t[96];
+    std::snprintf(t, sizeof t, "admittance, mode %d (fs %.3f kHz)", n.mode + 1, n.fs_hz / 1e3);
+    ny.title = t;
+    auto ms = [](const std::vector<double>& v) {
+      std::vector<double> o(v.size());
+      for (std::size_t i = 0; i < v.size(); ++i) o[i] = 1e3 * v[i];
+      return o;
+    };
+    ny.series.push_back({"motional circle", ms(n.circle_g_s), ms(n.circle_b_s), IM_COL32(255, 255, 255, 110), 1.0f, false});
+    ny.series.push_back({"fitted BVD", ms(n.fit_g_s), ms(n.fit_b_s), kColUpdated, 2.0f, false});
+    ny.series.push_back({"measured (Prony-SS)", ms(n.g_s), ms(n.b_s), kColMeasured, 1.0f, true});
+  }
+  // (Not in the hover read-out, which looks samples up by a rising x: G is not.)
+  for (auto& se : ny.series) se.hover = false;
+  plot("nyquist", ny, s.nyquist_view, ImVec2(width * 0.42f, height));
+  ImGui::SameLine();
+  ImGui::BeginChild("modes_table", ImVec2(0, height), true);
+  if (!s.result || !s.result->mode_figures) {
+    ImGui::TextDisabled("no per-mode figures (no impedance estimate)");
+  } else if (!s.result->mode_figures->error.empty()) {
+    ImGui::TextWrapped("no per-mode figures: %s", s.result->mode_figures->error.c_str());
+  } else {
+    const auto& r = s.result->mode_figures->figures;
+    ImGui::Text("C^T %s nF, tan d %s at %.0f Hz; N %s Hz m (hoop mode); hover a value for its sigma",
+                pm(r.free_capacitance_f, 1e9, "%.4g").c_str(), pm(r.tan_delta, 1.0, "%.2g").c_str(),
+                r.reference_used_hz, pm(r.frequency_constant_hz_m, 1.0, "%.5g").c_str());
+    const ImGuiTableFlags flags = ImGuiTableFlags_Borders | ImGuiTableFlags_RowBg | ImGuiTableFlags_ScrollY |
+                                  ImGuiTableFlags_SizingFixedFit;
+    if (ImGui::BeginTable("modes", 9, flags)) {
+      for (const char* h : {"mode", "fs kHz", "fp kHz", "k_eff", "Qm branch", "Qm 3 dB", "R1 ohm", "L1 mH", "C1 pF"})
+        ImGui::TableSetupColumn(h);
+      ImGui::TableSetupScrollFreeze(0, 1);
+      ImGui::TableHeadersRow();
+      for (std::size_t i = 0; i < r.modes.size(); ++i) {
+        const auto& m = r.modes[i];
+        ImGui::TableNextRow();
+        ImGui::TableNextColumn();
+        int ny_index = -1;
+        for (std::size_t k = 0; k < s.nyquist.size(); ++k)
+          if (s.nyquist[k].mode == static_cast<int>(i)) ny_index = static_cast<int>(k);
+        char lab[32];
+        std::snprintf(lab, sizeof lab, "%zu%s", i + 1, static_cast<int>(i) == r.hoop_mode ? " (hoop)" : "");
+        if (ImGui::Selectable(lab, ny_index >= 0 && ny_index == s.nyquist_mode, ImGuiSelectableFlags_SpanAllColumns) &&
+            ny_index >= 0) {
+          s.nyquist_mode = ny_index;
+          s.nyquist_view.fitted = false;
+        }
+        cell(m.fs_hz, 1e-3, "%.4f");
+        cell(m.fp_hz, 1e-3, "%.4f");
+        cell(m.k_eff, 1.0, "%.4f");
+        cell(m.qm_branch, 1.0, "%.4g");
+        cell(m.qm_bandwidth, 1.0, "%.4g");
+        cell(m.r1_ohm, 1.0, "%.4g");
+        cell(m.l1_h, 1e3, "%.4g");
+        cell(m.c1_f, 1e12, "%.4g");
+      }
+      ImGui::EndTable();
+    }
+  }
+  ImGui::EndChild();
+}
 }  // namespace
 
 void render_plots_window(AppState& s) {
@@ -71,8 +166,13 @@ void render_plots_window(AppState& s) {
   if (ImGui::Checkbox("log f", &s.residual_view.log_x)) s.residual_view.fitted = false;
   if (ImGui::IsItemHovered()) ImGui::SetTooltip("Logarithmic frequency axis for the residual plot");
   ImGui::SameLine();
+  tracked_checkbox(s, "Modes", &s.show_modes);
+  if (ImGui::IsItemHovered())
+    ImGui::SetTooltip("Per-mode figures (IEEE 176 / EN 50324-2) and the admittance circle of each mode");
+  ImGui::SameLine();
   if (ImGui::Button("Fit views"))
-    s.mag_view.fitted = s.phase_view.fitted = s.sv_view.fitted = s.residual_view.fitted = false;
+    s.mag_view.fitted = s.phase_view.fitted = s.sv_view.fitted = s.residual_view.fitted = s.nyquist_view.fitted =
+        false;
   PlotSpec mag{"|Z|", "f [Hz]", "ohm", {}, {}, {}}, ph{"phase", "f [Hz]", "deg", {}, {}, {}};
   impedance_specs(s, mag, ph);
   PlotSpec res{"gap: residual (no diagnosis)", "f [kHz]", "dB", {}, {}, {}};
@@ -95,6 +195,11 @@ void render_plots_window(AppState& s) {
   const float gap = ImGui::GetStyle().ItemSpacing.x;
   const float row2 = avail.y * 0.52f;
   plot("mag", mag, s.mag_view, ImVec2(avail.x, avail.y - row2 - ImGui::GetStyle().ItemSpacing.y));
+  if (s.show_modes) {
+    render_modes_row(s, avail.x, row2);
+    ImGui::End();
+    return;
+  }
   plot("residual", res, s.residual_view, ImVec2(avail.x * 0.42f, row2));
   ImGui::SameLine();
   plot("phase", ph, s.phase_view, ImVec2(avail.x * 0.30f - gap, row2));

@@ -13,6 +13,13 @@ bool tracked_button(AppState& s, const char* label, ImVec2 size) {
   return clicked;
 }
 
+bool tracked_checkbox(AppState& s, const char* label, bool* value) {
+  const bool changed = ImGui::Checkbox(label, value);
+  ImVec2 a = ImGui::GetItemRectMin(), b = ImGui::GetItemRectMax();
+  s.button_rects[label] = ImVec4(a.x, a.y, b.x, b.y);
+  return changed;
+}
+
 void show_problem(const Problem& p) {
   const bool error = p.kind != ErrorKind::Attention;
   ImGui::PushStyleColor(ImGuiCol_Text,

@@ -14,6 +14,8 @@ void render_diagnosis_window(AppState& s);
 
 // A button whose screen rectangle is recorded under its label (scripted tests click it).
 bool tracked_button(AppState& s, const char* label, ImVec2 size = ImVec2(0, 0));
+// A checkbox whose rectangle is recorded like tracked_button's (scripted clicks).
+bool tracked_checkbox(AppState& s, const char* label, bool* value);
 
 // A problem in red with its advice below it (error_advice.hpp).
 void show_problem(const Problem& p);

@@ -5,6 +5,7 @@
 #include <sstream>
 
 #include "ui/report/impedance_plot.hpp"
+#include "ui/report/mode_report.hpp"
 #include "ui/report_export.hpp"
 #include "ui/report/markdown.hpp"
 
@@ -71,6 +72,7 @@ std::string capture_summary_markdown(const ui::PipelineResult& r, const CaptureI
     o << "\n## Warnings\n\n";
     for (const auto& w : r.warnings) o << "- " << w << "\n";
   }
+  o << mode_figures_markdown(r);
   o << "\n## Impedance\n\n![|Z| and phase: measured, original and updated model](impedance.svg)\n\n"
     << "Exports: [impedance.csv](impedance.csv) (f_hz,re_ohm,im_ohm), "
        "[impedance.s1p](impedance.s1p) "
@@ -89,6 +91,7 @@ void write_capture_report(const ui::PipelineResult& r, const CaptureInfo& info,
                           const fs::path& dir) {
   make_dir(dir);
   write_svg(impedance_figure(r, info.input_path), dir / "impedance.svg");
+  if (const auto ny = nyquist_figure(r)) write_svg(*ny, dir / "nyquist.svg");
   if (!r.curves.empty()) {
     ui::export_csv(r, (dir / "impedance.csv").string());
     ui::export_touchstone(r, (dir / "impedance.s1p").string());
