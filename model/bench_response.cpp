@@ -21,13 +21,14 @@ cd port_capacitance(const ModalPortModel& port, const EffectSet& fx, double omeg
   return port.c_clamped * (1.0 + port.eps_t_over_s * (phi - 1.0)) + port.c_residual;
 }
 
-cd tube_admittance(const ModalPortModel& port, const RayleighDamping& d, const EffectSet& fx, double omega) {
+cd tube_admittance(const ModalPortModel& port, const RayleighDamping& d, const EffectSet& fx,
+                   double omega, double elastic_loss) {
   cd q = port_capacitance(port, fx, omega);
   for (const auto& m : port.modes) {
     const double ck = d.alpha + d.beta * m.kappa + 2.0 * fx.mechanical_damping * m.omega;
     // p²/(ω_k² − ω² + jωc_k), the real-over-complex division written out
     // (std::complex's general division is a libgcc call, a tenth of a fit).
-    const double re = m.omega * m.omega - omega * omega, im = omega * ck;
+    const double re = m.omega * m.omega - omega * omega, im = omega * ck + elastic_loss * m.kappa;
     const double s = m.participation * m.participation / (re * re + im * im);
     q += cd(s * re, -s * im);
   }
@@ -50,12 +51,13 @@ cd reported_impedance(cd y_tube, const EffectSet& fx, double r1_nominal_ohm, dou
   return r1_nominal_ohm * hm / (1.0 - hm);
 }
 
-std::vector<cd> bench_impedance(const ModalPortModel& port, const RayleighDamping& d, const EffectSet& fx,
-                                double r1_nominal_ohm, std::span<const double> f_hz) {
+std::vector<cd> bench_impedance(const ModalPortModel& port, const RayleighDamping& d,
+                                const EffectSet& fx, double r1_nominal_ohm,
+                                std::span<const double> f_hz, double elastic_loss) {
   std::vector<cd> z(f_hz.size());
   for (std::size_t i = 0; i < f_hz.size(); ++i) {
     const double w = 2 * M_PI * f_hz[i];
-    z[i] = reported_impedance(tube_admittance(port, d, fx, w), fx, r1_nominal_ohm, w);
+    z[i] = reported_impedance(tube_admittance(port, d, fx, w, elastic_loss), fx, r1_nominal_ohm, w);
   }
   return z;
 }

@@ -57,8 +57,9 @@ struct ModalPortModel {
   double eps_t_over_s = 1.0;
 
   // Q/V at angular frequency ω (≥ 0) with Rayleigh damping and, optionally,
-  // Qm / tanδ (first-order modal approximation: ω_k² → ω_k² + jκ_k/Qm,
-  // C0 → C0(1 − j tanδ); the direct solve in model/harmonic.hpp is exact).
+  // Qm / tanδ on cE / εS (complex constants, first-order modal approximation:
+  // ω_k² → κ_k(1 + j/Qm) + (ω_k² − κ_k)/(1 − j tanδ), C0 → C0(1 − j tanδ);
+  // derivation in port_model.cpp; the direct solve in model/harmonic.hpp is exact).
   std::complex<double> charge_per_volt(double omega, const RayleighDamping& d,
                                        const MaterialLosses& l = {}) const;
 };

@@ -32,6 +32,16 @@ nlohmann::json output_error_json(const update::OeResult& r, const std::string& e
     o["chi2"] = 2.0 * r.optima_cost[k];
     optima.push_back(o);
   }
+  // The damping model fitted (issue 19): the Rayleigh fields always, the
+  // complex constants' Qm with its sigma beside them when that model was fitted.
+  nlohmann::json damping = {{"model", update::damping_name(r.damping_model)},
+                            {"rayleigh_alpha", r.damping.alpha},
+                            {"rayleigh_beta", r.damping.beta}};
+  if (r.damping_model == update::OeDamping::complex_constants) {
+    damping["qm"] = r.qm;
+    damping["qm_sigma"] = r.qm_sigma;
+    damping["qm_inverse"] = r.eta;
+  }
   return {{"method", "oe"},
           {"converged", r.ok()},
           {"status", update::to_string(r.status)},
@@ -40,7 +50,7 @@ nlohmann::json output_error_json(const update::OeResult& r, const std::string& e
           {"parameters", params},
           {"correlation", {{"names", names}, {"matrix", corr}}},
           {"corr_nu12_d31", r.corr_nu12_d31},
-          {"damping", {{"rayleigh_alpha", r.damping.alpha}, {"rayleigh_beta", r.damping.beta}}},
+          {"damping", damping},
           {"fit",
            {{"excitation", excitation},
             {"shots", r.shots_used},

@@ -314,20 +314,38 @@ double kappa_ratio_near(const model::ModalPortModel* port, double f_hz) {
 
 // Rayleigh damping of the model curves from the damping ratios of the zeros of
 // Z(s) at the first two resonances (the short-circuit modes; eqs 168-169 with
-// the model's κ/ω² of those modes); the seed's β = 1e-7 s when that fails.
+// the model's κ/ω² of those modes). Where the two-parameter fit is not
+// physical (α < 0 in every normal run), the one-parameter damping the two
+// modes support with its sigma, and their measured Qm (update::damping_from_modes,
+// issue 19); the seed's β = 1e-7 s only when the resonances give no damping.
 model::RayleighDamping damping_from_features(const dsp::ImpedanceResult& z, PipelineResult& out,
                                              const model::ModalPortModel* port) {
   model::RayleighDamping d{0.0, 1e-7};
   const auto& r = z.features.resonances;
   if (r.size() < 2 || !std::isfinite(r[0].damping_ratio) || !std::isfinite(r[1].damping_ratio)) return d;
-  auto fit = update::rayleigh_from_damping(r[0].f_hz, r[0].damping_ratio, r[1].f_hz, r[1].damping_ratio,
-                                           kappa_ratio_near(port, r[0].f_hz),
-                                           kappa_ratio_near(port, r[1].f_hz));
+  const auto fit = update::damping_from_modes(r[0].f_hz, r[0].damping_ratio, r[1].f_hz,
+                                              r[1].damping_ratio, kappa_ratio_near(port, r[0].f_hz),
+                                              kappa_ratio_near(port, r[1].f_hz));
   if (!fit.ok) {
-    out.warnings.push_back("Rayleigh damping from the resonances refused (" + fit.message +
+    out.warnings.push_back("damping from the resonances unusable (" + fit.message +
                            "); model curves use beta = 1e-7 s");
     return d;
   }
+  char buf[320];
+  if (fit.model == "rayleigh (alpha, beta)")
+    std::snprintf(buf, sizeof buf, "%s: alpha %.4g 1/s, beta %.4g s", fit.model.c_str(),
+                  fit.damping.alpha, fit.damping.beta);
+  else if (fit.damping.alpha == 0)
+    std::snprintf(buf, sizeof buf, "%s: beta %.4g +- %.2g s", fit.model.c_str(), fit.damping.beta,
+                  fit.beta_sigma);
+  else
+    std::snprintf(buf, sizeof buf, "%s: alpha %.4g +- %.2g 1/s", fit.model.c_str(),
+                  fit.damping.alpha, fit.alpha_sigma);
+  char qm[160];
+  std::snprintf(qm, sizeof qm, "; measured Qm %.4g at %.4g kHz, %.4g at %.4g kHz", fit.qm1,
+                r[0].f_hz / 1e3, fit.qm2, r[1].f_hz / 1e3);
+  out.damping_from_resonances =
+      std::string(buf) + qm + (fit.note.empty() ? "" : " (" + fit.note + ")");
   return fit.damping;
 }
 
@@ -655,11 +673,12 @@ void output_error_gap_curves(const acq::Capture& cap, const acq::Shot& shot, con
     var.push_back(dd * (s2 * s2 * std::norm(1.0 / x2[k] + 1.0 / xi) + s1 * s1 * std::norm(1.0 / xi)));
   }
   if (f.size() < 2) return;
-  auto curve = [&](const update::TubeParams& p, double beta_s, const model::EffectSet& fx) {
+  auto curve = [&](const update::TubeParams& p, const update::OeLoss& loss,
+                   const model::EffectSet& fx) {
     model::ModalOptions mo = oo.modal;
     mo.end_mass_fraction = fx.mass_loading;
     const auto port = cm.solver->port_model(cm.cls.e_form(p), mo);
-    const auto z = model::bench_impedance(port, {0.0, beta_s}, fx, r1, f);
+    const auto z = model::bench_impedance(port, {0.0, loss.beta_s}, fx, r1, f, loss.eta);
     update::GapCurve c;
     for (std::size_t i = 0; i < f.size(); ++i) {
       const auto l = std::log(zm[i] / z[i]);
@@ -673,11 +692,12 @@ void output_error_gap_curves(const acq::Capture& cap, const acq::Shot& shot, con
     }
     return c;
   };
-  d.before = curve(r.updated, r.damping.beta, r.effect_set);
+  d.before = curve(r.updated, r.loss(), r.effect_set);
   d.after = d.before;
   if (!d.steps.empty())
     for (const auto& e : r.effects)  // the fit with the verdict's effect: its constants, β and effects
-      if (e.name == d.steps.front().name && std::isfinite(e.value)) d.after = curve(e.material, e.beta_s, e.effect_set);
+      if (e.name == d.steps.front().name && std::isfinite(e.value))
+        d.after = curve(e.material, e.loss(), e.effect_set);
 }
 
 void diagnose_stage(const PipelineRequest& req, const acq::Capture& cap, const CaptureModel& cm,

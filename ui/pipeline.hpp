@@ -125,6 +125,10 @@ struct PipelineResult {
   std::string heldout_path;  // the held-out capture, when there is one
   std::vector<StageReport> stages;
   std::vector<std::string> warnings;
+  // The damping of the seed chain's model curves read from the first two
+  // resonances (when the seed chain's constants are used): the model and
+  // value with its sigma and the measured per-mode Qm (issue 19).
+  std::string damping_from_resonances;
 };
 
 struct PipelineProgress {

@@ -93,6 +93,7 @@ nlohmann::json report_json(const PipelineResult& r) {
   if (r.output_error) j["output_error"] = output_error_json(*r.output_error, r.output_error_excitation);
   if (r.diagnosis) j["diagnosis"] = diagnosis_json(*r.diagnosis);
   j["warnings"] = r.warnings;
+  if (!r.damping_from_resonances.empty()) j["damping_from_resonances"] = r.damping_from_resonances;
   return j;
 }
 

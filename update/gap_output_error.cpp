@@ -284,7 +284,7 @@ GapDiagnosis gap_from_output_error(const OeResult& r, const std::string& fit_des
   std::vector<bool> wanted(candidates.size(), false);
   auto predict_base = [&](model::ModalSolver& s) {
     try {
-      base = predict_output_error(s, cls, r.updated, r.damping.beta, r.effect_set, heldout.data, r.band_hz, options,
+      base = predict_output_error(s, cls, r.updated, r.loss(), r.effect_set, heldout.data, r.band_hz, options,
                                   r.covariance_rel);
     } catch (...) {
       base_error = std::current_exception();
@@ -293,7 +293,7 @@ GapDiagnosis gap_from_output_error(const OeResult& r, const std::string& fit_des
   auto predict_with = [&](model::ModalSolver& s, std::size_t i) {
     const OeEffect& e = *candidates[i];
     try {
-      with[i] = predict_output_error(s, cls, e.material, e.beta_s, e.effect_set, heldout.data, r.band_hz, options,
+      with[i] = predict_output_error(s, cls, e.material, e.loss(), e.effect_set, heldout.data, r.band_hz, options,
                                      e.covariance_rel, e.name);
     } catch (const std::exception& ex) {
       // not simulable with it (an end mass the FE model refuses, a value that

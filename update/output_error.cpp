@@ -30,7 +30,7 @@ namespace {
 
 constexpr double kTwoPi = 2.0 * M_PI;
 using cd = std::complex<double>;
-constexpr int kParams = 5;  // ln YE11, nu12 (relative), ln d31, ln εT33, ln β
+constexpr int kParams = 5;  // ln YE11, nu12 (relative), ln d31, ln εT33, ln β (or ln η, η = 1/Qm)
 
 [[noreturn]] void fail(const std::string& msg) {
   throw std::invalid_argument("fit_output_error: " + msg);
@@ -39,7 +39,8 @@ constexpr int kParams = 5;  // ln YE11, nu12 (relative), ln d31, ln εT33, ln β
 // The parameter vector θ relative to the nominal constants.
 struct Coordinates5 {
   TubeParams p0;
-  double beta0 = 1e-7;
+  double beta0 = 1e-7;  // the loss at x[4] = 0: β (rayleigh) or η = 1/Qm (complex constants)
+  OeDamping damping = OeDamping::rayleigh;
   TubeParams params(const Eigen::VectorXd& x) const {
     TubeParams p = p0;
     p.y_e11 = p0.y_e11 * std::exp(x[0]);
@@ -48,7 +49,13 @@ struct Coordinates5 {
     p.eps_t33 = p0.eps_t33 * std::exp(x[3]);
     return p;
   }
-  double beta(const Eigen::VectorXd& x) const { return beta0 * std::exp(x[4]); }
+  double loss(const Eigen::VectorXd& x) const { return beta0 * std::exp(x[4]); }
+  double beta(const Eigen::VectorXd& x) const {
+    return damping == OeDamping::rayleigh ? loss(x) : 0.0;
+  }
+  double eta(const Eigen::VectorXd& x) const {
+    return damping == OeDamping::complex_constants ? loss(x) : 0.0;
+  }
 };
 
 // Shots averaged per (length, pretrigger) group; the largest group is used.
@@ -232,7 +239,7 @@ class Problem {
   std::optional<std::vector<cd>> transfer(const Eigen::VectorXd& x, const model::EffectSet& fx) {
     const model::ModalPortModel* pp = port_of(x, fx.mass_loading);
     if (!pp) return std::nullopt;
-    return transfer_of(*pp, co_.beta(x), fx);
+    return transfer_of(*pp, co_.beta(x), co_.eta(x), fx);
   }
 
   // The port models' tangent ∂port/∂x_c (c < 4: the constants) by forward
@@ -317,7 +324,7 @@ class Problem {
     if (!at || !same_structure(*at, tangent_.base)) return std::nullopt;
     model::ModalPortModel p = *at;
     for (int c = 0; c < 4; ++c) shift(p, tangent_.plus[static_cast<std::size_t>(c)], (x[c] - anchor[c]) / tangent_.h);
-    return transfer_of(p, co_.beta(x), fx);
+    return transfer_of(p, co_.beta(x), co_.eta(x), fx);
   }
   // T at x with the constant c moved by h, through the tangent (tangent_near).
   std::optional<std::vector<cd>> tangent_transfer(const Eigen::VectorXd& x, int c, double h) {
@@ -329,7 +336,7 @@ class Problem {
     if (!at || !same_structure(*at, tangent_.base)) return std::nullopt;
     model::ModalPortModel p = *at;
     shift(p, tangent_.plus[static_cast<std::size_t>(c)], h / tangent_.h);
-    return transfer_of(p, co_.beta(x), fx);
+    return transfer_of(p, co_.beta(x), co_.eta(x), fx);
   }
 
   // Filtered output error for a given transfer.
@@ -399,7 +406,7 @@ class Problem {
     for (std::size_t k = 2 * r; k <= kmax_; k += r) {
       if (std::abs(l_[k]) < 0.5 * lmax) continue;
       const double w = kTwoPi * fs_ * double(k) / double(nfft_);
-      const cd y = model::tube_admittance(*pp, damp, fx, w);
+      const cd y = model::tube_admittance(*pp, damp, fx, w, co_.eta(x));
       const cd t = model::recorded_transfer(y, fx, r1_, w);
       const cd dy = 1e-6 * std::abs(y);
       const cd dt = (model::recorded_transfer(y + dy, fx, r1_, w) - t) / dy;
@@ -452,12 +459,13 @@ class Problem {
       m.participation = std::abs(m.participation) + k * (std::abs(mp.participation) - std::abs(mb.participation));
     }
   }
-  std::vector<cd> transfer_of(const model::ModalPortModel& port, double beta, const model::EffectSet& fx) const {
+  std::vector<cd> transfer_of(const model::ModalPortModel& port, double beta, double eta,
+                              const model::EffectSet& fx) const {
     const model::RayleighDamping damp{0.0, beta};
     std::vector<cd> t(kmax_ + 1);
     for (std::size_t k = 0; k <= kmax_; ++k) {
       const double w = kTwoPi * fs_ * double(k) / double(nfft_);
-      const cd yt = w > 0 ? model::tube_admittance(port, damp, fx, w) : cd(0.0, 0.0);
+      const cd yt = w > 0 ? model::tube_admittance(port, damp, fx, w, eta) : cd(0.0, 0.0);
       t[k] = model::recorded_transfer(yt, fx, r1_, w);
     }
     return t;
@@ -1014,6 +1022,27 @@ class Fitter {
 
 }  // namespace
 
+const char* damping_name(OeDamping d) {
+  return d == OeDamping::complex_constants ? "complex constants" : "rayleigh";
+}
+
+std::string damping_summary(const OeResult& r) {
+  char buf[160];
+  if (r.damping_model == OeDamping::complex_constants)
+    std::snprintf(buf, sizeof buf, "complex constants Qm %.4g +- %.2g (1/Qm on cE)", r.qm,
+                  r.qm_sigma);
+  else
+    std::snprintf(buf, sizeof buf, "Rayleigh beta %.4g s", r.damping.beta);
+  return buf;
+}
+
+std::optional<OeDamping> parse_damping(const std::string& s) {
+  if (s == "rayleigh") return OeDamping::rayleigh;
+  if (s == "complex" || s == "complex constants" || s == "complex_constants")
+    return OeDamping::complex_constants;
+  return std::nullopt;
+}
+
 std::optional<EffectCoordinate> effect_coordinate(const std::string& name) {
   EffectCoordinate c;
   if (name == "daq_input_resistance") {  // 1/R: x·1 µS
@@ -1071,7 +1100,10 @@ OeResult fit_output_error(model::ModalSolver& solver, const MaterialClass& cls,
   out.cp_sigma_f = opt.cp_sigma_f;
   out.gain_rel_sigma = opt.gain_rel_sigma;
   out.skew_sigma_s = opt.skew_sigma_s;
-  Coordinates5 co{nominal, opt.beta0_s};
+  const bool complex_loss = opt.damping == OeDamping::complex_constants;
+  if (complex_loss && !(opt.eta0 > 0 && std::isfinite(opt.eta0)))
+    fail("eta0 (1/Qm to start from) must be > 0");
+  Coordinates5 co{nominal, complex_loss ? opt.eta0 : opt.beta0_s, opt.damping};
   try {
     out.band_hz = opt.band_hz > 0 ? opt.band_hz
                                   : std::min(1.6 * third_active_mode_hz(solver, cls, nominal, opt.modal),
@@ -1227,6 +1259,8 @@ OeResult fit_output_error(model::ModalSolver& solver, const MaterialClass& cls,
   }
   out.updated = co.params(best.x);
   out.damping = {0.0, co.beta(best.x)};
+  out.damping_model = opt.damping;
+  out.eta = co.eta(best.x);
   out.effect_set = prob.effects();
 
   // Noise at the answer, χ², covariance.
@@ -1333,8 +1367,13 @@ OeResult fit_output_error(model::ModalSolver& solver, const MaterialClass& cls,
       {"d31", "C/N", u.d31, std::abs(u.d31) * sx[2], nominal.d31, opt.identifiable_rel_sigma},
       {"epsT33_rel", "-", u.eps_t33 / model::kEps0, u.eps_t33 / model::kEps0 * sx[3],
        nominal.eps_t33 / model::kEps0, opt.identifiable_rel_sigma},
-      {"beta", "s", beta, beta * sx[4], opt.beta0_s, 0.5},
+      complex_loss ? Row{"qm_inverse", "-", out.eta, out.eta * sx[4], opt.eta0, 0.5}
+                   : Row{"beta", "s", beta, beta * sx[4], opt.beta0_s, 0.5},
   };
+  if (complex_loss && out.eta > 0) {
+    out.qm = 1.0 / out.eta;
+    out.qm_sigma = out.qm * sx[4];  // the same relative sigma (first order in ln η)
+  }
   for (int i = 0; i < kParams; ++i) {
     OeParameter p;
     p.name = rows[i].name;
@@ -1425,6 +1464,8 @@ OeResult fit_output_error(model::ModalSolver& solver, const MaterialClass& cls,
     e.converged = run.converged;
     e.material = co.params(run.x.head(kParams));
     e.beta_s = co.beta(run.x.head(kParams));
+    e.eta = co.eta(run.x.head(kParams));
+    e.damping_model = opt.damping;
     e.effect_set = p.effects();
     rf.apply(e.effect_set, run.x[kParams]);
     const double dof_e = std::max(1.0, dof - 1.0);
@@ -1528,6 +1569,8 @@ OeResult fit_output_error(model::ModalSolver& solver, const MaterialClass& cls,
       e.linearised = true;
       e.material = out.updated;
       e.beta_s = out.damping.beta;
+      e.eta = out.eta;
+      e.damping_model = out.damping_model;
       e.effect_set = p.effects();
       apply(e.effect_set, step_lin);
       e.delta_chi2 = score;
@@ -1680,13 +1723,24 @@ OePrediction predict_output_error(model::ModalSolver& solver, const MaterialClas
                                   double beta_s, const model::EffectSet& effects, const OeData& data,
                                   double band_hz, const OeOptions& opt, const Eigen::MatrixXd& covariance_rel,
                                   const std::string& effect) {
+  return predict_output_error(solver, cls, params, OeLoss{OeDamping::rayleigh, beta_s, 0.0},
+                              effects, data, band_hz, opt, covariance_rel, effect);
+}
+
+OePrediction predict_output_error(model::ModalSolver& solver, const MaterialClass& cls,
+                                  const TubeParams& params, const OeLoss& loss,
+                                  const model::EffectSet& effects, const OeData& data,
+                                  double band_hz, const OeOptions& opt,
+                                  const Eigen::MatrixXd& covariance_rel,
+                                  const std::string& effect) {
   const double fs = data.sample_rate_hz;
   if (!(fs > 0) || !std::isfinite(fs)) fail("sample rate must be positive");
   data.circuit.validate();
   if (!(band_hz > 0) || !(band_hz < fs / 4)) fail("band above a quarter of the held-out capture's sample rate");
   const Averaged rec = average(data);
   if (rec.v1.size() < 256) fail("too short: " + std::to_string(rec.v1.size()) + " samples (need 256)");
-  const Coordinates5 co{params, beta_s};
+  const Coordinates5 co{params, loss.model == OeDamping::complex_constants ? loss.eta : loss.beta_s,
+                        loss.model};
   Problem prob(solver, cls, co, rec, data, band_hz, opt.modal);
   const Eigen::VectorXd x = Eigen::VectorXd::Zero(kParams);
   const auto t = prob.transfer(x, effects);

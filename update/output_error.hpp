@@ -36,6 +36,7 @@
 //               pin it).
 #include <Eigen/Core>
 #include <functional>
+#include <limits>
 #include <optional>
 #include <span>
 #include <string>
@@ -64,6 +65,30 @@ struct OeData {
   double v2_delay_s = 0;          // channel 2 recorded late by this (a measured skew)
 };
 
+// How the tube's mechanical loss is modelled (issue 19, item 2):
+//  rayleigh          C = βK_UU (α = 0): mode k damped by jωβκ_k, ξ_k ∝ ω — the
+//                    fifth coordinate is ln β;
+//  complex_constants cE·(1 + j/Qm), the hysteretic loss of the piezo-
+//                    characterisation programs: jκ_k/Qm per mode (mode k's
+//                    Qm_k = Qm·ω_k²/κ_k, independent of frequency) — the fifth
+//                    coordinate is ln(1/Qm) (model::tube_admittance's elastic_loss).
+enum class OeDamping { rayleigh, complex_constants };
+const char* damping_name(OeDamping d);  // "rayleigh" | "complex constants"
+// "rayleigh" | "complex" (or "complex constants"); nullopt otherwise.
+std::optional<OeDamping> parse_damping(const std::string& s);
+
+// "Rayleigh beta 1.02e-07 s" or "complex constants Qm 95.3 +- 1.2" (displays).
+struct OeResult;
+std::string damping_summary(const OeResult& r);
+
+// A fitted loss: the model and its one value (β for rayleigh, η = 1/Qm for
+// complex constants; the other is 0).
+struct OeLoss {
+  OeDamping model = OeDamping::rayleigh;
+  double beta_s = 0;  // Rayleigh β (s)
+  double eta = 0;     // 1/Qm
+};
+
 struct OeOptions {
   double band_hz = 0;  // 0: 1.6 × the nominal model's third electrically active mode
   model::ModalOptions modal = [] {
@@ -72,6 +97,12 @@ struct OeOptions {
     return m;
   }();
   double beta0_s = 1e-7;  // Rayleigh β to start from (the seed's value)
+  // The damping model fitted (OeDamping; the default was chosen by the
+  // comparison study, update/README.md) and, for complex constants, the
+  // 1/Qm to start from (Qm = 100, soft PZT; β = 1e-7 s gives the 50 kHz hoop
+  // mode Qm ≈ 32).
+  OeDamping damping = OeDamping::rayleigh;
+  double eta0 = 1e-2;
   // Coarse stage: the grid (1 ± span) over YE11 and nu12; LM from the best `refine` points.
   double grid_span_ye11 = 0.08, grid_span_nu12 = 0.10;
   int refine = 3;
@@ -144,7 +175,10 @@ struct OeEffect {
   // quarter of the significance, so value, σ and Δχ² are the linear ones.
   bool linearised = false;
   TubeParams material;  // the constants refitted with it
-  double beta_s = 0;    // … and the Rayleigh β
+  double beta_s = 0;    // … and the Rayleigh β (0 with complex constants)
+  double eta = 0;       // … or 1/Qm (complex constants; 0 with Rayleigh)
+  OeDamping damping_model = OeDamping::rayleigh;
+  OeLoss loss() const { return {damping_model, beta_s, eta}; }
   // The whole effect set of the fit with it (the bench's known effects and
   // this one at its value): what predicts another capture with it.
   model::EffectSet effect_set;
@@ -172,8 +206,17 @@ struct OeResult {
   UpdateStatus status = UpdateStatus::bad_input;
   std::string message;
   TubeParams original, updated;
-  model::RayleighDamping damping;           // fitted β (α = 0)
-  std::vector<OeParameter> parameters;      // YE11, nu12, d31, epsT33_rel, beta
+  model::RayleighDamping damping;  // fitted β (α = 0); β = 0 with complex constants
+  // The damping model fitted (OeOptions::damping) and, with complex
+  // constants, the fitted loss as Qm = 1/η with its sigma (statistical and
+  // type B as the other parameters'; NaN/inf with Rayleigh).
+  OeDamping damping_model = OeDamping::rayleigh;
+  double eta = 0;  // 1/Qm (complex constants)
+  double qm = std::numeric_limits<double>::infinity(),
+         qm_sigma = std::numeric_limits<double>::quiet_NaN();
+  OeLoss loss() const { return {damping_model, damping.beta, eta}; }
+  // YE11, nu12, d31, epsT33_rel, then "beta" (Rayleigh) or "qm_inverse" (1/Qm, complex constants)
+  std::vector<OeParameter> parameters;
   Eigen::MatrixXd correlation;              // same order as parameters
   double corr_nu12_d31 = 0;
   double band_hz = 0;
@@ -200,7 +243,7 @@ struct OeResult {
   model::EffectSet effect_set;               // the bench's known effects the fit held (a measured fixture's)
   // Statistical covariance (Birge-widened, no type-B part) of the fit's
   // coordinates at the answer, RELATIVE to it: ln YE11, nu12/nu12 − 1, ln d31,
-  // ln εT33, ln β (what the held-out prediction propagates).
+  // ln εT33, ln β or ln(1/Qm) (what the held-out prediction propagates).
   Eigen::MatrixXd covariance_rel;
   std::vector<TubeParams> optima;            // every refined start's optimum (best first)
   std::vector<double> optima_cost;
@@ -258,6 +301,14 @@ struct OePrediction {
 // sees the fit's constants' sigmas, which are no gap.
 OePrediction predict_output_error(model::ModalSolver& solver, const MaterialClass& cls, const TubeParams& params,
                                   double beta_s, const model::EffectSet& effects, const OeData& data,
+                                  double band_hz, const OeOptions& options = {},
+                                  const Eigen::MatrixXd& covariance_rel = {},
+                                  const std::string& effect = "");
+// The same with the fit's damping model (OeResult/OeEffect::loss()): a held-out
+// prediction must use the damping model that was fitted.
+OePrediction predict_output_error(model::ModalSolver& solver, const MaterialClass& cls,
+                                  const TubeParams& params, const OeLoss& loss,
+                                  const model::EffectSet& effects, const OeData& data,
                                   double band_hz, const OeOptions& options = {},
                                   const Eigen::MatrixXd& covariance_rel = {},
                                   const std::string& effect = "");

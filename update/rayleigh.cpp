@@ -1,6 +1,7 @@
 #include "update/rayleigh.hpp"
 
 #include <cmath>
+#include <limits>
 #include <sstream>
 
 namespace piezo::update {
@@ -46,6 +47,56 @@ RayleighFit rayleigh_from_damping(double f1_hz, double zeta1, double f2_hz, doub
   }
   r.ok = true;
   return r;
+}
+
+ModeDamping damping_from_modes(double f1_hz, double zeta1, double f2_hz, double zeta2,
+                               double kappa_ratio1, double kappa_ratio2) {
+  ModeDamping out;
+  const RayleighFit two =
+      rayleigh_from_damping(f1_hz, zeta1, f2_hz, zeta2, kappa_ratio1, kappa_ratio2);
+  if (two.ok) {
+    out.ok = true;
+    out.damping = two.damping;
+    out.model = "rayleigh (alpha, beta)";
+  } else if (two.damping.alpha < 0 || two.damping.beta < 0) {
+    // Input was usable (the solution exists) but not physical: fit one
+    // parameter to both modes. y_k = 2ω_kξ_k = a·x_k with x_k = κ_k (β only)
+    // or 1 (α only); least squares a = Σx y / Σx², s² = Σ(y − a x)²/(2 − 1),
+    // σ_a = s/sqrt(Σx²).
+    const double w1 = 2 * M_PI * f1_hz, w2 = 2 * M_PI * f2_hz;
+    const double y[2] = {2 * zeta1 * w1, 2 * zeta2 * w2};
+    const bool beta_only = two.damping.alpha < 0;
+    const double x[2] = {beta_only ? kappa_ratio1 * w1 * w1 : 1.0,
+                         beta_only ? kappa_ratio2 * w2 * w2 : 1.0};
+    const double sxx = x[0] * x[0] + x[1] * x[1];
+    const double a = (x[0] * y[0] + x[1] * y[1]) / sxx;
+    const double r0 = y[0] - a * x[0], r1 = y[1] - a * x[1];
+    const double sigma = std::sqrt((r0 * r0 + r1 * r1) / sxx);
+    std::ostringstream n;
+    n.precision(4);
+    n << "the two-parameter Rayleigh solution has " << (beta_only ? "alpha = " : "beta = ")
+      << (beta_only ? two.damping.alpha : two.damping.beta) << (beta_only ? " 1/s" : " s")
+      << " < 0 (zeta " << zeta1 << " at " << f1_hz << " Hz, " << zeta2 << " at " << f2_hz
+      << " Hz): the damping these modes support is " << (beta_only ? "stiffness" : "mass")
+      << "-proportional, fitted to both";
+    out.ok = true;
+    out.note = n.str();
+    if (beta_only) {
+      out.damping = {0.0, a};
+      out.beta_sigma = sigma;
+      out.model = "stiffness-proportional (beta only)";
+    } else {
+      out.damping = {a, 0.0};
+      out.alpha_sigma = sigma;
+      out.model = "mass-proportional (alpha only)";
+    }
+  } else {
+    out.message = two.message;
+    return out;
+  }
+  out.qm1 = zeta1 > 0 ? 0.5 / zeta1 : std::numeric_limits<double>::infinity();
+  out.qm2 = zeta2 > 0 ? 0.5 / zeta2 : std::numeric_limits<double>::infinity();
+  return out;
 }
 
 }  // namespace piezo::update

@@ -56,12 +56,21 @@ TEST(CliUpdate, BothMethodsAndOverlay) {
   std::filesystem::remove(overlay);
 }
 
-TEST(CliUpdate, NegativeRayleighIsRefusedNotUsed) {
+// Issue 19: a two-mode Rayleigh solution with β < 0 (ζ falling faster than
+// 1/ω) is no longer refused: the one-parameter (mass-proportional) damping the
+// two modes support is used, with its sigma and the measured Qm of each mode.
+TEST(CliUpdate, NegativeRayleighBecomesTheDampingTheModesSupport) {
   const auto r = run_cli(kTable45 + "--damping 50000:0.02,100000:0.005 --json");
   ASSERT_EQ(r.exit_code, 0) << r.err;
   const auto j = nlohmann::json::parse(r.out);
-  EXPECT_FALSE(j["rayleigh"]["ok"].get<bool>());
-  EXPECT_NE(j["rayleigh"]["message"].get<std::string>().find("negative"), std::string::npos);
+  EXPECT_TRUE(j["rayleigh"]["ok"].get<bool>());
+  EXPECT_EQ(j["rayleigh"]["model"].get<std::string>(), "mass-proportional (alpha only)");
+  EXPECT_EQ(j["rayleigh"]["beta"].get<double>(), 0.0);
+  EXPECT_GT(j["rayleigh"]["alpha"].get<double>(), 0.0);
+  EXPECT_GT(j["rayleigh"]["alpha_sigma"].get<double>(), 0.0);
+  EXPECT_NEAR(j["rayleigh"]["qm"][0].get<double>(), 25.0, 1e-9);
+  EXPECT_NEAR(j["rayleigh"]["qm"][1].get<double>(), 100.0, 1e-9);
+  EXPECT_NE(j["rayleigh"]["message"].get<std::string>().find("beta"), std::string::npos);
 }
 
 TEST(CliUpdate, BadInputExitsTwo) {

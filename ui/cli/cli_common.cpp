@@ -2,9 +2,10 @@
 
 #include <unistd.h>
 
-#include <iomanip>
 #include <cstdio>
+#include <iomanip>
 #include <iostream>
+#include <map>
 
 #include "acquisition/capture.hpp"
 #include "ui/json_text.hpp"
@@ -64,6 +65,15 @@ void add_chain_tolerance_options(CLI::App* cmd, update::OeOptions& o) {
   cmd->add_option("--skew-sigma", o.skew_sigma_s, "Standard uncertainty of the channels' skew, s")
       ->check(CLI::Range(0.0, 1e-3))
       ->capture_default_str();
+  // Issue 19: the damping model of the output-error fit.
+  static const std::map<std::string, update::OeDamping> damping_models = {
+      {"rayleigh", update::OeDamping::rayleigh}, {"complex", update::OeDamping::complex_constants}};
+  cmd->add_option(
+         "--damping-model", o.damping,
+         "Damping model of the output-error fit: rayleigh (C = beta K) or complex (cE(1 + j/Qm), "
+         "Qm fitted with its sigma)")
+      ->transform(CLI::CheckedTransformer(damping_models, CLI::ignore_case))
+      ->default_str(o.damping == update::OeDamping::rayleigh ? "rayleigh" : "complex");
 }
 
 void add_json_flag(CLI::App* cmd, Context& ctx) {

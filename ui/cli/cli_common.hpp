@@ -35,7 +35,8 @@ void print_json(const nlohmann::json& j);
 void add_json_flag(CLI::App* cmd, Context& ctx);
 // The measurement chain's tolerances that the output-error fit carries into
 // every sigma (update::OeOptions): --r1-tolerance, --cp-sigma,
-// --gain-tolerance, --skew-sigma, defaults as OeOptions states them.
+// --gain-tolerance, --skew-sigma, defaults as OeOptions states them; and its
+// damping model, --damping-model rayleigh|complex (OeOptions::damping).
 void add_chain_tolerance_options(CLI::App* cmd, update::OeOptions& o);
 
 // Text progress bar on stderr (only when stderr is a terminal or forced).

@@ -115,10 +115,13 @@ void register_demo_command(CLI::App& app, Context& ctx) {
                       t, oe, os, oee, p.oe_status.c_str(), cm, cme, lm, lme);
         }
         if (res.output_error)
-          std::printf("  corr(nu12, d31) of the output-error fit: %+.3f; fitted Rayleigh beta %.4g s\n",
-                      res.output_error->corr_nu12_d31, res.output_error->damping.beta);
+          std::printf("  corr(nu12, d31) of the output-error fit: %+.3f; fitted %s\n",
+                      res.output_error->corr_nu12_d31,
+                      update::damping_summary(*res.output_error).c_str());
       }
       if (res.diagnosis) print_diagnosis(std::cout, *res.diagnosis);
+      if (!res.damping_from_resonances.empty())
+        std::cout << "  damping from the resonances: " << res.damping_from_resonances << "\n";
       for (const auto& w : res.warnings) std::cout << "  warning: " << w << "\n";
       std::cout << "\n  capture: " << res.capture_path << " (inspect: piezobench capture info " << res.capture_path
                 << ")\n";

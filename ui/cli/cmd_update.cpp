@@ -265,12 +265,20 @@ void run_update_features(Context& ctx, const UpdateArgs& a0, const std::string& 
                       pu::parse_list(item.substr(c + 1)).at(0));
     }
     if (fz.size() != 2) throw InputError("--damping: exactly two modes F1:ZETA1,F2:ZETA2");
-    const auto fit =
-        pu::rayleigh_from_damping(fz[0].first, fz[0].second, fz[1].first, fz[1].second);
+    // The two-parameter fit where physical, else the one-parameter damping
+    // the two modes support with its sigma (issue 19: no refusal).
+    const auto fit = pu::damping_from_modes(fz[0].first, fz[0].second, fz[1].first, fz[1].second);
+    auto num = [](double x) {
+      return std::isfinite(x) ? nlohmann::json(x) : nlohmann::json(nullptr);
+    };
     out["rayleigh"] = {{"ok", fit.ok},
-                       {"message", fit.message},
+                       {"message", fit.ok ? fit.note : fit.message},
                        {"alpha", fit.damping.alpha},
-                       {"beta", fit.damping.beta}};
+                       {"beta", fit.damping.beta},
+                       {"model", fit.model},
+                       {"alpha_sigma", num(fit.alpha_sigma)},
+                       {"beta_sigma", num(fit.beta_sigma)},
+                       {"qm", {num(fit.qm1), num(fit.qm2)}}};
     if (fit.ok)
       damping = fit.damping;
     else

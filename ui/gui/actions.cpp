@@ -107,6 +107,8 @@ bool collect_job(AppState& s) {
   for (const auto& st : r.stages)
     s.log.push_back((st.ran ? "  ran " : "  skipped ") + st.name + ": " + st.note);
   for (const auto& w : r.warnings) s.log.push_back("  warning: " + w);
+  if (!r.damping_from_resonances.empty())
+    s.log.push_back("  damping from the resonances: " + r.damping_from_resonances);
   s.warnings = result_problems(r);
   judge_result(s);
   if (s.verdict)

@@ -39,9 +39,10 @@ void parameter_table(const ui::PipelineResult& r) {
     ImGui::Text("%.5g", p.updated);
     if (ImGui::IsItemHovered()) {
       if (r.output_error && r.output_error->ok())
-        ImGui::SetTooltip("%s\ncorr(nu12, d31) %+.2f, chi2/dof %.3g (limit %.3g), Rayleigh beta %.3g s", method,
-                          r.output_error->corr_nu12_d31, r.output_error->chi2_per_dof, r.output_error->chi2_limit,
-                          r.output_error->damping.beta);
+        ImGui::SetTooltip("%s\ncorr(nu12, d31) %+.2f, chi2/dof %.3g (limit %.3g), %s", method,
+                          r.output_error->corr_nu12_d31, r.output_error->chi2_per_dof,
+                          r.output_error->chi2_limit,
+                          update::damping_summary(*r.output_error).c_str());
       else
         ImGui::SetTooltip("%s", method);
     }

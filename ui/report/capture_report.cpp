@@ -56,8 +56,9 @@ std::string capture_summary_markdown(const ui::PipelineResult& r, const CaptureI
         << " | " << cell(p.status) << " | " << (p.cmcm ? fmt("%.6g", *p.cmcm) : "-") << " |\n";
     if (r.output_error && r.output_error->ok())
       o << "\ncorr(nu12, d31) " << fmt("%+.3f", r.output_error->corr_nu12_d31) << ", chi2/dof "
-        << fmt("%.3g", r.output_error->chi2_per_dof) << " (limit " << fmt("%.3g", r.output_error->chi2_limit)
-        << "), Rayleigh beta " << fmt("%.3g s", r.output_error->damping.beta) << "\n";
+        << fmt("%.3g", r.output_error->chi2_per_dof) << " (limit "
+        << fmt("%.3g", r.output_error->chi2_limit) << "), "
+        << update::damping_summary(*r.output_error) << "\n";
   }
   o << "\n## Features (Prony-SS)\n\n";
   auto list = [&](const char* what, const std::vector<double>& v) {
