@@ -11,8 +11,10 @@ CaptureModeFigures capture_mode_figures(const acq::Capture& cap, const dsp::Impe
   dsp::ModeFigureOptions o;
   o.mean_diameter_m = 0.5 * (g.inner_diameter_m + g.outer_diameter_m);
   out.mean_diameter_m = o.mean_diameter_m;
-  out.mean_diameter_source = given ? "capture /setup" : "the project's default tube (not in the capture)";
-  const Eigen::VectorXd sigma = z.z_sigma_ohm.size() == z.f_hz.size() ? z.z_sigma_ohm : Eigen::VectorXd();
+  out.mean_diameter_source =
+      given ? "capture /setup" : "the project's default tube (not in the capture)";
+  const Eigen::VectorXd sigma =
+      z.z_sigma_ohm.size() == z.f_hz.size() ? z.z_sigma_ohm : Eigen::VectorXd();
   try {
     out.figures = dsp::mode_figures(z.f_hz, z.z_ohm, sigma, o);
   } catch (const std::invalid_argument& e) {  // a grid too short for figures: the impedance stands

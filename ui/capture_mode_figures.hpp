@@ -16,8 +16,9 @@ namespace piezo::ui {
 struct CaptureModeFigures {
   dsp::ModeFiguresResult figures;
   double mean_diameter_m = 0;
-  std::string mean_diameter_source;  // "capture /setup" | "the project's default tube (not in the capture)"
-  std::string error;                 // non-empty: no figures (e.g. a grid too short), and why
+  std::string
+      mean_diameter_source;  // "capture /setup" | "the project's default tube (not in the capture)"
+  std::string error;         // non-empty: no figures (e.g. a grid too short), and why
 };
 
 CaptureModeFigures capture_mode_figures(const acq::Capture& cap, const dsp::ImpedanceResult& z);

@@ -248,6 +248,34 @@ TEST(Gui, ReplayOfARecordedCapture) {
   EXPECT_FALSE(j["verdict_shown"].get<std::string>().empty());
 }
 
+// Limits loaded with 'Limits...' (as `replay --limits`): the replayed
+// capture's result is judged and its pass/fail and reasons are shown.
+TEST(Gui, LimitsShowPassOrFailWithTheReasons) {
+  ScratchCleanup cleanup;
+  const fs::path dir = scratch();
+  fs::create_directories(dir);
+  const fs::path cap = dir / "limits-capture.h5", limits = dir / "limits.toml";
+  const std::string measure =
+      std::string("'") + PIEZO_CLI +
+      "' measure --instrument sim --sim-isotropic "
+      "--sim-set YE11=6.66e10,nu12=0.3333,d31=-210e-12,epsT33_rel=2294 --noise 0.005 "
+      "--shots 2 --overwrite --out '" +
+      cap.string() + "' > /dev/null 2>&1";
+  ASSERT_EQ(std::system(measure.c_str()), 0);
+  // YE11 must exceed 7e10 (it is ~6.66e10: fail); C^T is in range (pass).
+  std::ofstream(limits) << "[[limit]]\nquantity = \"parameters.YE11\"\nunit = \"Pa\"\nmin = 7e10\n"
+                           "[[limit]]\nquantity = \"mode_summary.free_capacitance_f\"\nmin = 1e-9\nmax = 1e-7\n";
+  auto run = run_gui("limits", "--replay '" + cap.string() + "' --limits '" + limits.string() +
+                                   "' --click 'Limits...' --click 'Replay capture' --wait-job");
+  ASSERT_EQ(run.exit_code, 0) << "GUI run failed; see " << (run.dir / "gui.log");
+  const auto& j = run.stats;
+  EXPECT_EQ(j["error"], "");
+  EXPECT_EQ(j["limits_status"], "fail");
+  ASSERT_EQ(j["limits_reasons"].size(), 1u) << j["limits_reasons"].dump();
+  EXPECT_EQ(j["limits_reasons"][0].get<std::string>().rfind("parameters.YE11 = 6.", 0), 0u);
+  EXPECT_NE(j["limits_reasons"][0].get<std::string>().find("< min 7e+10 Pa"), std::string::npos);
+}
+
 // Errors end in the window with what to do, never in a crash: exit code 2
 // (the run's error) with the problem's kind and advice in the statistics.
 TEST(Gui, ErrorsAreShownWithWhatToDo) {

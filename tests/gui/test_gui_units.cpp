@@ -259,3 +259,37 @@ TEST(ModeNyquist, ExactBvdPointsOnTheFittedCircle) {
     EXPECT_GE(near, 5);
   }
 }
+
+// The result of a job judged against the loaded limits (actions.cpp's
+// judge_result, as collect_job and load_limits call it): no limits or no
+// result, no verdict; otherwise pass or fail with the reasons.
+TEST(Limits, JudgeResultAgainstTheLoadedLimits) {
+  AppState s;
+  judge_result(s);
+  EXPECT_FALSE(s.verdict);
+  auto r = std::make_shared<ui::PipelineResult>();
+  ui::ParamRow p;
+  p.name = "YE11";
+  p.unit = "Pa";
+  p.original = 6.3e10;
+  p.updated = 6.5e10;
+  r->params.push_back(p);
+  s.result = r;
+  judge_result(s);
+  EXPECT_FALSE(s.verdict);  // no limits loaded
+  s.limits = std::make_shared<const report::Limits>(report::parse_limits(
+      "[[limit]]\nquantity = \"parameters.YE11\"\nmin = 6e10\nmax = 7e10\n", "l.toml"));
+  judge_result(s);
+  ASSERT_TRUE(s.verdict);
+  EXPECT_EQ(s.verdict->status, "pass");
+  r->params[0].updated = 7.5e10;
+  judge_result(s);
+  EXPECT_EQ(s.verdict->status, "fail");
+  ASSERT_EQ(s.verdict->reasons.size(), 1u);
+  EXPECT_EQ(s.verdict->reasons[0], "parameters.YE11 = 7.5e+10 > max 7e+10");
+  s.limits = std::make_shared<const report::Limits>(report::parse_limits(
+      "[[limit]]\nquantity = \"modes[0].k_eff\"\nmin = 0.1\n", "l.toml"));
+  judge_result(s);  // the result has no per-mode figures: not measured, a fail
+  EXPECT_EQ(s.verdict->status, "fail");
+  EXPECT_EQ(s.verdict->reasons[0], "modes[0].k_eff not measured");
+}

@@ -3,7 +3,9 @@
 // `piezobench replay-merge A.h5 B.h5 ... --out ALL.h5` for sharded runs.
 // Exit codes: 0 every capture replayed; 2 some captures were refused or
 // failed (each reported, the batch went on) or bad options; 1 the batch
-// itself failed or was interrupted (rerun the same command to resume).
+// itself failed or was interrupted (rerun the same command to resume). With
+// --limits, captures that fail their limits do not change the exit code: the
+// verdicts are data (the records, the lot summary), not errors of the run.
 #include <unistd.h>
 
 #include <csignal>
@@ -14,6 +16,8 @@
 #include "ui/cli/cli_common.hpp"
 #include "ui/replay/merge.hpp"
 #include "ui/replay/replay_batch.hpp"
+#include "ui/report/limits.hpp"
+#include "ui/report/lot_summary.hpp"
 #include "ui/version.hpp"
 
 namespace piezo::cli {
@@ -51,6 +55,29 @@ auto as_input(F&& f) {
   }
 }
 
+// The lot against the limits: counts, then each capture that did not pass with its reasons.
+void print_lot(const report::Limits& l, const report::LotSummary& s,
+               const std::optional<std::filesystem::path>& report_dir) {
+  std::printf("limits %s: %zu pass, %zu fail, %zu error of %zu record(s) in the results file%s\n",
+              l.source.c_str(), s.pass, s.fail, s.error, s.captures.size(),
+              report_dir ? (", lot report: " + (*report_dir / "lot.md").string()).c_str() : "");
+  for (const auto& q : s.quantities) {
+    const auto& lim = l.limits[q.limit];
+    if (!lim.numeric()) continue;
+    std::printf("  %-36s n %zu  mean %.6g  sd %.3g  fail low %zu high %zu  not measured %zu", lim.label.c_str(),
+                q.n, q.mean, q.sd, q.below, q.above, q.not_measured);
+    if (q.capability.cpk) std::printf("  Cpk %.2f", *q.capability.cpk);
+    std::printf("\n");
+  }
+  for (const auto& c : s.captures)
+    if (c.verdict.status != "pass") {
+      std::printf("  %s %s:", c.verdict.status == "fail" ? "FAIL " : "ERROR", c.path.c_str());
+      for (std::size_t k = 0; k < c.verdict.reasons.size(); ++k)
+        std::printf("%s %s", k ? ";" : "", c.verdict.reasons[k].c_str());
+      std::printf("\n");
+    }
+}
+
 }  // namespace
 
 void register_replay_commands(CLI::App& app, Context& ctx) {
@@ -59,7 +86,7 @@ void register_replay_commands(CLI::App& app, Context& ctx) {
                                "Replay recorded captures headless: impedance, update, diagnosis");
   struct Args {
     std::vector<std::string> inputs;
-    std::string out, shard = "0/1", report, jsonl, material;
+    std::string out, shard = "0/1", report, jsonl, material, limits;
     std::size_t jobs = 1;
     double timeout_s = 600.0;
     bool transverse = false;
@@ -97,6 +124,9 @@ void register_replay_commands(CLI::App& app, Context& ctx) {
                 "Held-out capture beside each capture, by name: {stem} is the capture's name without .h5 "
                 "(e.g. holdout.h5, or {stem}-heldout.h5 for piezobench's own pairs); the diagnosis "
                 "predicts it from its v1");
+  r->add_option("--limits", a->limits,
+                "Acceptance limits (TOML, see README 'Limits and the lot report'): pass/fail per "
+                "capture with the reasons, and the lot summary (counts, distributions, outliers, Cpk)");
   add_chain_tolerance_options(r, a->oe);
   add_json_flag(r, ctx);
   r->callback([&ctx, a] {
@@ -115,6 +145,13 @@ void register_replay_commands(CLI::App& app, Context& ctx) {
       opt.seed_chain = a->seed_chain;
       opt.holdout = a->holdout;
       opt.software = std::string("piezobench ") + kVersion + " replay";
+      if (!a->limits.empty()) {  // a malformed file stops the run before any capture
+        try {
+          opt.limits = report::read_limits(a->limits);
+        } catch (const report::LimitsError& e) {
+          throw InputError(std::string("--limits: ") + e.what());
+        }
+      }
       g_stop = false;
       std::signal(SIGINT, on_signal);
       std::signal(SIGTERM, on_signal);  // Slurm's warning before a time-limit kill
@@ -160,6 +197,7 @@ void register_replay_commands(CLI::App& app, Context& ctx) {
       j["issues"] = nlohmann::json::array();
       for (const auto& i : s.issues)
         j["issues"].push_back({{"path", i.path}, {"kind", i.kind}, {"message", i.message}});
+      if (s.lot) j["lot"] = report::lot_json(*opt.limits, *s.lot);
       if (ctx.json) {
         print_json(j);
       } else {
@@ -176,6 +214,7 @@ void register_replay_commands(CLI::App& app, Context& ctx) {
         std::printf("results: %s%s%s\n", opt.out.string().c_str(),
                     opt.report_dir ? ", report: " : "",
                     opt.report_dir ? (*opt.report_dir / "summary.md").string().c_str() : "");
+        if (s.lot) print_lot(*opt.limits, *s.lot, opt.report_dir);
         if (s.interrupted) std::printf("interrupted: run the same command again to resume\n");
       }
       if (s.interrupted || s.report_errors)

@@ -80,6 +80,7 @@ bool collect_job(AppState& s) {
   const bool cancelled = s.job.cancel_requested();
   if (!s.job.take(res, problem)) return false;
   s.result = std::move(res);
+  s.verdict.reset();
   s.error = std::move(problem);
   s.warnings.clear();
   s.mag_view.fitted = s.phase_view.fitted = s.sv_view.fitted = s.residual_view.fitted = false;
@@ -109,6 +110,10 @@ bool collect_job(AppState& s) {
   if (!r.damping_from_resonances.empty())
     s.log.push_back("  damping from the resonances: " + r.damping_from_resonances);
   s.warnings = result_problems(r);
+  judge_result(s);
+  if (s.verdict)
+    s.log.push_back("limits: " + s.verdict->status +
+                    (s.verdict->reasons.empty() ? "" : " (" + std::to_string(s.verdict->reasons.size()) + " reason(s))"));
   if (r.awg_idn.empty()) {
     in.state = InstrumentForm::State::Replay;
   } else {
@@ -118,6 +123,36 @@ bool collect_job(AppState& s) {
     in.problem.reset();
   }
   return true;
+}
+
+void judge_result(AppState& s) {
+  s.verdict.reset();
+  if (!s.limits || !s.result) return;
+  s.verdict = report::evaluate_result(*s.limits, ui::report_json(*s.result));
+}
+
+void load_limits(AppState& s) {
+  const std::string path = s.limits_path;
+  s.tasks.post("limits", [path]() -> TaskQueue::Apply {
+    try {
+      auto l = std::make_shared<const report::Limits>(report::read_limits(path));
+      return [l](AppState& st) {
+        st.limits = l;
+        st.log.push_back("limits loaded: " + l->source + " (" + std::to_string(l->limits.size()) + " limit(s))");
+        judge_result(st);
+      };
+    } catch (const report::LimitsError& e) {  // names the file and the line
+      Problem pr{ErrorKind::Input, "limits", e.what(),
+                 "Fix the limits file at the line named (README, 'Limits and the lot report'; "
+                 "docs/limits-example.toml) and press 'Limits...' again."};
+      return [pr](AppState& st) {
+        st.limits.reset();
+        st.verdict.reset();
+        st.error = pr;
+        st.log.push_back("limits not loaded: " + pr.message);
+      };
+    }
+  });
 }
 
 void connect_instruments(AppState& s) {

@@ -18,6 +18,7 @@
 #include "ui/gui/task_queue.hpp"
 #include "ui/mode_nyquist.hpp"
 #include "ui/pipeline.hpp"
+#include "ui/report/limits.hpp"
 
 namespace piezo::gui {
 
@@ -90,6 +91,11 @@ struct AppState {
   ~AppState() { calibration_prompt.close(); }
   Job job;
   int jobs_started = 0;
+  // Acceptance limits (ui/report/limits.hpp, as `replay --limits`): loaded on
+  // the task thread; each finished result is judged against them.
+  char limits_path[256] = "";
+  std::shared_ptr<const report::Limits> limits;
+  std::optional<report::CaptureVerdict> verdict;  // of `result` against `limits`
   // Shared with background exports, so a new job can replace it while one runs.
   std::shared_ptr<const ui::PipelineResult> result;
   std::optional<Problem> error;   // stopped the last job or export; shown with what to do
@@ -129,6 +135,12 @@ void connect_instruments(AppState& s);
 // Takes a finished job's outcome into the state (result, error, instrument
 // state, log); true when a job finished this frame.
 bool collect_job(AppState& s);
+
+// Reads the limits file named in the plan panel on the task thread (a
+// malformed one is an error with its line); then judges the result.
+void load_limits(AppState& s);
+// The result against the loaded limits (none loaded or no result: no verdict).
+void judge_result(AppState& s);
 
 // Writes the result as CSV, Touchstone or a JSON report on the task thread.
 enum class ExportFormat { Csv, Touchstone, Json };

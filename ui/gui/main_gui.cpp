@@ -97,6 +97,8 @@ nlohmann::json frame_stats(const AppState& s, const TestScript& script) {
                       {"params", nlohmann::json::array()},
                       {"verdict_shown", s.diagnosis_shown.verdict},
                       {"effects_shown", s.diagnosis_shown.effects},
+                      {"limits_status", s.verdict ? s.verdict->status : ""},
+                      {"limits_reasons", s.verdict ? s.verdict->reasons : std::vector<std::string>()},
                       {"log", s.log}};
   auto rect = [](const PlotView& v) {
     return nlohmann::json{v.frame.x, v.frame.y, v.frame.z, v.frame.w};
@@ -145,6 +147,8 @@ int main(int argc, char** argv) {
   cli.add_option("--replay", replay, "Put this recorded capture in the plan panel for replay");
   cli.add_option("--replay-heldout", replay_heldout,
                  "… and this one beside it as its held-out capture (another drive of the same transducer)");
+  std::string limits;
+  cli.add_option("--limits", limits, "Put this limits file in the plan panel (load it with 'Limits...')");
   cli.add_option("--click", clicks, "Test hook: click these buttons in order once drawn");
   cli.add_flag("--wait-job", wait_job, "Test hook: exit when the clicked work has finished");
   cli.add_option("--hover", hover, "Test hook: rest the mouse at X Y after the clicks")
@@ -204,6 +208,7 @@ int main(int argc, char** argv) {
                   sim_effects.c_str());
     std::snprintf(state.replay_path, sizeof state.replay_path, "%s", replay.c_str());
     std::snprintf(state.heldout_path, sizeof state.heldout_path, "%s", replay_heldout.c_str());
+    std::snprintf(state.limits_path, sizeof state.limits_path, "%s", limits.c_str());
     connect_instruments(state);  // on the task thread: *IDN? shows as soon as the bench answers
 
     const auto t_start = std::chrono::steady_clock::now();

@@ -1,4 +1,5 @@
-// Results: the error that stopped the last run (with what to do), original
+// Results: the error that stopped the last run (with what to do), the limits
+// file and pass/fail against it with the reasons, original
 // vs updated parameters with the change in %, the stages that ran, the exports (CSV, Touchstone,
 // JSON report, PNG of the window) and the log. The gap verdict and effect ranking are in the
 // diagnosis window.
@@ -77,6 +78,15 @@ void parameter_table(const ui::PipelineResult& r) {
   }
   ImGui::EndTable();
 }
+// Pass / fail against the loaded limits, with one line per reason.
+void limits_line(const report::CaptureVerdict& v, const std::string& file) {
+  const bool pass = v.status == "pass";
+  ImGui::TextColored(pass ? ImVec4(0.4f, 1.0f, 0.4f, 1) : ImVec4(1.0f, 0.4f, 0.4f, 1), "Limits: %s",
+                     pass ? "PASS" : "FAIL");
+  ImGui::SameLine();
+  ImGui::TextDisabled("(%s)", file.c_str());
+  for (const auto& reason : v.reasons) ImGui::TextColored(ImVec4(1.0f, 0.6f, 0.5f, 1), "  %s", reason.c_str());
+}
 }  // namespace
 
 void render_results_window(AppState& s) {
@@ -84,12 +94,22 @@ void render_results_window(AppState& s) {
   // What stopped the last run, or needs the technician's action, comes first.
   if (s.error) show_problem(*s.error);
   for (const auto& w : s.warnings) show_problem(w);
+  // Acceptance limits (as `replay --limits`): each result is judged against them.
+  ImGui::SetNextItemWidth(ImGui::GetContentRegionAvail().x - 90);
+  ImGui::InputTextWithHint("##limits", "limits.toml (optional: pass/fail of each result)", s.limits_path,
+                           sizeof s.limits_path);
+  ImGui::SameLine();
+  if (tracked_button(s, "Limits...", ImVec2(-1, 0))) load_limits(s);
+  if (ImGui::IsItemHovered())
+    ImGui::SetTooltip("Load acceptance limits (README, 'Limits and the lot report'): the result is shown "
+                      "as pass or fail with the reasons");
   if (!s.result && !s.error) {
     ImGui::TextWrapped(
         "No result yet. Set the plan and press 'Measure and update', or replay a capture.");
   } else if (s.result) {
     const auto& r = *s.result;
     ImGui::TextWrapped("Capture: %s (%d shots)", r.capture_path.c_str(), r.shots);
+    if (s.verdict) limits_line(*s.verdict, s.limits ? s.limits->source : std::string());
     if (r.params.empty())
       ImGui::TextDisabled("No updated parameters (see the stages below).");
     else

@@ -25,6 +25,7 @@
 #include "ui/replay/sha256.hpp"
 #include "ui/report/batch_summary.hpp"
 #include "ui/report/capture_report.hpp"
+#include "ui/report/lot_report.hpp"
 #include "ui/json_text.hpp"
 #include "ui/nominal_material.hpp"
 
@@ -49,7 +50,7 @@ std::string naming(const std::string& path, const std::string& what) {
 class Sink {
  public:
   Sink(const ReplayOptions& opt, const ReplayCallbacks& cb, std::size_t total)
-      : results_(acq::ResultsFile::open_or_create(opt.out, opt.software)), cb_(cb) {
+      : results_(acq::ResultsFile::open_or_create(opt.out, opt.software)), cb_(cb), limits_(opt.limits) {
     counts_.total = total;
     for (auto& e : results_.index()) {
       if (e.status == "ok") done_.emplace(e.key, e.input_path);
@@ -71,14 +72,25 @@ class Sink {
 
   // A capture finished earlier: its stored line goes to this run's JSON lines.
   void skipped(const std::string& key) {
-    if (jsonl_.is_open())
+    if (limits_) {  // judged against this run's limits; the stored verdict follows them
+      acq::ResultsReadOptions ro;
+      ro.load_curves = true;
+      if (auto rec = results_.get(key, ro)) {
+        const std::string before = rec->result_json;
+        judge(*rec);
+        if (rec->result_json != before) results_.put(*rec);
+        line(*rec);
+      }
+    } else if (jsonl_.is_open()) {
       if (auto rec = results_.get(key)) line(*rec);
+    }
     ++counts_.skipped;
     if (failed_done_.count(key)) ++counts_.failed_before;
     step();
   }
 
-  void put(const acq::ResultRecord& rec, const std::optional<ReplayIssue>& issue) {
+  void put(acq::ResultRecord rec, const std::optional<ReplayIssue>& issue) {
+    judge(rec);
     results_.put(rec);
     // Older records of this path with another digest describe a file that has changed since.
     for (const auto& old : by_path_[rec.input_path])
@@ -114,6 +126,16 @@ class Sink {
     jsonl_.flush();
   }
 
+  // The record's "limits" object (pass / fail / error and the reasons), in its stored JSON.
+  void judge(acq::ResultRecord& rec) const {
+    if (!limits_) return;
+    auto j = nlohmann::json::parse(rec.result_json, nullptr, false);
+    if (!j.is_object()) return;  // record_json() reports it as a bad record
+    j.erase("limits");
+    j["limits"] = report::verdict_json(*limits_, report::evaluate_record(*limits_, j));
+    rec.result_json = ui::json_text(j);
+  }
+
   void step() {
     ++counts_.done;
     const double t = seconds_since(t0_);
@@ -126,6 +148,7 @@ class Sink {
 
   acq::ResultsFile results_;
   const ReplayCallbacks& cb_;
+  const std::optional<report::Limits>& limits_;
   std::ofstream jsonl_;
   bool kept_failure(const std::string& key) const {
     const auto rec = results_.get(key);
@@ -580,7 +603,19 @@ ReplaySummary run_replay(const ReplayOptions& opt, const ReplayCallbacks& cb,
   sum.interrupted = cancel && sum.counts.done < sum.counts.total;
   sum.wall_s = seconds_since(t0);
   if (opt.report_dir) write_batch_summary(opt.out, *opt.report_dir);
+  if (opt.limits) {
+    sum.lot = summarize_lot_file(opt.out, *opt.limits);
+    if (opt.report_dir) report::write_lot_report(*opt.limits, *sum.lot, opt.out.string(), *opt.report_dir);
+  }
   return sum;
+}
+
+report::LotSummary summarize_lot_file(const fs::path& results, const report::Limits& limits) {
+  std::vector<report::LotRecord> records;
+  acq::for_each_result(results, [&](const acq::ResultRecord& r) {
+    records.push_back({r.input_path, r.key, record_json(r)});
+  });
+  return report::summarize_lot(limits, std::move(records));
 }
 
 void write_batch_summary(const fs::path& results, const fs::path& report_dir) {

@@ -29,6 +29,8 @@
 #include <vector>
 
 #include "ui/replay/discover.hpp"
+#include "ui/report/limits.hpp"
+#include "ui/report/lot_summary.hpp"
 #include "update/output_error.hpp"
 
 namespace piezo::replay {
@@ -55,6 +57,11 @@ struct ReplayOptions {
   // A capture whose worker has not answered after this long is a hang: the
   // worker is killed and the capture recorded as failed ("hung").
   double capture_timeout_s = 600.0;
+  // Acceptance limits (ui/report/limits.hpp): each record gets a "limits"
+  // object (pass / fail / error and the reasons) in the results file and its
+  // JSON line, and the run ends with the lot summary of the whole results
+  // file (ReplaySummary::lot; lot.md, lot.json and the histograms in report_dir).
+  std::optional<report::Limits> limits;
 };
 
 struct ReplayProgress {
@@ -77,6 +84,7 @@ struct ReplaySummary {
   bool interrupted = false;
   std::vector<ReplayIssue> issues;  // failed captures and report write errors, in order
   std::size_t report_errors = 0;
+  std::optional<report::LotSummary> lot;  // with ReplayOptions::limits
 };
 
 struct ReplayCallbacks {
@@ -93,5 +101,9 @@ ReplaySummary run_replay(const ReplayOptions& opt, const ReplayCallbacks& cb,
 // The batch summary of everything in a results file (report/batch_summary.hpp).
 void write_batch_summary(const std::filesystem::path& results,
                          const std::filesystem::path& report_dir);
+
+// The lot summary of every record in a results file against `limits`
+// (each record judged afresh, whatever its stored "limits" object says).
+report::LotSummary summarize_lot_file(const std::filesystem::path& results, const report::Limits& limits);
 
 }  // namespace piezo::replay

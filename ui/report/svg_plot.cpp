@@ -16,6 +16,8 @@ constexpr double kLeft = 78, kRight = 24, kTop = 30, kBottom = 44;
 
 bool usable(double v, Scale s) { return std::isfinite(v) && (s == Scale::Linear || v > 0); }
 
+}  // namespace
+
 std::pair<double, double> data_range(const Panel& p, bool x_axis) {
   const Scale s = x_axis ? p.x_scale : p.y_scale;
   double lo = std::numeric_limits<double>::infinity(), hi = -lo;
@@ -47,6 +49,8 @@ std::pair<double, double> data_range(const Panel& p, bool x_axis) {
   const double pad = 0.05 * (hi - lo);
   return {lo - pad, hi + pad};
 }
+
+namespace {
 
 struct Axis {
   double lo, hi, px0, px1;

@@ -54,7 +54,10 @@ std::string render_svg(const Figure& fig);
 // Throws std::runtime_error naming the file when it cannot be written.
 void write_svg(const Figure& fig, const std::filesystem::path& file);
 
-// Axis helpers (exposed for the tests).
+// Axis helpers (exposed for the tests and for figure_png.hpp).
+// The range an axis spans when the panel gives none: the data's (and, for y,
+// the reference lines'), padded.
+std::pair<double, double> data_range(const Panel& p, bool x_axis);
 std::vector<double> linear_ticks(double lo, double hi, int target = 6);
 std::vector<double> log_ticks(double lo, double hi);  // decades; 2 and 5 too over < 2 decades
 std::string tick_label(double v, Scale s);
