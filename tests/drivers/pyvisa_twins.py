@@ -125,6 +125,11 @@ def infiniium_acquire(rm, port, rate, rng_v, fire):
         configure(daq, cmd)
     daq.query(":ADER?")
     daq.write(":SINGle")
+    # A query on the same link before the trigger: the scope has taken :SINGle
+    # (armed) before the AWG fires on the other link, as the C++ driver does it
+    # (without it the trigger could overtake the arm: the twin never acquired).
+    err = daq.query(":SYSTem:ERRor?").strip()
+    assert err.split(",")[0].lstrip("+") == "0", f":SINGle: {err}"
     fire()
     poll(lambda: daq.query(":ADER?"), ("1", "+1"), ":ADER? never 1 after the burst")
     channels = []
