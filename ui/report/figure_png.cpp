@@ -15,17 +15,6 @@ constexpr Rgba kInk{30, 30, 30, 255}, kGrid{228, 228, 228, 255}, kFrame{51, 51, 
 
 bool usable(double v, Scale s) { return std::isfinite(v) && (s == Scale::Linear || v > 0); }
 
-struct Axis {
-  double lo, hi, px0, px1;
-  Scale s;
-  double to_px(double v) const {
-    const double t = s == Scale::Log
-                         ? (std::log10(v) - std::log10(lo)) / (std::log10(hi) - std::log10(lo))
-                         : (v - lo) / (hi - lo);
-    return px0 + t * (px1 - px0);
-  }
-};
-
 void render_panel(PngCanvas& c, const Panel& p, double x0, double y0, double w, double h) {
   const auto xr = p.x_range.value_or(data_range(p, true));
   const auto yr = p.y_range.value_or(data_range(p, false));

@@ -52,17 +52,6 @@ std::pair<double, double> data_range(const Panel& p, bool x_axis) {
 
 namespace {
 
-struct Axis {
-  double lo, hi, px0, px1;
-  Scale s;
-  double to_px(double v) const {
-    const double t = s == Scale::Log
-                         ? (std::log10(v) - std::log10(lo)) / (std::log10(hi) - std::log10(lo))
-                         : (v - lo) / (hi - lo);
-    return px0 + t * (px1 - px0);
-  }
-};
-
 std::string num(double v) {
   char b[32];
   std::snprintf(b, sizeof b, "%.2f", v);

@@ -3,6 +3,7 @@
 // logarithmic axes, vertical markers and horizontal reference lines, written
 // as standalone SVG (no GL context, no fonts to ship). Used by replay reports
 // (impedance overlays, parameter distributions); pure string building.
+#include <cmath>
 #include <filesystem>
 #include <optional>
 #include <string>
@@ -62,5 +63,15 @@ std::vector<double> linear_ticks(double lo, double hi, int target = 6);
 std::vector<double> log_ticks(double lo, double hi);  // decades; 2 and 5 too over < 2 decades
 std::string tick_label(double v, Scale s);
 std::string xml_escape(const std::string& s);
+// Data → pixel along one axis of a panel (both renderers: SVG and PNG).
+struct Axis {
+  double lo, hi, px0, px1;
+  Scale s;
+  double to_px(double v) const {
+    const double t = s == Scale::Log ? (std::log10(v) - std::log10(lo)) / (std::log10(hi) - std::log10(lo))
+                                     : (v - lo) / (hi - lo);
+    return px0 + t * (px1 - px0);
+  }
+};
 
 }  // namespace piezo::report
