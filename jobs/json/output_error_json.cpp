@@ -1,0 +1,106 @@
+#include "jobs/json/output_error_json.hpp"
+
+#include <cmath>
+
+#include "model/material.hpp"
+
+namespace piezo::jobs {
+
+nlohmann::json tube_params_json(const update::TubeParams& p) {
+  return {{"YE11", p.y_e11}, {"nu12", p.nu12}, {"d31", p.d31}, {"epsT33_rel", p.eps_t33 / model::kEps0}};
+}
+
+nlohmann::json output_error_json(const update::OeResult& r, const std::string& excitation) {
+  nlohmann::json params = nlohmann::json::array();
+  std::vector<std::string> names;
+  for (const auto& p : r.parameters) {
+    params.push_back({{"name", p.name}, {"unit", p.unit}, {"value", p.value}, {"sigma", p.sigma},
+                      {"relative_sigma", std::abs(p.sigma / p.value)}, {"nominal", p.nominal},
+                      {"sigma_statistical", p.sigma_statistical}, {"status", p.status},
+                      {"reason", p.reason}, {"note", p.note}});
+    names.push_back(p.name);
+  }
+  nlohmann::json corr = nlohmann::json::array();
+  for (Eigen::Index i = 0; i < r.correlation.rows(); ++i) {
+    std::vector<double> row;
+    for (Eigen::Index j = 0; j < r.correlation.cols(); ++j) row.push_back(r.correlation(i, j));
+    corr.push_back(row);
+  }
+  nlohmann::json optima = nlohmann::json::array();
+  for (std::size_t k = 0; k < r.optima.size(); ++k) {
+    auto o = tube_params_json(r.optima[k]);
+    o["chi2"] = 2.0 * r.optima_cost[k];
+    optima.push_back(o);
+  }
+  // The damping model fitted (issue 19): the Rayleigh fields always, the
+  // complex constants' Qm with its sigma beside them when that model was fitted.
+  nlohmann::json damping = {{"model", update::damping_name(r.damping_model)},
+                            {"rayleigh_alpha", r.damping.alpha},
+                            {"rayleigh_beta", r.damping.beta}};
+  if (r.damping_model == update::OeDamping::complex_constants) {
+    damping["qm"] = r.qm;
+    damping["qm_sigma"] = r.qm_sigma;
+    damping["qm_inverse"] = r.eta;
+  }
+  return {{"method", "oe"},
+          {"converged", r.ok()},
+          {"status", update::to_string(r.status)},
+          {"message", r.message},
+          {"updated", tube_params_json(r.updated)},
+          {"parameters", params},
+          {"correlation", {{"names", names}, {"matrix", corr}}},
+          {"corr_nu12_d31", r.corr_nu12_d31},
+          {"damping", damping},
+          {"fit",
+           {{"excitation", excitation},
+            {"shots", r.shots_used},
+            {"band_hz", r.band_hz},
+            {"residual_samples", r.residual_samples},
+            {"noise_source", r.noise_source},
+            {"noise_rms_v", r.noise_rms_v},
+            {"residual_rms_v", r.residual_rms_v},
+            {"chi2_per_dof", r.chi2_per_dof},
+            {"chi2_limit", r.chi2_limit},
+            {"lack_of_fit", r.lack_of_fit},
+            {"offset_model", r.offset_model},
+            {"chain_tolerances",
+             {{"r1_rel_sigma", r.r1_rel_sigma},
+              {"cp_sigma_f", r.cp_sigma_f},
+              {"gain_rel_sigma", r.gain_rel_sigma},
+              {"skew_sigma_s", r.skew_sigma_s}}},
+            {"band_test",
+             {{"log10_p", r.band_log10_p},
+              {"excess", r.band_excess},
+              {"lo_hz", r.band_lo_hz},
+              {"hi_hz", r.band_hi_hz},
+              {"windows", r.band_windows}}},
+            {"noise_dof", r.noise_dof},
+            {"starts", r.starts},
+            {"iterations", r.iterations},
+            {"evaluations", r.evaluations},
+            {"optima", optima}}},
+          {"effects",
+           [&] {
+             nlohmann::json a = nlohmann::json::array();
+             for (const auto& e : r.effects) {
+               a.push_back({{"name", e.name},
+                            {"unit", e.unit},
+                            {"value", std::isfinite(e.value) ? nlohmann::json(e.value) : nlohmann::json(nullptr)},
+                            {"sigma", std::isfinite(e.sigma) ? nlohmann::json(e.sigma) : nlohmann::json(nullptr)},
+                            {"delta_chi2", e.delta_chi2},
+                            {"alias", e.alias},
+                            {"alias_residual", e.alias_residual},
+                            {"significant", e.significant},
+                            {"explains", e.explains},
+                            {"chi2_per_dof", e.chi2_per_dof},
+                            {"band_log10_p", e.band_log10_p},
+                            {"converged", e.converged},
+                            {"updated", tube_params_json(e.material)}});
+               if (!e.law.empty()) a.back()["law"] = e.law;
+             }
+             return a;
+           }()},
+          {"seconds", r.seconds}};
+}
+
+}  // namespace piezo::jobs

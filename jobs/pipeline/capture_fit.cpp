@@ -1,0 +1,76 @@
+#include "jobs/pipeline/capture_fit.hpp"
+
+#include <stdexcept>
+
+#include "model/material_presets.hpp"
+#include "model/material_spec.hpp"
+#include "model/modal.hpp"
+#include "model/tube_model.hpp"
+
+namespace piezo::jobs {
+
+CaptureModel capture_model(const acq::Capture& cap, const std::string& material, bool isotropic) {
+  CaptureModel m;
+  m.nominal = model::resolve_material({material, isotropic, ""});
+  model::TubeGeometry g = cap.setup.geometry();
+  if (!cap.setup.density_kg_m3) g.density_kg_m3 = m.nominal.density_kg_m3;
+  m.tube = std::make_unique<model::TubeModel>(g);
+  m.solver = std::make_unique<model::ModalSolver>(*m.tube);
+  m.cls = isotropic ? update::MaterialClass::isotropic()
+                    : update::MaterialClass::transversely_isotropic(m.nominal.d);
+  m.p0 = model::isotropic_params(m.nominal.d);
+  return m;
+}
+
+CaptureFit fit_capture(const acq::Capture& cap, const CaptureFitRequest& req) {
+  return fit_capture(cap, req, capture_model(cap, req.material, req.isotropic));
+}
+
+update::OeData capture_oe_data(const acq::Capture& cap, const std::optional<dsp::FixtureCalibration>& fixture,
+                               std::string* excitation) {
+  // The dut transient shots of the first one's drive.
+  const acq::Shot* first = nullptr;
+  for (const auto& s : cap.shots)
+    if (s.role == acq::Role::Dut && s.excitation != acq::Excitation::Sine) {
+      first = &s;
+      break;
+    }
+  if (!first) throw std::invalid_argument("the capture holds no dut transient shot to fit");
+  if (excitation) *excitation = std::string(acq::to_string(first->excitation));
+  update::OeData data;
+  data.sample_rate_hz = first->sample_rate_hz;
+  data.circuit.r1_ohm = cap.setup.divider_r1_ohm;
+  for (const auto& s : cap.shots) {
+    if (s.role != acq::Role::Dut || s.excitation != first->excitation ||
+        s.sample_rate_hz != first->sample_rate_hz)
+      continue;
+    data.shots.push_back({s.v1, s.v2, static_cast<std::size_t>(std::max<std::int64_t>(0, s.pretrigger_samples))});
+  }
+  if (fixture) {
+    const auto& fx = *fixture;
+    data.circuit.r1_ohm *= 1.0 + fx.r1_error.value_or(0.0);
+    data.circuit.c_parallel_f = std::max(0.0, fx.fixture_capacitance_f.value_or(0.0));
+    data.circuit.r_lead_ohm = std::max(0.0, fx.lead_resistance_ohm.value_or(0.0));
+    data.v2_delay_s = fx.skew_s.value_or(0.0);
+  }
+  return data;
+}
+
+CaptureFit fit_capture(const acq::Capture& cap, const CaptureFitRequest& req, const CaptureModel& m) {
+  CaptureFit out;
+  update::OeOptions opts = req.options;
+  const update::OeData data = capture_oe_data(cap, req.fixture, &out.excitation);
+  out.shots_available = static_cast<int>(data.shots.size());
+  if (req.fixture) {
+    // Measured: their sigmas replace the stated tolerances.
+    const auto& fx = *req.fixture;
+    auto& o = opts;
+    if (fx.r1_error) o.r1_rel_sigma = fx.r1_error_sigma.value_or(o.r1_rel_sigma);
+    if (fx.fixture_capacitance_f) o.cp_sigma_f = fx.fixture_capacitance_sigma_f.value_or(o.cp_sigma_f);
+    if (fx.skew_s) o.skew_sigma_s = fx.skew_sigma_s.value_or(o.skew_sigma_s);
+  }
+  out.result = update::fit_output_error(*m.solver, m.cls, m.p0, data, opts);
+  return out;
+}
+
+}  // namespace piezo::jobs

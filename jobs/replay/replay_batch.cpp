@@ -1,0 +1,629 @@
+#include "jobs/replay/replay_batch.hpp"
+
+#include <chrono>
+#include <fstream>
+#include <map>
+#include <set>
+#include <stdexcept>
+
+#include <fcntl.h>
+#include <poll.h>
+#include <sys/prctl.h>
+#include <signal.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <cerrno>
+#include <cstring>
+
+#include "acquisition/capture_file.hpp"
+#include "acquisition/contained_read.hpp"
+#include "acquisition/results_file.hpp"
+#include "jobs/pipeline/pipeline.hpp"
+#include "jobs/replay/record_wire.hpp"
+#include "jobs/replay/replay_record.hpp"
+#include "jobs/replay/sha256.hpp"
+#include "jobs/report/batch_summary.hpp"
+#include "jobs/report/capture_report.hpp"
+#include "jobs/report/lot_report.hpp"
+#include "jobs/json/json_text.hpp"
+#include "jobs/nominal_material.hpp"
+
+namespace piezo::jobs::replay {
+
+namespace fs = std::filesystem;
+using Clock = std::chrono::steady_clock;
+
+namespace {
+
+double seconds_since(Clock::time_point t0) {
+  return std::chrono::duration<double>(Clock::now() - t0).count();
+}
+
+// A message that names the file (CaptureError's already does).
+std::string naming(const std::string& path, const std::string& what) {
+  return what.rfind(path, 0) == 0 ? what : path + ": " + what;
+}
+
+// What the batch process keeps (one thread; workers send it their outcomes):
+// the results file, the JSON lines, counters.
+class Sink {
+ public:
+  Sink(const ReplayOptions& opt, const ReplayCallbacks& cb, std::size_t total)
+      : results_(acq::ResultsFile::open_or_create(opt.out, opt.software)), cb_(cb), limits_(opt.limits) {
+    counts_.total = total;
+    for (auto& e : results_.index()) {
+      if (e.status == "ok") done_.emplace(e.key, e.input_path);
+      // A capture that crashed or hung a worker would do so again: the same bytes
+      // (the key holds the digest) are not retried. Other failures are.
+      if (e.status == "failed" && kept_failure(e.key)) failed_done_.insert(e.key);
+      by_path_[e.input_path].push_back(e.key);
+    }
+    if (opt.jsonl) {
+      jsonl_.open(*opt.jsonl, std::ios::trunc);
+      if (!jsonl_) throw std::invalid_argument("--jsonl: cannot write " + opt.jsonl->string());
+    }
+  }
+
+  // done_ is only read after construction: no lock needed.
+  bool finished(const std::string& key) const {
+    return done_.count(key) > 0 || failed_done_.count(key) > 0;
+  }
+
+  // A capture finished earlier: its stored line goes to this run's JSON lines.
+  void skipped(const std::string& key) {
+    if (limits_) {  // judged against this run's limits; the stored verdict follows them
+      acq::ResultsReadOptions ro;
+      ro.load_curves = true;
+      if (auto rec = results_.get(key, ro)) {
+        const std::string before = rec->result_json;
+        judge(*rec);
+        if (rec->result_json != before) results_.put(*rec);
+        line(*rec);
+      }
+    } else if (jsonl_.is_open()) {
+      if (auto rec = results_.get(key)) line(*rec);
+    }
+    ++counts_.skipped;
+    if (failed_done_.count(key)) ++counts_.failed_before;
+    step();
+  }
+
+  void put(acq::ResultRecord rec, const std::optional<ReplayIssue>& issue) {
+    judge(rec);
+    results_.put(rec);
+    // Older records of this path with another digest describe a file that has changed since.
+    for (const auto& old : by_path_[rec.input_path])
+      if (old != rec.key) results_.remove(old);
+    by_path_[rec.input_path] = {rec.key};
+    line(rec);
+    ++processed_;
+    (rec.status == "ok" ? counts_.ok : counts_.failed)++;
+    if (issue) report_issue(*issue);
+    step();
+  }
+
+  void report_issue(const ReplayIssue& i) {
+    issues_.push_back(i);
+    if (cb_.issue) cb_.issue(i);
+  }
+  void issue(const ReplayIssue& i) {
+    report_issue(i);
+  }
+
+  void close() {
+    results_.close();
+    if (jsonl_.is_open()) jsonl_.close();
+  }
+
+  ReplayProgress counts() const { return counts_; }
+  std::vector<ReplayIssue> issues() const { return issues_; }
+
+ private:
+  void line(const acq::ResultRecord& rec) {
+    if (!jsonl_.is_open()) return;
+    jsonl_ << jobs::json_text(record_json(rec)) << "\n";
+    jsonl_.flush();
+  }
+
+  // The record's "limits" object (pass / fail / error and the reasons), in its stored JSON.
+  void judge(acq::ResultRecord& rec) const {
+    if (!limits_) return;
+    auto j = nlohmann::json::parse(rec.result_json, nullptr, false);
+    if (!j.is_object()) return;  // record_json() reports it as a bad record
+    j.erase("limits");
+    j["limits"] = report::verdict_json(*limits_, report::evaluate_record(*limits_, j));
+    rec.result_json = jobs::json_text(j);
+  }
+
+  void step() {
+    ++counts_.done;
+    const double t = seconds_since(t0_);
+    counts_.rate_per_s = t > 0 ? processed_ / t : 0;
+    const std::size_t left = counts_.total - counts_.done;
+    counts_.eta_s =
+        processed_ > 0 && counts_.rate_per_s > 0 ? left / counts_.rate_per_s : (left ? -1.0 : 0.0);
+    if (cb_.progress) cb_.progress(counts_);
+  }
+
+  acq::ResultsFile results_;
+  const ReplayCallbacks& cb_;
+  const std::optional<report::Limits>& limits_;
+  std::ofstream jsonl_;
+  bool kept_failure(const std::string& key) const {
+    const auto rec = results_.get(key);
+    if (!rec) return false;
+    const auto j = nlohmann::json::parse(rec->result_json, nullptr, false);
+    if (!j.is_object() || !j.contains("error") || !j["error"].is_object()) return false;
+    const auto kind = j["error"].value("kind", std::string());
+    return kind == "crashed" || kind == "hung";
+  }
+
+  std::map<std::string, std::string> done_;  // key → path of finished ("ok") records
+  std::set<std::string> failed_done_;        // keys of captures that crashed or hung a worker
+  std::map<std::string, std::vector<std::string>> by_path_;  // path → keys
+  ReplayProgress counts_;
+  std::size_t processed_ = 0;
+  std::vector<ReplayIssue> issues_;
+  Clock::time_point t0_ = Clock::now();
+};
+
+// ReplayOptions::holdout for `file`: the named file beside it, if it exists
+// and is not the capture itself.
+std::optional<fs::path> heldout_for(const fs::path& file, const std::string& pattern) {
+  if (pattern.empty()) return std::nullopt;
+  std::string name = pattern;
+  const std::string stem = file.stem().string();
+  for (std::size_t p = name.find("{stem}"); p != std::string::npos; p = name.find("{stem}", p + stem.size()))
+    name.replace(p, 6, stem);
+  const fs::path ho = file.parent_path() / name;
+  std::error_code ec;
+  if (!fs::is_regular_file(ho, ec) || fs::equivalent(ho, file, ec)) return std::nullopt;
+  return ho;
+}
+
+// ------------------------------------------------------------- one capture
+// Runs in a worker process: everything but the results file. `stage` tells the
+// batch what the worker is doing, so that a crash can be named.
+Outcome replay_capture(const fs::path& file, const ReplayOptions& opt, const Sink& sink,
+                       const std::atomic<bool>& cancel,
+                       const std::function<void(const char*, const std::string&)>& stage) {
+  const std::string path = file.string();
+  const auto t0 = Clock::now();
+  Outcome out;
+  auto fail = [&](const std::string& sha, const std::string& kind, const std::string& msg) {
+    out.record = failed_record(path, sha, kind, msg, seconds_since(t0));
+    out.key = out.record.key;
+    out.issue = WireIssue{path, kind, msg};
+    if (opt.report_dir) {
+      try {
+        report::write_failed_capture_report(
+            {path, sha, "", out.record.elapsed_s}, msg,
+            *opt.report_dir / report::capture_report_folder(path, out.key));
+      } catch (const std::exception& e) {
+        out.report_issue = WireIssue{path, "report", e.what()};
+      }
+    }
+    return out;
+  };
+  std::string sha;
+  try {
+    sha = sha256_file(file);
+  } catch (const std::exception& e) {
+    return fail("", "bad capture", naming(path, e.what()));
+  }
+  out.key = record_key(path, sha);
+  if (sink.finished(out.key)) {
+    out.skipped = true;
+    return out;
+  }
+  std::string material = opt.material;
+  jobs::PipelineResult result;
+  try {
+    stage("reading", sha);
+    std::optional<std::string> material_warning;
+    if (material.empty()) {
+      acq::ReadOptions ro;
+      ro.load_samples = false;  // attributes only: which nominal model to update
+      ro.skip_invalid_shots = true;
+      const auto nm = jobs::nominal_material("", acq::read_capture(file, ro).setup.material);
+      material = nm.name;
+      material_warning = nm.warning;
+    }
+    stage("processing", sha);
+    jobs::PipelineRequest req;
+    req.replay_capture = path;
+    req.replay_contained = false;  // this worker process is the containment
+    req.material = material;
+    req.isotropic = opt.isotropic;
+    req.seed_chain = opt.seed_chain;
+    req.oe_options = opt.oe_options;
+    // --jobs workers keep the cores busy already: one thread per fit then.
+    if (opt.jobs > 1) req.oe_options.threads = 1;
+    if (const auto ho = heldout_for(file, opt.holdout)) {
+      req.heldout_capture = ho->string();
+      req.heldout_optional = true;
+    }
+    result = jobs::run_pipeline(req, nullptr, cancel);
+    if (material_warning) result.warnings.insert(result.warnings.begin(), *material_warning);
+  } catch (const acq::CaptureError& e) {
+    return fail(sha, "bad capture", e.what());
+  } catch (const std::invalid_argument& e) {
+    return fail(sha, "bad input", naming(path, e.what()));
+  } catch (const std::exception& e) {
+    return fail(sha, "failed", naming(path, e.what()));
+  }
+  if (cancel) {  // a cancelled pipeline returns a partial result: not a finished capture
+    out.cancelled = true;
+    return out;
+  }
+  const double elapsed = seconds_since(t0);
+  if (opt.report_dir) {
+    try {
+      report::write_capture_report(result, {path, sha, material, elapsed},
+                                   *opt.report_dir / report::capture_report_folder(path, out.key));
+    } catch (const std::exception& e) {
+      out.issue = WireIssue{path, "report", e.what()};
+    }
+  }
+  out.record = ok_record(path, sha, material, result, elapsed);
+  return out;
+}
+
+// ---------------------------------------------------------- worker processes
+// Each worker is a forked copy of this process that replays the captures the
+// batch sends it (their index in `files`, 8 bytes on its task pipe) and answers
+// with frames (record_wire.hpp) on its result pipe. The batch itself stays one
+// thread and is the only writer of the results file. A worker that dies (a
+// crash inside a library, e.g. libhdf5 on a damaged file) or overruns the
+// capture timeout costs that capture only: it is recorded as failed and a new
+// worker takes the next one.
+struct WorkerProc {
+  pid_t pid = -1;
+  int task_fd = -1, result_fd = -1;
+  std::string buf;
+  std::optional<std::size_t> task;
+  Clock::time_point started;
+  std::string stage, sha;
+};
+
+void write_all(int fd, const void* data, std::size_t n) {
+  const char* p = static_cast<const char*>(data);
+  while (n) {
+    const ssize_t w = ::write(fd, p, n);
+    if (w < 0 && errno == EINTR) continue;
+    if (w <= 0) throw std::runtime_error(std::string("pipe write: ") + std::strerror(errno));
+    p += w;
+    n -= static_cast<std::size_t>(w);
+  }
+}
+
+bool read_exact(int fd, void* data, std::size_t n) {
+  char* p = static_cast<char*>(data);
+  while (n) {
+    const ssize_t r = ::read(fd, p, n);
+    if (r < 0 && errno == EINTR) continue;
+    if (r <= 0) return false;
+    p += r;
+    n -= static_cast<std::size_t>(r);
+  }
+  return true;
+}
+
+// Closes every descriptor above stdio except a and b (in a forked worker).
+void keep_only_fds(int a, int b) {
+  const int lo = std::min(a, b), hi = std::max(a, b);
+  if (lo > 3) ::close_range(3, static_cast<unsigned>(lo - 1), 0);
+  if (hi - lo > 1) ::close_range(static_cast<unsigned>(lo + 1), static_cast<unsigned>(hi - 1), 0);
+  ::close_range(static_cast<unsigned>(hi + 1), ~0U, 0);
+}
+
+class WorkerPool {
+ public:
+  WorkerPool(const std::vector<fs::path>& files, const ReplayOptions& opt, Sink& sink,
+             const std::atomic<bool>& cancel)
+      : files_(files), opt_(opt), sink_(sink), cancel_(cancel) {}
+  ~WorkerPool() {
+    for (auto& w : workers_) stop(w, /*kill_it=*/true);
+  }
+
+  void run() {
+    const std::size_t n = std::min(opt_.jobs, std::max<std::size_t>(1, files_.size()));
+    workers_.resize(n);
+    for (auto& w : workers_) spawn(w);
+    std::size_t next = 0;
+    for (;;) {
+      if (cancel_) {  // interrupted: what is under way is not recorded (a rerun resumes it)
+        for (auto& w : workers_) stop(w, true);
+        return;
+      }
+      for (auto& w : workers_)
+        if (!w.task && next < files_.size()) {
+          if (w.pid < 0) spawn(w);
+          const std::uint64_t i = next++;
+          w.task = i;
+          w.started = Clock::now();
+          w.stage.clear();
+          w.sha.clear();
+          write_all(w.task_fd, &i, sizeof i);
+        }
+      bool busy = false;
+      for (const auto& w : workers_) busy |= w.task.has_value();
+      if (!busy) break;
+      wait_and_collect();
+    }
+    for (auto& w : workers_) stop(w, false);
+  }
+
+ private:
+  void spawn(WorkerProc& w) {
+    int task[2], result[2];
+    if (::pipe2(task, O_CLOEXEC) != 0) throw std::runtime_error("replay: pipe: " + std::string(std::strerror(errno)));
+    if (::pipe2(result, O_CLOEXEC) != 0) {
+      ::close(task[0]), ::close(task[1]);
+      throw std::runtime_error("replay: pipe: " + std::string(std::strerror(errno)));
+    }
+    const pid_t parent = ::getpid();
+    const pid_t pid = ::fork();
+    if (pid < 0) {
+      for (int fd : {task[0], task[1], result[0], result[1]}) ::close(fd);
+      throw std::runtime_error("replay: cannot start a worker process: " + std::string(std::strerror(errno)));
+    }
+    if (pid == 0) {
+      // The worker dies with the batch (a killed batch must not leave workers
+      // behind that hold its results file open and locked).
+      ::prctl(PR_SET_PDEATHSIG, SIGKILL);
+      if (::getppid() != parent) ::_exit(1);
+      // Only its own two pipe ends and stdio stay open: not the results file and
+      // its lock, not the JSON lines, not a sibling's pipe (whose write end kept
+      // here would hide that sibling's death from the batch).
+      keep_only_fds(task[0], result[1]);
+      worker_main(task[0], result[1]);
+    }
+    ::close(task[0]);
+    ::close(result[1]);
+    w.pid = pid;
+    w.task_fd = task[1];
+    w.result_fd = result[0];
+    w.buf.clear();
+    w.task.reset();
+  }
+
+  [[noreturn]] void worker_main(int task_fd, int result_fd) {
+    int code = 0;
+    try {
+      std::uint64_t i;
+      while (read_exact(task_fd, &i, sizeof i)) {
+        if (i >= files_.size()) break;
+        auto stage = [&](const char* what, const std::string& sha) {
+          const std::string f = frame('S', std::string(what) + '\0' + sha);
+          write_all(result_fd, f.data(), f.size());
+        };
+        // A damaged file must not take the machine's memory (contained_read.hpp);
+        // twice its size for a held-out partner beside it.
+        std::error_code ec;
+        const auto size = std::filesystem::file_size(files_[i], ec);
+        acq::limit_memory_for_capture(ec ? 0 : 2 * size);
+        const Outcome o = replay_capture(files_[i], opt_, sink_, cancel_, stage);
+        const std::string f = frame('O', encode_outcome(o));
+        write_all(result_fd, f.data(), f.size());
+      }
+    } catch (...) {
+      code = 1;
+    }
+    ::_exit(code);  // no atexit handlers: the batch's open files are not this process's to flush
+  }
+
+  void stop(WorkerProc& w, bool kill_it) {
+    if (w.pid < 0) return;
+    if (kill_it) ::kill(w.pid, SIGKILL);
+    if (w.task_fd >= 0) ::close(w.task_fd);  // EOF on its task pipe: the worker exits
+    if (w.result_fd >= 0) ::close(w.result_fd);
+    int status;
+    while (::waitpid(w.pid, &status, 0) < 0 && errno == EINTR) {
+    }
+    w.pid = -1;
+    w.task_fd = w.result_fd = -1;
+    w.task.reset();
+  }
+
+  void wait_and_collect() {
+    std::vector<pollfd> fds;
+    std::vector<WorkerProc*> who;
+    double wait_s = 0.2;  // the cancel flag is looked at this often
+    for (auto& w : workers_)
+      if (w.task) {
+        fds.push_back({w.result_fd, POLLIN, 0});
+        who.push_back(&w);
+        wait_s = std::min(wait_s, std::max(0.0, opt_.capture_timeout_s - seconds_since(w.started)));
+      }
+    const int r = ::poll(fds.data(), fds.size(), static_cast<int>(wait_s * 1000.0) + 1);
+    if (r < 0 && errno != EINTR) throw std::runtime_error(std::string("replay: poll: ") + std::strerror(errno));
+    for (std::size_t k = 0; r > 0 && k < fds.size(); ++k) {
+      if (!fds[k].revents) continue;
+      WorkerProc& w = *who[k];
+      char b[65536];
+      const ssize_t n = ::read(w.result_fd, b, sizeof b);
+      if (n < 0 && errno == EINTR) continue;
+      if (n <= 0) {
+        died(w);
+        continue;
+      }
+      w.buf.append(b, static_cast<std::size_t>(n));
+      char kind;
+      std::string payload;
+      try {
+        while (w.task && next_frame(w.buf, kind, payload)) {
+          if (kind == 'S') {
+            const auto z = payload.find('\0');
+            w.stage = payload.substr(0, z);
+            if (z != std::string::npos) w.sha = payload.substr(z + 1);
+          } else if (kind == 'O') {
+            apply(decode_outcome(payload));
+            w.task.reset();
+          }
+        }
+      } catch (const std::runtime_error&) {  // garbled frames: the worker is not trusted further
+        ::kill(w.pid, SIGKILL);
+        died(w);
+      }
+    }
+    for (auto& w : workers_)
+      if (w.task && seconds_since(w.started) > opt_.capture_timeout_s) {
+        ::kill(w.pid, SIGKILL);
+        char b[200];
+        std::snprintf(b, sizeof b,
+                      "replay did not finish within %.0f s (%s); the worker was killed and the "
+                      "capture left out",
+                      opt_.capture_timeout_s,
+                      w.stage == "reading" ? "the HDF5 library hung reading the file" : "hung");
+        kill_and_record(w, "hung", b);
+      }
+  }
+
+  // The worker's pipe closed: it exited or died, maybe in the middle of a capture.
+  void died(WorkerProc& w) {
+    int status = 0;
+    ::close(w.task_fd);
+    ::close(w.result_fd);
+    while (::waitpid(w.pid, &status, 0) < 0 && errno == EINTR) {
+    }
+    w.pid = -1;
+    w.task_fd = w.result_fd = -1;
+    if (!w.task) return;
+    const std::size_t i = *w.task;
+    const std::string path = files_[i].string();
+    std::string how = WIFSIGNALED(status) ? acq::describe_signal(WTERMSIG(status))
+                                          : "exit code " + std::to_string(WEXITSTATUS(status));
+    std::string msg =
+        w.stage == "reading"
+            ? "the HDF5 library crashed reading " + path + " (" + how +
+                  "): the file is damaged or not a capture; it was left out"
+            : "the replay worker died (" + how + ") while processing " + path +
+                  (w.stage.empty() ? "" : " (stage: " + w.stage + ")") + "; the capture was left out";
+    record_lost(i, w.sha, "crashed", msg, seconds_since(w.started));
+    w.task.reset();
+  }
+
+  void kill_and_record(WorkerProc& w, const std::string& kind, const std::string& msg) {
+    const std::size_t i = *w.task;
+    const std::string sha = w.sha;
+    const double t = seconds_since(w.started);
+    stop(w, true);
+    record_lost(i, sha, kind, msg, t);
+  }
+
+  void record_lost(std::size_t i, std::string sha, const std::string& kind,
+                   const std::string& msg, double elapsed) {
+    const std::string path = files_[i].string();
+    if (sha.empty()) {
+      try {
+        sha = sha256_file(files_[i]);
+      } catch (const std::exception&) {
+        // unreadable bytes: the record is keyed by the path alone
+      }
+    }
+    auto rec = failed_record(path, sha, kind, msg, elapsed);
+    if (opt_.report_dir) {
+      try {
+        report::write_failed_capture_report(
+            {path, sha, "", elapsed}, msg,
+            *opt_.report_dir / report::capture_report_folder(path, rec.key));
+      } catch (const std::exception& e) {
+        sink_.issue({path, "report", e.what()});
+      }
+    }
+    sink_.put(rec, ReplayIssue{path, kind, msg});
+  }
+
+  void apply(const Outcome& o) {
+    if (o.cancelled) return;
+    if (o.skipped) {
+      sink_.skipped(o.key);
+      return;
+    }
+    if (o.report_issue) sink_.issue({o.report_issue->path, o.report_issue->kind, o.report_issue->message});
+    std::optional<ReplayIssue> issue;
+    if (o.issue) issue = ReplayIssue{o.issue->path, o.issue->kind, o.issue->message};
+    sink_.put(o.record, issue);
+  }
+
+  const std::vector<fs::path>& files_;
+  const ReplayOptions& opt_;
+  Sink& sink_;
+  const std::atomic<bool>& cancel_;
+  std::vector<WorkerProc> workers_;
+};
+
+}  // namespace
+
+ReplaySummary run_replay(const ReplayOptions& opt, const ReplayCallbacks& cb,
+                         const std::atomic<bool>& cancel) {
+  if (opt.jobs < 1 || opt.jobs > 256) throw std::invalid_argument("--jobs must be in 1..256");
+  if (opt.inputs.empty())
+    throw std::invalid_argument("replay: no input given (files or folders of captures)");
+  if (opt.out.empty()) throw std::invalid_argument("replay: --out RESULTS.h5 is required");
+  const auto t0 = Clock::now();
+  ReplaySummary sum;
+  const auto all = find_captures(opt.inputs, {opt.out, acq::partial_path_for(opt.out)});
+  sum.found = all.size();
+  if (all.empty())
+    throw std::invalid_argument("replay: no capture (*.h5, *.hdf5) found under the given paths");
+  const auto mine = select_shard(all, opt.shard);
+  if (opt.report_dir) {
+    std::error_code ec;
+    fs::create_directories(*opt.report_dir, ec);
+    if (ec)
+      throw std::invalid_argument("--report: cannot create " + opt.report_dir->string() + ": " +
+                                  ec.message());
+  }
+  Sink sink(opt, cb, mine.size());
+  if (cb.progress) cb.progress(sink.counts());
+
+  std::exception_ptr fatal;
+  try {
+    WorkerPool pool(mine, opt, sink, cancel);
+    pool.run();
+  } catch (...) {  // the results file could not be written, or no worker could be started
+    fatal = std::current_exception();
+  }
+  if (fatal) {
+    try {
+      sink.close();
+    } catch (...) {
+      // The first failure is the one to report.
+    }
+    std::rethrow_exception(fatal);
+  }
+  sink.close();
+
+  sum.counts = sink.counts();
+  sum.issues = sink.issues();
+  for (const auto& i : sum.issues) sum.report_errors += i.kind == "report";
+  sum.interrupted = cancel && sum.counts.done < sum.counts.total;
+  sum.wall_s = seconds_since(t0);
+  if (opt.report_dir) write_batch_summary(opt.out, *opt.report_dir);
+  if (opt.limits) {
+    sum.lot = summarize_lot_file(opt.out, *opt.limits);
+    if (opt.report_dir) report::write_lot_report(*opt.limits, *sum.lot, opt.out.string(), *opt.report_dir);
+  }
+  return sum;
+}
+
+report::LotSummary summarize_lot_file(const fs::path& results, const report::Limits& limits) {
+  std::vector<report::LotRecord> records;
+  acq::for_each_result(results, [&](const acq::ResultRecord& r) {
+    records.push_back({r.input_path, r.key, record_json(r)});
+  });
+  return report::summarize_lot(limits, std::move(records));
+}
+
+void write_batch_summary(const fs::path& results, const fs::path& report_dir) {
+  std::vector<report::BatchEntry> entries;
+  acq::for_each_result(results, [&](const acq::ResultRecord& r) {
+    entries.push_back(report::batch_entry(r.key, record_json(r)));
+  });
+  report::write_batch_report(report::summarize(std::move(entries)), results.string(), report_dir);
+}
+
+}  // namespace piezo::jobs::replay
