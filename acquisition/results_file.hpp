@@ -3,12 +3,12 @@
 // collects, per replayed capture, the input's path and SHA-256, the status,
 // the pipeline's JSON report and the impedance curves. It lives beside
 // capture_file.hpp because every HDF5 call of the project lives in
-// acquisition/; what goes into a record is decided by the caller (ui/replay).
+// acquisition/; what goes into a record is decided by the caller (jobs/replay).
 //
 // Layout (all strings UTF-8, variable length):
 //   /                     format = "piezo-replay", format_version = 1, software, created_utc
 //   /results/KEY          one group per capture; KEY is chosen by the caller
-//                         (ui/replay derives it from path + SHA-256, so shards merge by name)
+//                         (jobs/replay derives it from path + SHA-256, so shards merge by name)
 //     attrs   input_path, sha256, status ("ok" | "failed"), elapsed_s, replayed_utc
 //     result_json         scalar string dataset: the JSON report (ok) or the error (failed)
 //     curves/NN           attr label; datasets f_hz [N] float64, z_ohm [N, 2] float64 (re, im)

@@ -9,7 +9,7 @@
 #include <string>
 
 #include "acquisition/capture_file.hpp"
-#include "ui/capture_fit.hpp"
+#include "jobs/pipeline/capture_fit.hpp"
 #include "update/gap_diagnosis.hpp"
 #include "update/gap_output_error.hpp"
 
@@ -28,10 +28,10 @@ void BM_OneShotDiagnosis(benchmark::State& state, const std::string& which, bool
   const auto ho_cap = piezo::acq::read_capture(dir / "holdout.h5");
   for (auto _ : state) {
     // As the pipeline does it: the tube model, the fit with its scan, the diagnosis.
-    const auto cm = piezo::ui::capture_model(cap, "apc850", true);
-    piezo::ui::CaptureFitRequest req;
+    const auto cm = piezo::jobs::capture_model(cap, "apc850", true);
+    piezo::jobs::CaptureFitRequest req;
     req.options.scan_effects = piezo::update::supported_gap_effects();
-    const auto fit = piezo::ui::fit_capture(cap, req, cm).result;
+    const auto fit = piezo::jobs::fit_capture(cap, req, cm).result;
     if (!fit.ok()) {
       state.SkipWithError(fit.message.c_str());
       return;
@@ -39,7 +39,7 @@ void BM_OneShotDiagnosis(benchmark::State& state, const std::string& which, bool
     piezo::update::GapDiagnosis d;
     if (heldout) {
       piezo::update::OeHeldout ho;
-      ho.data = piezo::ui::capture_oe_data(ho_cap, std::nullopt);
+      ho.data = piezo::jobs::capture_oe_data(ho_cap, std::nullopt);
       ho.description = "holdout.h5";
       d = piezo::update::gap_from_output_error(fit, which, *cm.solver, cm.cls, ho, req.options);
     } else {

@@ -32,4 +32,6 @@ NominalMaterial nominal_material(const std::string& cli, const std::optional<std
                         " assumed; give --material to choose"};
 }
 
+const std::vector<model::MaterialPreset>& material_presets() { return model::material_presets(); }
+
 }  // namespace piezo::jobs

@@ -2,7 +2,7 @@
 // few shots, low noise) → Prony-SS with the bench's options → damping ratios of
 // the zeros of Z(s) at the first two resonances (the short-circuit modes,
 // dsp/prony_impedance.hpp) → Rayleigh α, β (update/rayleigh.hpp, seed eqs
-// 166-169), as the pipeline's model curves take them (ui/pipeline.cpp,
+// 166-169), as the pipeline's model curves take them (jobs/pipeline/estimate_stage.cpp,
 // damping_from_features) — against the bench's own damping, α = 0, β = 1e-7 s.
 //
 // Independent truth: the sim's modes carry modal damping c_k = α + βκ_k with
@@ -73,7 +73,7 @@ TEST(SimRayleighDamping, PronyDampingOfTheResonancesAndTheRayleighPair) {
                                      test::scratch_dir("sim_rayleigh_damping") / "lab.h5");
   ASSERT_EQ(cap.shots.size(), 4u);
 
-  // The pipeline's estimate (ui/pipeline.cpp, estimate()): the shots averaged
+  // The pipeline's estimate (jobs/pipeline/estimate_stage.cpp, estimate()): the shots averaged
   // sample by sample, Prony-SS with the bench's options on 6000 samples, band 120 kHz.
   const auto& first = cap.shots.front();
   std::vector<double> v1(first.v1.size(), 0.0), v2(first.v2.size(), 0.0);

@@ -1,4 +1,4 @@
-// ui::probe_bench — what the GUI's Connect button runs: the embedded simulated
+// jobs::probe_bench — what the GUI's Connect button runs: the embedded simulated
 // bench and the same simulated instruments served over TCP go through one test
 // body (both must identify as the Keysight 33522B AWG and Infiniium DSO9104A
 // DAQ); then the failures the instrument panel must tell apart: nobody at the
@@ -16,7 +16,7 @@
 #include "drivers/sim/sim_daq.hpp"
 #include "drivers/sim/tcp_server.hpp"
 #include "drivers/transport.hpp"
-#include "ui/bench_probe.hpp"
+#include "jobs/bench_probe.hpp"
 
 using namespace piezo;
 
@@ -64,7 +64,7 @@ TEST_P(BenchProbe, IdentifiesBothInstruments) {
     awg = "tcp://127.0.0.1:" + std::to_string(tcp->awg->port());
     daq = "tcp://127.0.0.1:" + std::to_string(tcp->daq->port());
   }
-  const ui::BenchProbe p = ui::probe_bench(awg, daq, acq::SimSpec{}, kR1);
+  const jobs::BenchProbe p = jobs::probe_bench(awg, daq, acq::SimSpec{}, kR1);
   EXPECT_NE(p.awg_idn.find("33522B"), std::string::npos) << p.awg_idn;
   EXPECT_NE(p.daq_idn.find("DSO9104A"), std::string::npos) << p.daq_idn;
   EXPECT_FALSE(p.description.empty());
@@ -77,7 +77,7 @@ TEST(BenchProbeErrors, NobodyAtTheAddressIsATransportError) {
   ASSERT_GT(port, 0);
   const std::string addr = "tcp://127.0.0.1:" + std::to_string(port);
   try {
-    ui::probe_bench(addr, "", acq::SimSpec{}, kR1);
+    jobs::probe_bench(addr, "", acq::SimSpec{}, kR1);
     FAIL() << "no exception";
   } catch (const drivers::TransportError& e) {
     EXPECT_NE(std::string(e.what()).find(addr), std::string::npos) << e.what();
@@ -85,8 +85,8 @@ TEST(BenchProbeErrors, NobodyAtTheAddressIsATransportError) {
 }
 
 TEST(BenchProbeErrors, BadAddressesAreInvalidArguments) {
-  EXPECT_THROW(ui::probe_bench("gpib://3", "", acq::SimSpec{}, kR1), std::invalid_argument);
+  EXPECT_THROW(jobs::probe_bench("gpib://3", "", acq::SimSpec{}, kR1), std::invalid_argument);
   // A USB bench cannot guess the DAQ's address.
-  EXPECT_THROW(ui::probe_bench("usbtmc://0957:1607", "", acq::SimSpec{}, kR1),
+  EXPECT_THROW(jobs::probe_bench("usbtmc://0957:1607", "", acq::SimSpec{}, kR1),
                std::invalid_argument);
 }

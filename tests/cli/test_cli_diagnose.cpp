@@ -17,7 +17,7 @@
 #include <nlohmann/json.hpp>
 
 #include "tests/support/run_cli.hpp"
-#include "ui/report/diagnosis_plot.hpp"
+#include "jobs/report/diagnosis_plot.hpp"
 
 namespace {
 namespace fs = std::filesystem;
@@ -55,8 +55,8 @@ void make_captures(const fs::path& dir) {
 bool is_number_or_null(const json& v) { return v.is_number() || v.is_null(); }
 
 // Pixels within ±30 per channel of a colour inside a rectangle of an RGBA image.
-int count_colour(const unsigned char* px, int w, const piezo::report::PixelRect& r,
-                 piezo::report::Rgba c) {
+int count_colour(const unsigned char* px, int w, const piezo::jobs::report::PixelRect& r,
+                 piezo::jobs::report::Rgba c) {
   int n = 0;
   for (int y = static_cast<int>(r.y0); y < static_cast<int>(r.y1); ++y)
     for (int x = static_cast<int>(r.x0); x < static_cast<int>(r.x1); ++x) {
@@ -157,10 +157,10 @@ TEST(CliDiagnose, FitAndHoldoutCapturesNameTheLeadResistance) {
   ASSERT_NE(px, nullptr) << stbi_failure_reason();
   EXPECT_EQ(w, 1000);
   EXPECT_EQ(h, 700);
-  namespace pal = piezo::report::diagnosis_palette;
-  const auto L = piezo::report::diagnosis_plot_layout(w, h);
-  const piezo::report::PixelRect right{L.z.x0 + 0.6 * (L.z.x1 - L.z.x0), L.z.y0, L.z.x1, L.z.y1};
-  const piezo::report::PixelRect title{0, 0, static_cast<double>(w), L.z.y0 - 4};
+  namespace pal = piezo::jobs::report::diagnosis_palette;
+  const auto L = piezo::jobs::report::diagnosis_plot_layout(w, h);
+  const piezo::jobs::report::PixelRect right{L.z.x0 + 0.6 * (L.z.x1 - L.z.x0), L.z.y0, L.z.x1, L.z.y1};
+  const piezo::jobs::report::PixelRect title{0, 0, static_cast<double>(w), L.z.y0 - 4};
   const int measured = count_colour(px, w, right, pal::kMeasured);
   const int after = count_colour(px, w, right, pal::kAfter);
   const int before = count_colour(px, w, right, pal::kBefore);

@@ -1,5 +1,5 @@
 // Issue 18, item 4: a capture's /setup/material that is a description, or
-// nothing, never fails a capture (ui/nominal_material.hpp); the CLI's
+// nothing, never fails a capture (jobs/nominal_material.hpp); the CLI's
 // `update CAP.h5` and `replay` use it.
 #include <gtest/gtest.h>
 
@@ -8,10 +8,10 @@
 
 #include "acquisition/capture_file.hpp"
 #include "tests/support/run_cli.hpp"
-#include "ui/nominal_material.hpp"
+#include "jobs/nominal_material.hpp"
 
 namespace fs = std::filesystem;
-using piezo::ui::nominal_material;
+using piezo::jobs::nominal_material;
 
 TEST(NominalMaterial, TheUsersChoiceWinsAndMustBeAPreset) {
   const auto m = nominal_material("PZT-5H", std::string("apc850"));

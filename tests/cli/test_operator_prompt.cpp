@@ -1,4 +1,4 @@
-// The GUI's calibration prompt logic (ui/operator_prompt.hpp), without a
+// The GUI's calibration prompt logic (jobs/operator_prompt.hpp), without a
 // window: a worker thread asks and waits, the "frame loop" (this test) sees
 // the question and answers; a cancel flag or close() releases the worker.
 #include <gtest/gtest.h>
@@ -7,11 +7,11 @@
 #include <future>
 #include <thread>
 
-#include "ui/operator_prompt.hpp"
+#include "jobs/operator_prompt.hpp"
 
 namespace {
 using namespace std::chrono_literals;
-using piezo::ui::OperatorPrompt;
+using piezo::jobs::OperatorPrompt;
 
 std::optional<std::string> wait_question(const OperatorPrompt& p) {
   for (int i = 0; i < 200; ++i) {

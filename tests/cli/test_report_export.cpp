@@ -7,15 +7,15 @@
 #include <nlohmann/json.hpp>
 #include <sstream>
 
-#include "ui/report_export.hpp"
+#include "jobs/export/report_export.hpp"
 
 using namespace piezo;
 
 TEST(ReportExport, CsvTouchstoneAndJson) {
-  ui::PipelineResult r;
+  jobs::PipelineResult r;
   r.capture_path = "x.h5";
   r.curves.push_back({"measured (Prony-SS)", {1000.0, 2000.0}, {{10.0, -20.0}, {5.0, -8.0}}});
-  ui::ParamRow p;
+  jobs::ParamRow p;
   p.name = "YE11";
   p.unit = "Pa";
   p.original = 6.3e10;
@@ -29,9 +29,9 @@ TEST(ReportExport, CsvTouchstoneAndJson) {
   r.stages.push_back({"update", true, "converged"});
   const auto dir = std::filesystem::temp_directory_path() / ("piezobench-export-" + std::to_string(::getpid()));
   std::filesystem::create_directories(dir);
-  ui::export_csv(r, (dir / "a.csv").string());
-  ui::export_touchstone(r, (dir / "a.s1p").string());
-  ui::export_json(r, (dir / "a.json").string());
+  jobs::export_csv(r, (dir / "a.csv").string());
+  jobs::export_touchstone(r, (dir / "a.s1p").string());
+  jobs::export_json(r, (dir / "a.json").string());
   std::ifstream csv(dir / "a.csv");
   std::string header, row;
   std::getline(csv, header);
@@ -51,8 +51,8 @@ TEST(ReportExport, CsvTouchstoneAndJson) {
   EXPECT_EQ(j["parameters"][0]["cmcm"], 6.7e10);  // the seed's chain side by side
   EXPECT_EQ(j["update_method"], "output-error");
   EXPECT_EQ(j["stages"][0]["ran"], true);
-  EXPECT_THROW(ui::export_csv(r, (dir / "no/such/dir/a.csv").string()), std::runtime_error);
-  ui::PipelineResult empty;
-  EXPECT_THROW(ui::export_csv(empty, (dir / "b.csv").string()), std::runtime_error);
+  EXPECT_THROW(jobs::export_csv(r, (dir / "no/such/dir/a.csv").string()), std::runtime_error);
+  jobs::PipelineResult empty;
+  EXPECT_THROW(jobs::export_csv(empty, (dir / "b.csv").string()), std::runtime_error);
   std::filesystem::remove_all(dir);
 }

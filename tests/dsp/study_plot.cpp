@@ -26,8 +26,8 @@ std::string label_of(const StudyRow& r) {
 
 double phase_deg(std::complex<double> z) { return std::arg(z) * 180.0 / std::numbers::pi; }
 
-report::Panel panel(const char* title, const char* y_label, report::Scale x, report::Scale y) {
-  report::Panel p;
+jobs::report::Panel panel(const char* title, const char* y_label, jobs::report::Scale x, jobs::report::Scale y) {
+  jobs::report::Panel p;
   p.title = title;
   p.x_label = "frequency (Hz)";
   p.y_label = y_label;
@@ -36,9 +36,9 @@ report::Panel panel(const char* title, const char* y_label, report::Scale x, rep
   return p;
 }
 
-report::Series series(const std::string& label, const std::string& colour, double width,
+jobs::report::Series series(const std::string& label, const std::string& colour, double width,
                       bool dashed = false) {
-  report::Series s;
+  jobs::report::Series s;
   s.label = label;
   s.colour = colour;
   s.width = width;
@@ -48,9 +48,9 @@ report::Series series(const std::string& label, const std::string& colour, doubl
 
 }  // namespace
 
-report::Figure comparison_figure(const StudyInput& in, const std::vector<StudyRow>& rows,
+jobs::report::Figure comparison_figure(const StudyInput& in, const std::vector<StudyRow>& rows,
                                  const std::vector<ErrorBand>& bands, const std::string& title) {
-  report::Figure fig;
+  jobs::report::Figure fig;
   fig.title = title;
   fig.width = 1000;
   fig.panel_height = 340;
@@ -58,22 +58,22 @@ report::Figure comparison_figure(const StudyInput& in, const std::vector<StudyRo
   // The truth on a fine grid (the features are sharp at β = 1e-7).
   std::vector<double> ft;
   for (double f = in.f_lo_hz; f <= in.f_hi_hz * (1 + 1e-12); f *= 1.002) ft.push_back(f);
-  report::Series mag_true = series("true (FE modal)", "#000000", 2.5);
+  jobs::report::Series mag_true = series("true (FE modal)", "#000000", 2.5);
   mag_true.x = ft;
-  report::Series ph_true = mag_true;
+  jobs::report::Series ph_true = mag_true;
   for (double f : ft) {
     const auto z = in.z_true(f);
     mag_true.y.push_back(std::abs(z));
     ph_true.y.push_back(phase_deg(z));
   }
 
-  using report::Scale;
-  report::Panel mag = panel("|Z|", "|Z| (ohm)", Scale::Log, Scale::Log);
-  report::Panel zoom = panel("|Z|, 45-100 kHz", "|Z| (ohm)", Scale::Linear, Scale::Log);
-  report::Panel ph = panel("phase", "phase (deg)", Scale::Log, Scale::Linear);
-  report::Panel err =
+  using jobs::report::Scale;
+  jobs::report::Panel mag = panel("|Z|", "|Z| (ohm)", Scale::Log, Scale::Log);
+  jobs::report::Panel zoom = panel("|Z|, 45-100 kHz", "|Z| (ohm)", Scale::Linear, Scale::Log);
+  jobs::report::Panel ph = panel("phase", "phase (deg)", Scale::Log, Scale::Linear);
+  jobs::report::Panel err =
       panel("|Z| error: 20 log10(|Z est| / |Z true|)", "error (dB)", Scale::Log, Scale::Linear);
-  report::Panel err_zoom =
+  jobs::report::Panel err_zoom =
       panel("|Z| error, 45-100 kHz", "error (dB)", Scale::Linear, Scale::Linear);
   mag.x_range = ph.x_range = err.x_range = std::make_pair(in.f_lo_hz, in.f_hi_hz);
   zoom.x_range = err_zoom.x_range = std::make_pair(45e3, 100e3);
@@ -83,8 +83,8 @@ report::Figure comparison_figure(const StudyInput& in, const std::vector<StudyRo
 
   for (std::size_t k = 0; k < rows.size(); ++k) {
     const auto& r = rows[k];
-    report::Series m = series(label_of(r), colour_of(r, k), width_of(r));
-    report::Series p = m, e = m;
+    jobs::report::Series m = series(label_of(r), colour_of(r, k), width_of(r));
+    jobs::report::Series p = m, e = m;
     for (std::size_t i = 0; i < r.f_hz.size(); ++i) {
       const double f = r.f_hz[i];
       if (f < in.f_lo_hz || f > in.f_hi_hz) continue;
@@ -108,7 +108,7 @@ report::Figure comparison_figure(const StudyInput& in, const std::vector<StudyRo
   ph.series.push_back(ph_true);
 
   for (const auto& b : bands) {
-    report::Series up = series(b.label, b.colour, 1.5, true), dn = series("", b.colour, 1.5, true);
+    jobs::report::Series up = series(b.label, b.colour, 1.5, true), dn = series("", b.colour, 1.5, true);
     up.x = dn.x = b.f_hz;
     for (double s : b.sigma_db) {
       up.y.push_back(s);
@@ -120,19 +120,19 @@ report::Figure comparison_figure(const StudyInput& in, const std::vector<StudyRo
     }
   }
   for (auto* p : {&err, &err_zoom}) {
-    p->hlines.push_back(report::HLine{1.0, "#444444", true, "+1 dB target"});
-    p->hlines.push_back(report::HLine{-1.0, "#444444", true, "-1 dB"});
+    p->hlines.push_back(jobs::report::HLine{1.0, "#444444", true, "+1 dB target"});
+    p->hlines.push_back(jobs::report::HLine{-1.0, "#444444", true, "-1 dB"});
   }
   for (const auto* v : {&in.true_resonances_hz, &in.true_antiresonances_hz})
     for (double f : *v)
       for (auto* p : {&mag, &zoom, &ph, &err, &err_zoom})
-        p->markers.push_back(report::VMarker{f, "#bbbbbb"});
+        p->markers.push_back(jobs::report::VMarker{f, "#bbbbbb"});
 
   // The zoom panels keep only their points in range (+1 on each side): the
   // writer clips, but the file would carry every point.
   for (auto* p : {&zoom, &err_zoom})
     for (auto& ser : p->series) {
-      report::Series kept = ser;
+      jobs::report::Series kept = ser;
       kept.x.clear();
       kept.y.clear();
       for (std::size_t i = 0; i < ser.x.size(); ++i) {
@@ -151,9 +151,9 @@ report::Figure comparison_figure(const StudyInput& in, const std::vector<StudyRo
   return fig;
 }
 
-void write_comparison_svg(const report::Figure& fig, const std::filesystem::path& file) {
+void write_comparison_svg(const jobs::report::Figure& fig, const std::filesystem::path& file) {
   if (file.has_parent_path()) std::filesystem::create_directories(file.parent_path());
-  report::write_svg(fig, file);
+  jobs::report::write_svg(fig, file);
 }
 
 }  // namespace piezo::study

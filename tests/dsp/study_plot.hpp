@@ -4,13 +4,13 @@
 // |Z| error in dB against frequency (whole band and the modes' zoom) with the
 // Cramér–Rao band and the ±1 dB target. Rows are drawn in the order given (put
 // the smooth estimates last to keep them on top). Drawn by the project's
-// headless SVG writer (ui/report/svg_plot).
+// headless SVG writer (jobs/report/svg_plot).
 #include <filesystem>
 #include <string>
 #include <vector>
 
 #include "impedance_study.hpp"
-#include "ui/report/svg_plot.hpp"
+#include "jobs/report/svg_plot.hpp"
 
 namespace piezo::study {
 
@@ -21,10 +21,10 @@ struct ErrorBand {
   std::string colour = "#7f7f7f";
 };
 
-report::Figure comparison_figure(const StudyInput& in, const std::vector<StudyRow>& rows,
+jobs::report::Figure comparison_figure(const StudyInput& in, const std::vector<StudyRow>& rows,
                                  const std::vector<ErrorBand>& bands, const std::string& title);
 
 // Writes the figure; throws std::runtime_error naming the file when it cannot.
-void write_comparison_svg(const report::Figure& fig, const std::filesystem::path& file);
+void write_comparison_svg(const jobs::report::Figure& fig, const std::filesystem::path& file);
 
 }  // namespace piezo::study

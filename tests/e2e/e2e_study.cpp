@@ -207,7 +207,7 @@ E2eOutcome run_e2e_case(const E2eCase& c, const E2eChain& chain,
         }
       }
       const std::size_t nfit = chain.prony_samples > 0 ? std::min(chain.prony_samples, post) : post;
-      const std::size_t lead = pre > 0 ? 1 : 0;  // as ui/pipeline.cpp: from the idle sample before t = 0
+      const std::size_t lead = pre > 0 ? 1 : 0;  // as jobs/pipeline/estimate_stage.cpp: from the idle sample before t = 0
       std::vector<double> a(nfit), b(nfit);
       for (std::size_t i = 0; i < nfit; ++i) {
         a[i] = rec.v1[pre - lead + i] - m1;

@@ -12,7 +12,7 @@
 #include "acquisition/capture.hpp"
 #include "dsp/mode_figures.hpp"
 #include "tests/dsp/bvd_model.hpp"
-#include "ui/mode_nyquist.hpp"
+#include "jobs/mode_nyquist.hpp"
 #include "drivers/instrument_uri.hpp"
 #include "drivers/scpi_client.hpp"
 #include "drivers/transport.hpp"
@@ -70,12 +70,12 @@ TEST(ErrorAdvice, ClassifiesByExceptionType) {
 }
 
 TEST(ErrorAdvice, ResultProblemsNeedAction) {
-  ui::PipelineResult ok;
+  jobs::PipelineResult ok;
   ok.stages = {
       {"acquire", true, ""}, {"estimate", true, ""}, {"update", true, ""}, {"diagnose", true, ""}};
   EXPECT_TRUE(result_problems(ok).empty());
 
-  ui::PipelineResult r;
+  jobs::PipelineResult r;
   r.stages = {{"update", false, "extended CMCM did NOT converge"},
               {"diagnose", false, "failed: needs at least 3 repeated shots"}};
   r.warnings = {"cancelled during acquisition; kept 2 shot(s)", "overlay estimators: too short"};
@@ -90,7 +90,7 @@ TEST(ErrorAdvice, ResultProblemsNeedAction) {
   EXPECT_NE(p[1].advice.find("Shots"), std::string::npos) << p[1].advice;
   EXPECT_EQ(p[2].stage, "acquire");
   // "diagnose: not requested" is a choice, not a problem.
-  ui::PipelineResult skipped;
+  jobs::PipelineResult skipped;
   skipped.stages = {{"diagnose", false, "not requested"}};
   EXPECT_TRUE(result_problems(skipped).empty());
 }
@@ -223,7 +223,7 @@ TEST(PlotReadout, SnapsToTheNearestResonanceAndReadsEachCurve) {
   EXPECT_TRUE(piezo::gui::readout_at(spec, 60e3, nullptr).empty());  // outside the curve's range
 }
 
-// The admittance view of each mode (ui/mode_nyquist.hpp) on an exact
+// The admittance view of each mode (jobs/mode_nyquist.hpp) on an exact
 // two-branch BVD network: the fitted network traced across the window is the
 // network's own admittance (the fit is exact and the neighbour is included),
 // and the estimate's points near fs lie on the motional circle (diameter 1/R1)
@@ -237,7 +237,7 @@ TEST(ModeNyquist, ExactBvdPointsOnTheFittedCircle) {
   ASSERT_EQ(figs.modes.size(), 2u);
   const std::vector<double> fv(f.data(), f.data() + f.size());
   const std::vector<std::complex<double>> zv(z.data(), z.data() + z.size());
-  const auto ny = piezo::ui::mode_nyquist(fv, zv, figs);
+  const auto ny = piezo::jobs::mode_nyquist(fv, zv, figs);
   ASSERT_EQ(ny.size(), 2u);
   for (std::size_t i = 0; i < 2; ++i) {
     const auto& n = ny[i];
@@ -267,8 +267,8 @@ TEST(Limits, JudgeResultAgainstTheLoadedLimits) {
   AppState s;
   judge_result(s);
   EXPECT_FALSE(s.verdict);
-  auto r = std::make_shared<ui::PipelineResult>();
-  ui::ParamRow p;
+  auto r = std::make_shared<jobs::PipelineResult>();
+  jobs::ParamRow p;
   p.name = "YE11";
   p.unit = "Pa";
   p.original = 6.3e10;
@@ -277,7 +277,7 @@ TEST(Limits, JudgeResultAgainstTheLoadedLimits) {
   s.result = r;
   judge_result(s);
   EXPECT_FALSE(s.verdict);  // no limits loaded
-  s.limits = std::make_shared<const report::Limits>(report::parse_limits(
+  s.limits = std::make_shared<const jobs::report::Limits>(jobs::report::parse_limits(
       "[[limit]]\nquantity = \"parameters.YE11\"\nmin = 6e10\nmax = 7e10\n", "l.toml"));
   judge_result(s);
   ASSERT_TRUE(s.verdict);
@@ -287,7 +287,7 @@ TEST(Limits, JudgeResultAgainstTheLoadedLimits) {
   EXPECT_EQ(s.verdict->status, "fail");
   ASSERT_EQ(s.verdict->reasons.size(), 1u);
   EXPECT_EQ(s.verdict->reasons[0], "parameters.YE11 = 7.5e+10 > max 7e+10");
-  s.limits = std::make_shared<const report::Limits>(report::parse_limits(
+  s.limits = std::make_shared<const jobs::report::Limits>(jobs::report::parse_limits(
       "[[limit]]\nquantity = \"modes[0].k_eff\"\nmin = 0.1\n", "l.toml"));
   judge_result(s);  // the result has no per-mode figures: not measured, a fail
   EXPECT_EQ(s.verdict->status, "fail");

@@ -2,9 +2,9 @@
 // flag on a transducer that differs, failed captures listed.
 #include <gtest/gtest.h>
 
-#include "ui/report/batch_summary.hpp"
+#include "jobs/report/batch_summary.hpp"
 
-using namespace piezo::report;
+using namespace piezo::jobs::report;
 
 namespace {
 nlohmann::json ok_record(const std::string& path, double ye11, double f1) {

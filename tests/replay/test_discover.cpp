@@ -9,7 +9,7 @@
 #include <fstream>
 #include <set>
 
-#include "ui/replay/discover.hpp"
+#include "jobs/replay/discover.hpp"
 
 using namespace piezo;
 namespace fs = std::filesystem;
@@ -38,7 +38,7 @@ std::vector<std::string> strings(const std::vector<fs::path>& v) {
 
 TEST(Discover, FoldersRecursivelyFilesAsGivenSortedOnce) {
   Tree t;
-  auto found = replay::find_captures(
+  auto found = jobs::replay::find_captures(
       {t.s("line2"), t.s("other/extra.dat"), t.s("line1"), t.root.string() + "/line1/./T-001.h5"});
   EXPECT_EQ(strings(found),
             (std::vector<std::string>{t.s("line1/T-001.h5"), t.s("line1/T-002.h5"),
@@ -47,10 +47,10 @@ TEST(Discover, FoldersRecursivelyFilesAsGivenSortedOnce) {
 
 TEST(Discover, ExcludesTheResultsFileAndNamesAMissingInput) {
   Tree t;
-  auto found = replay::find_captures({t.s("line1")}, {t.root / "line1/../line1/T-002.h5"});
+  auto found = jobs::replay::find_captures({t.s("line1")}, {t.root / "line1/../line1/T-002.h5"});
   EXPECT_EQ(strings(found), (std::vector<std::string>{t.s("line1/T-001.h5")}));
   try {
-    replay::find_captures({t.s("line1"), t.s("nope")});
+    jobs::replay::find_captures({t.s("line1"), t.s("nope")});
     FAIL() << "expected an error";
   } catch (const std::invalid_argument& e) {
     EXPECT_NE(std::string(e.what()).find(t.s("nope")), std::string::npos) << e.what();
@@ -58,21 +58,21 @@ TEST(Discover, ExcludesTheResultsFileAndNamesAMissingInput) {
 }
 
 TEST(Shard, ParsesIOverN) {
-  auto s = replay::parse_shard("3/4");
+  auto s = jobs::replay::parse_shard("3/4");
   EXPECT_EQ(s.index, 3u);
   EXPECT_EQ(s.count, 4u);
   for (const char* bad : {"4/4", "1/0", "x/4", "1", "-1/4", "1/4/2", "/4", "1/"})
-    EXPECT_THROW(replay::parse_shard(bad), std::invalid_argument) << bad;
+    EXPECT_THROW(jobs::replay::parse_shard(bad), std::invalid_argument) << bad;
 }
 
 TEST(Shard, DisjointCoveringBalancedAndOrderIndependent) {
   Tree t;
-  const auto a = replay::find_captures({t.s("line1"), t.s("line2"), t.s("other/extra.dat")});
-  const auto b = replay::find_captures({t.s("other/extra.dat"), t.s("line2"), t.s("line1")});
+  const auto a = jobs::replay::find_captures({t.s("line1"), t.s("line2"), t.s("other/extra.dat")});
+  const auto b = jobs::replay::find_captures({t.s("other/extra.dat"), t.s("line2"), t.s("line1")});
   ASSERT_EQ(a, b);
   std::vector<fs::path> all;
   for (std::size_t i = 0; i < 3; ++i) {
-    auto part = replay::select_shard(a, {i, 3});
+    auto part = jobs::replay::select_shard(a, {i, 3});
     EXPECT_GE(part.size(), 1u);
     EXPECT_LE(part.size(), 2u);
     all.insert(all.end(), part.begin(), part.end());
@@ -83,7 +83,7 @@ TEST(Shard, DisjointCoveringBalancedAndOrderIndependent) {
   // Position k of the sorted list goes to shard k mod N.
   std::vector<fs::path> ten;
   for (char k = '0'; k <= '9'; ++k) ten.emplace_back(std::string("c") + k + ".h5");
-  auto s1 = replay::select_shard(ten, {1, 4});
+  auto s1 = jobs::replay::select_shard(ten, {1, 4});
   EXPECT_EQ(strings(s1), (std::vector<std::string>{"c1.h5", "c5.h5", "c9.h5"}));
-  EXPECT_EQ(replay::select_shard(ten, {0, 1}), ten);
+  EXPECT_EQ(jobs::replay::select_shard(ten, {0, 1}), ten);
 }

@@ -1,4 +1,4 @@
-// ui/report/limits: the LIMITS.toml schema (valid files, malformed ones named
+// jobs/report/limits: the LIMITS.toml schema (valid files, malformed ones named
 // by file and line), the path language into a record, and the pass/fail of a
 // capture with its reasons (each way out of range, bounds included, a quantity
 // not measured, an allowed list, a failed replay).
@@ -6,9 +6,9 @@
 
 #include <fstream>
 
-#include "ui/report/limits.hpp"
+#include "jobs/report/limits.hpp"
 
-using namespace piezo::report;
+using namespace piezo::jobs::report;
 
 namespace {
 
@@ -42,7 +42,7 @@ quantity = "output_error.converged"
 allowed = [true]
 )";
 
-// A record's "result" as ui::report_json writes it (the fields the limits read).
+// A record's "result" as jobs::report_json writes it (the fields the limits read).
 nlohmann::json result(double ye11, double qm, double tan_delta, const std::string& verdict) {
   return nlohmann::json::parse(R"({
     "parameters": [{"name": "YE11", "unit": "Pa", "original": 6.3e10, "updated": 0, "sigma": 1e8},

@@ -1,4 +1,4 @@
-// ui/report/lot_summary and lot_report: counts, distribution, histogram,
+// jobs/report/lot_summary and lot_report: counts, distribution, histogram,
 // robust outliers and the capability indices against hand computations; the
 // lot report's files, and its histogram figure as SVG and PNG (the limits
 // drawn where they belong).
@@ -9,11 +9,11 @@
 #include <fstream>
 #include <sstream>
 
-#include "ui/report/figure_png.hpp"
-#include "ui/report/lot_report.hpp"
-#include "ui/report/lot_summary.hpp"
+#include "jobs/report/figure_png.hpp"
+#include "jobs/report/lot_report.hpp"
+#include "jobs/report/lot_summary.hpp"
 
-using namespace piezo::report;
+using namespace piezo::jobs::report;
 namespace fs = std::filesystem;
 
 namespace {

@@ -23,7 +23,7 @@
 #include <nlohmann/json.hpp>
 
 #include "dsp/mode_figures.hpp"
-#include "ui/pipeline.hpp"
+#include "jobs/pipeline/pipeline.hpp"
 
 namespace {
 namespace fs = std::filesystem;
@@ -80,12 +80,12 @@ TEST(ModeFiguresCorpus, FreeCapacitanceWithinHalfAPercentOfTheTrueImpedance) {
     std::ifstream tj(kCorpus / c / "truth.json");
     const auto truth = nlohmann::json::parse(tj);
     ASSERT_TRUE(truth["effect"].is_null()) << c << " is not a control";
-    ui::PipelineRequest req;
+    jobs::PipelineRequest req;
     req.replay_capture = (kCorpus / c / "fit.h5").string();
     req.replay_contained = false;
     req.diagnose = false;
     std::atomic<bool> cancel{false};
-    const auto r = ui::run_pipeline(req, {}, cancel);
+    const auto r = jobs::run_pipeline(req, {}, cancel);
     ASSERT_TRUE(r.mode_figures) << c;
     ASSERT_TRUE(r.mode_figures->error.empty()) << c << ": " << r.mode_figures->error;
     const auto& est = r.mode_figures->figures;

@@ -4,9 +4,9 @@
 #include <cmath>
 #include <limits>
 
-#include "ui/report/robust_stats.hpp"
+#include "jobs/report/robust_stats.hpp"
 
-using namespace piezo::report;
+using namespace piezo::jobs::report;
 
 TEST(RobustStats, MedianAndMadOddAndEven) {
   auto s = robust_stats({3, 1, 2, 100, 4});

@@ -3,9 +3,9 @@
 
 #include <cmath>
 
-#include "ui/report/svg_plot.hpp"
+#include "jobs/report/svg_plot.hpp"
 
-using namespace piezo::report;
+using namespace piezo::jobs::report;
 
 namespace {
 std::size_t count(const std::string& s, const std::string& what) {

@@ -29,7 +29,7 @@
 #include "model/modal.hpp"
 #include "model/transient.hpp"
 #include "model/tube_model.hpp"
-#include "ui/capture_fit.hpp"
+#include "jobs/pipeline/capture_fit.hpp"
 #include "update/output_error.hpp"
 
 namespace {
@@ -331,9 +331,9 @@ TEST_F(DampingModels, CorpusStudy) {
         truth["effect"].is_null() ? "none" : truth["effect"]["name"].get<std::string>();
     const auto cap = acq::read_capture(corpus / c / "fit.h5");
     const auto ho_cap = acq::read_capture(corpus / c / "holdout.h5");
-    const auto cm = ui::capture_model(cap, "apc850", true);
-    const auto fd = ui::capture_oe_data(cap, std::nullopt);
-    const auto hd = ui::capture_oe_data(ho_cap, std::nullopt);
+    const auto cm = jobs::capture_model(cap, "apc850", true);
+    const auto fd = jobs::capture_oe_data(cap, std::nullopt);
+    const auto hd = jobs::capture_oe_data(ho_cap, std::nullopt);
     const auto r = score(*cm.solver, cm.cls, cm.p0, fd, hd, update::OeDamping::rayleigh);
     const auto x = score(*cm.solver, cm.cls, cm.p0, fd, hd, update::OeDamping::complex_constants);
     print_row(c, effect, r, x);

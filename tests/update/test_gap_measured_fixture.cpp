@@ -13,8 +13,8 @@
 #include "acquisition/calibration_plan.hpp"
 #include "model/material_presets.hpp"
 #include "tests/support/sim_capture.hpp"
-#include "ui/pipeline.hpp"
-#include "ui/report_export.hpp"
+#include "jobs/pipeline/pipeline.hpp"
+#include "jobs/export/report_export.hpp"
 
 using namespace piezo;
 namespace fs = std::filesystem;
@@ -22,8 +22,8 @@ namespace fs = std::filesystem;
 namespace {
 constexpr double kCp = 150e-12, kR1Err = 0.02, kRs = 5.0, kSkew = 100e-9;
 
-ui::PipelineResult run(bool calibrate, const fs::path& dir) {
-  ui::PipelineRequest req;
+jobs::PipelineResult run(bool calibrate, const fs::path& dir) {
+  jobs::PipelineRequest req;
   req.instrument = "sim";
   req.plan = test::seed_lab_plan(16);
   req.sim.isotropic = true;
@@ -37,17 +37,17 @@ ui::PipelineResult run(bool calibrate, const fs::path& dir) {
   req.heldout_plan = test::chirp_plan(16);
   if (calibrate) req.calibration = acq::parse_calibration_list("open,short,load", 1000.0);
   std::atomic<bool> cancel{false};
-  return ui::run_pipeline(req, {}, cancel);
+  return jobs::run_pipeline(req, {}, cancel);
 }
 
-double error_pct(const ui::PipelineResult& r, const std::string& name) {
+double error_pct(const jobs::PipelineResult& r, const std::string& name) {
   for (const auto& p : r.params)
     if (p.name == name && p.truth) return 100.0 * (p.updated / *p.truth - 1.0);
   ADD_FAILURE() << "no " << name << " row with a truth";
   return 0;
 }
-double eps_error_pct(const ui::PipelineResult& r) { return error_pct(r, "epsT33_rel"); }
-double worst_elastic_pct(const ui::PipelineResult& r) {
+double eps_error_pct(const jobs::PipelineResult& r) { return error_pct(r, "epsT33_rel"); }
+double worst_elastic_pct(const jobs::PipelineResult& r) {
   double w = 0;
   for (const char* n : {"YE11", "nu12", "d31"}) w = std::max(w, std::abs(error_pct(r, n)));
   return w;
@@ -119,7 +119,7 @@ TEST(GapMeasuredFixture, CalibrationShotsTurnAliasesIntoMeasuredQuantities) {
   EXPECT_LT(std::abs(bias1), 0.3);
   EXPECT_EQ(d.verdict_effect, "none") << d.verdict;
   // The JSON carries them under "measured", in issue 7's shape.
-  const auto j = ui::diagnosis_json(d);
+  const auto j = jobs::diagnosis_json(d);
   ASSERT_EQ(j["measured"].size(), d.measured.size());
   EXPECT_TRUE(j["verdict"].is_object());
   EXPECT_EQ(j["verdict"]["effect"], d.verdict_effect);

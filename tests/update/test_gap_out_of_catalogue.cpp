@@ -32,7 +32,7 @@
 #include "model/material_spec.hpp"
 #include "tests/support/out_of_catalogue.hpp"
 #include "tests/support/sim_capture.hpp"
-#include "ui/pipeline.hpp"
+#include "jobs/pipeline/pipeline.hpp"
 
 using namespace piezo;
 namespace fs = std::filesystem;
@@ -45,14 +45,14 @@ struct OocRun {
   double band_lo_hz = 0, band_hi_hz = 0;
   double truth[4] = {0, 0, 0, 0};  // YE11, nu12, d31, epsT33_rel of the true material (its isotropic view)
   double eps_alias = 0;  // wall thickness: the relative εT33 that takes the clamped capacitance's change
-  ui::PipelineResult result;
+  jobs::PipelineResult result;
 };
 
 OocRun run_ooc(int kind_index, std::uint64_t seed, double noise, int shots, const fs::path& dir) {
   acq::SimSpec base = test::study_transducer(seed);
   base.noise_rel = noise;
   OocRun out;
-  ui::PipelineRequest req;
+  jobs::PipelineRequest req;
   req.instrument = "sim";
   req.plan = test::seed_lab_plan(shots);
   req.plan.setup.transducer_id = "out-of-catalogue";
@@ -83,7 +83,7 @@ OocRun run_ooc(int kind_index, std::uint64_t seed, double noise, int shots, cons
   out.truth[2] = iso.d31;
   out.truth[3] = iso.eps_t33 / model::kEps0;
   std::atomic<bool> cancel{false};
-  out.result = ui::run_pipeline(req, {}, cancel);
+  out.result = jobs::run_pipeline(req, {}, cancel);
   return out;
 }
 

@@ -14,7 +14,7 @@
 #include "model/effects.hpp"
 #include "tests/support/run_cli.hpp"
 #include "tests/support/sim_capture.hpp"
-#include "ui/capture_fit.hpp"
+#include "jobs/pipeline/capture_fit.hpp"
 #include "update/gap_diagnosis.hpp"
 #include "update/gap_output_error.hpp"
 
@@ -37,9 +37,9 @@ acq::SimSpec spec_with(const char* effect, std::uint64_t seed) {
 update::GapDiagnosis diagnose_one_shot(const acq::SimSpec& spec, const std::string& name) {
   auto sim = acq::make_sim_bench(spec, 3140.0);
   const auto cap = test::sim_capture(sim, test::seed_lab_plan(1), tmp_dir("gap-oe") / (name + ".h5"));
-  ui::CaptureFitRequest req;
+  jobs::CaptureFitRequest req;
   req.options.scan_effects = update::supported_gap_effects();
-  const auto f = ui::fit_capture(cap, req);
+  const auto f = jobs::fit_capture(cap, req);
   EXPECT_TRUE(f.result.ok()) << name << ": " << f.result.message;
   return update::gap_from_output_error(f.result, name);
 }
@@ -96,7 +96,7 @@ struct FitAndHeldout {
   acq::Capture heldout_capture;  // OeData's shots are views into it
   update::OeResult fit;
   update::OeHeldout heldout;
-  std::unique_ptr<ui::CaptureModel> model;
+  std::unique_ptr<jobs::CaptureModel> model;
 };
 FitAndHeldout fit_and_heldout(const acq::SimSpec& spec, const std::string& name) {
   auto sim = acq::make_sim_bench(spec, 3140.0);
@@ -104,12 +104,12 @@ FitAndHeldout fit_and_heldout(const acq::SimSpec& spec, const std::string& name)
   FitAndHeldout out;
   out.heldout_capture = test::sim_capture(sim, test::chirp_plan(1), tmp_dir("gap-oe-ho") / (name + "-heldout.h5"));
   const acq::Capture& ho = out.heldout_capture;
-  out.model = std::make_unique<ui::CaptureModel>(ui::capture_model(cap, "apc850", true));
-  ui::CaptureFitRequest req;
+  out.model = std::make_unique<jobs::CaptureModel>(jobs::capture_model(cap, "apc850", true));
+  jobs::CaptureFitRequest req;
   req.options.scan_effects = update::supported_gap_effects();
-  out.fit = ui::fit_capture(cap, req, *out.model).result;
+  out.fit = jobs::fit_capture(cap, req, *out.model).result;
   EXPECT_TRUE(out.fit.ok()) << name << ": " << out.fit.message;
-  out.heldout.data = ui::capture_oe_data(ho, std::nullopt);
+  out.heldout.data = jobs::capture_oe_data(ho, std::nullopt);
   out.heldout.description = name + " chirp";
   return out;
 }
@@ -124,13 +124,13 @@ TEST(GapOutputError, HeldOutPredictionByTheTrueTubeIsAtTheNoise) {
   const auto spec = spec_with("", 41);
   auto sim = acq::make_sim_bench(spec, 3140.0);
   const auto ho = test::sim_capture(sim, test::chirp_plan(1), tmp_dir("gap-oe-ho") / "truth-heldout.h5");
-  const auto cm = ui::capture_model(ho, "apc850", true);
+  const auto cm = jobs::capture_model(ho, "apc850", true);
   update::TubeParams truth = cm.p0;
   truth.y_e11 = 6.66e10;
   truth.nu12 = 0.3333;
   truth.d31 = -210e-12;
   truth.eps_t33 = 2294 * model::kEps0;
-  const auto data = ui::capture_oe_data(ho, std::nullopt);
+  const auto data = jobs::capture_oe_data(ho, std::nullopt);
   const double band = 130e3;
   const auto p = update::predict_output_error(*cm.solver, cm.cls, truth, spec.damping.beta, {}, data, band);
   std::printf("true tube: chi2/dof %.3f (limit %.3f, noise from %s)\n", p.chi2_per_dof, p.chi2_limit,

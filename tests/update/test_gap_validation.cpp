@@ -20,7 +20,7 @@
 #include "dsp/shot_ensemble.hpp"
 #include "model/bench_response.hpp"
 #include "tests/support/sim_truth.hpp"
-#include "ui/pipeline.hpp"
+#include "jobs/pipeline/pipeline.hpp"
 
 using namespace piezo;
 namespace fs = std::filesystem;
@@ -73,8 +73,8 @@ double truth_chi2(const acq::SimSpec& spec, const fs::path& capture) {
   return chi2 / (2.0 * f.size());
 }
 
-ui::PipelineResult run_case(const Case& c, const fs::path& dir) {
-  ui::PipelineRequest req;
+jobs::PipelineResult run_case(const Case& c, const fs::path& dir) {
+  jobs::PipelineRequest req;
   req.instrument = "sim";
   req.plan = test::seed_lab_plan(c.shots);
   req.plan.setup.transducer_id = "validation";
@@ -97,7 +97,7 @@ ui::PipelineResult run_case(const Case& c, const fs::path& dir) {
   req.capture_out = (dir / "fit.h5").string();
   req.heldout_plan = test::chirp_plan(c.shots);
   std::atomic<bool> cancel{false};
-  auto r = ui::run_pipeline(req, {}, cancel);
+  auto r = jobs::run_pipeline(req, {}, cancel);
   if (std::getenv("GAP_VERBOSE") && c.shots >= 3) {  // (the shot ensemble needs repeats)
     const acq::SimSpec& spec = req.sim;
     std::printf("    truth: chi2/N of the fit capture %.2f, of the held-out capture %.2f (estimates vs the true bench)\n",
@@ -115,7 +115,7 @@ struct Tally {
   std::vector<double> shrinks;  // held-out shrink of correct verdicts
 };
 
-void score(const Case& c, const ui::PipelineResult& r, Tally& t) {
+void score(const Case& c, const jobs::PipelineResult& r, Tally& t) {
   ASSERT_TRUE(r.diagnosis) << "no diagnosis for " << c.effect;
   const auto& d = *r.diagnosis;
   const std::string injected = c.effect.empty() ? "none" : c.effect;
@@ -274,7 +274,7 @@ TEST(GapDiagnosisCi, StrippingTruthChangesNothing) {
     const fs::path src = dir / name, dst = dir / (std::string("stripped-") + name);
     fs::copy_file(src, dst, fs::copy_options::overwrite_existing);
   }
-  ui::PipelineRequest with, without;
+  jobs::PipelineRequest with, without;
   with.replay_capture = (dir / "fit.h5").string();
   with.heldout_capture = (dir / "fit-heldout.h5").string();
   without = with;
@@ -283,7 +283,7 @@ TEST(GapDiagnosisCi, StrippingTruthChangesNothing) {
   ASSERT_TRUE(test::strip_truth(without.replay_capture));
   ASSERT_TRUE(test::strip_truth(without.heldout_capture));
   std::atomic<bool> cancel{false};
-  auto ra = ui::run_pipeline(with, {}, cancel), rb = ui::run_pipeline(without, {}, cancel);
+  auto ra = jobs::run_pipeline(with, {}, cancel), rb = jobs::run_pipeline(without, {}, cancel);
   ASSERT_TRUE(ra.diagnosis && rb.diagnosis);
   EXPECT_EQ(ra.diagnosis->verdict, rb.diagnosis->verdict);
   EXPECT_EQ(ra.diagnosis->chi2_fit, rb.diagnosis->chi2_fit);

@@ -22,7 +22,7 @@
 #include "model/modal.hpp"
 #include "model/transient.hpp"
 #include "model/tube_model.hpp"
-#include "ui/capture_fit.hpp"
+#include "jobs/pipeline/capture_fit.hpp"
 #include "update/gap_diagnosis.hpp"
 #include "update/gap_output_error.hpp"
 #include "update/output_error.hpp"
@@ -322,8 +322,8 @@ CaseResult check_case(const std::string& name) {
   const auto truth = nlohmann::json::parse(is);
   out.effect = truth["effect"].is_null() ? "none" : truth["effect"]["name"].get<std::string>();
   const auto cap = acq::read_capture(kCorpus / name / "fit.h5");
-  ui::CaptureFitRequest req;
-  const auto fit = ui::fit_capture(cap, req);
+  jobs::CaptureFitRequest req;
+  const auto fit = jobs::fit_capture(cap, req);
   const auto& r = fit.result;
   EXPECT_TRUE(r.ok()) << name << ": " << r.message;  // an estimate from every capture
   const std::pair<const char*, const char*> keys[] = {
@@ -401,17 +401,17 @@ TEST(OutputErrorCorpus, EffectScanOnEveryCase) {
     const auto truth = nlohmann::json::parse(is);
     const std::string effect = truth["effect"].is_null() ? "none" : truth["effect"]["name"].get<std::string>();
     const auto cap = acq::read_capture(kCorpus / c / "fit.h5");
-    ui::CaptureFitRequest req;
+    jobs::CaptureFitRequest req;
     req.options.scan_effects = {"series_resistance", "daq_input_resistance", "parallel_capacitance",
                                 "dielectric_loss",   "channel_skew",         "channel_gain",
                                 "r1_tolerance",      "mass_loading",         "mechanical_damping"};
-    const auto cm = ui::capture_model(cap, req.material, req.isotropic);
-    const auto r = ui::fit_capture(cap, req, cm).result;
+    const auto cm = jobs::capture_model(cap, req.material, req.isotropic);
+    const auto r = jobs::fit_capture(cap, req, cm).result;
     ASSERT_TRUE(r.ok()) << c;
     // The chirp held out (issue 18: the fit's model predicts its v2 from its v1).
     const auto ho_cap = acq::read_capture(kCorpus / c / "holdout.h5");
     update::OeHeldout ho;
-    ho.data = ui::capture_oe_data(ho_cap, std::nullopt);
+    ho.data = jobs::capture_oe_data(ho_cap, std::nullopt);
     ho.description = std::string(c) + "/holdout.h5";
     const auto d = update::gap_from_output_error(r, c, *cm.solver, cm.cls, ho, req.options);
     const std::string top = d.verdict_effect;

@@ -8,8 +8,8 @@
 #include <map>
 
 #include "acquisition/capture.hpp"
-#include "ui/json_text.hpp"
-#include "update/output_error.hpp"
+#include "jobs/json/json_text.hpp"
+#include "jobs/pipeline/capture_fit.hpp"  // update::OeOptions, the output-error fit's options
 
 namespace piezo::cli {
 
@@ -46,7 +46,7 @@ int run_command(Context& ctx, const std::function<void()>& body) {
 
 // Streamed (no serialised copy in memory: a 250 000-bin spectrum is ~100 MB of text).
 void print_json(const nlohmann::json& j) {
-  ui::write_json(std::cout, j);
+  jobs::write_json(std::cout, j);
   std::cout << std::endl;
 }
 

@@ -1,11 +1,14 @@
 #pragma once
 // Shared conventions of the `piezobench` commands: exit codes, --json output,
 // error reporting. Every command registers itself through a register_* function.
+// The CLI's room (ui/cli): commands parse options, call a job (jobs/) and print.
 #include <CLI/CLI.hpp>
 #include <functional>
 #include <iosfwd>
 #include <nlohmann/json.hpp>
 #include <string>
+
+#include "jobs/job_error.hpp"
 
 namespace piezo::update {
 struct OeOptions;
@@ -16,9 +19,8 @@ namespace piezo::cli {
 enum ExitCode : int { kOk = 0, kInternal = 1, kBadInput = 2 };
 
 // Error whose cause is the user's input (bad file, bad option value): exit 2.
-struct InputError : std::runtime_error {
-  using std::runtime_error::runtime_error;
-};
+// The jobs throw the same type (jobs/job_error.hpp).
+using InputError = jobs::InputError;
 
 struct Context {
   bool json = false;  // --json: machine-readable output on stdout

@@ -1,32 +1,23 @@
 // `piezobench demo`: the main job end to end on the embedded simulated bench —
 // the seed's lab measurement (R1 = 3140 Ω, 1 V exp_decay at 3000 1/s, 20000
 // samples at 10 MS/s) of a simulated tube, then every later stage that has
-// landed (the same pipeline as the GUI's "Measure and update").
-#include <filesystem>
+// landed (the same pipeline as the GUI's "Measure and update"). The CLI's
+// room (ui/cli): the demo's request and run are jobs/demo_job.hpp.
+#include <atomic>
+#include <cmath>
+#include <cstdio>
 #include <iostream>
 
-#include "acquisition/calibration_plan.hpp"
+#include "jobs/demo_job.hpp"
+#include "jobs/export/report_export.hpp"
 #include "ui/cli/cli_common.hpp"
-#include "model/effects.hpp"
 #include "ui/cli/diagnosis_text.hpp"
-#include "ui/pipeline.hpp"
-#include "ui/report_export.hpp"
 
 namespace piezo::cli {
 
 void register_demo_command(CLI::App& app, Context& ctx) {
   auto* demo = app.add_subcommand("demo", "Run the main job on the embedded simulated bench");
-  struct Args {
-    std::string out_dir = "demo-out";
-    double noise = 0.005;
-    std::uint64_t seed = 2016;
-    std::vector<std::string> effects;
-    bool no_diagnose = false;
-    std::string calibrate = "open,short,load";
-    bool no_calibrate = false;
-    int shots = 16;
-  };
-  auto a = std::make_shared<Args>();
+  auto a = std::make_shared<jobs::DemoRequest>();
   demo->add_option("--out", a->out_dir, "Folder for the demo's files")->capture_default_str();
   demo->add_option("--noise", a->noise, "White noise per channel, std(noise)/std(signal)")->capture_default_str();
   demo->add_option("--seed", a->seed, "Noise seed")->capture_default_str();
@@ -44,42 +35,11 @@ void register_demo_command(CLI::App& app, Context& ctx) {
   add_json_flag(demo, ctx);
   demo->callback([&ctx, a] {
     ctx.exit_code = run_command(ctx, [&] {
-      namespace fs = std::filesystem;
-      fs::create_directories(a->out_dir);
-      ui::PipelineRequest req;
-      req.instrument = "sim";
-      req.plan.setup.divider_r1_ohm = 3140.0;
-      req.plan.setup.transducer_id = "demo-tube";
-      req.plan.setup.material = "apc850";
-      req.plan.samples = 20000;
-      req.plan.pretrigger_samples = 200;
-      req.plan.shots = a->shots;
-      // The simulated "real" tube: the seed's Table 4/5 target material in the isotropic class.
-      req.sim.material = "apc850";
-      req.sim.isotropic = true;
-      req.sim.set = "YE11=6.66e10,nu12=0.3333,d31=-210e-12,epsT33_rel=2294";
-      req.sim.noise_rel = a->noise;
-      req.sim.seed = a->seed;
-      for (const auto& e : a->effects) model::apply_effect_assignment(req.sim.effects, e);
-      req.diagnose = !a->no_diagnose;
-      if (!a->no_calibrate && !a->calibrate.empty())
-        req.calibration = acq::parse_calibration_list(a->calibrate, 1000.0);
-      // Held-out data for the gap diagnosis: a chirp of the same tube, 1-150 kHz.
-      acq::MeasurementPlan ho = req.plan;
-      ho.excitation.kind = acq::Excitation::Chirp;
-      ho.excitation.f_start_hz = 1e3;
-      ho.excitation.f_stop_hz = 150e3;
-      ho.excitation.burst_fraction = 0.6;
-      req.heldout_plan = ho;
-      req.capture_out = (fs::path(a->out_dir) / "demo-capture.h5").string();
-      req.material = "apc850";
-      req.isotropic = true;
-      req.compare_lm = true;  // the table shows oe, cmcm and lm
       std::atomic<bool> cancel{false};
       ProgressBar bar("demo");
-      auto res = ui::run_pipeline(req, [&](const ui::PipelineProgress& p) { bar.update(p.fraction, p.stage); }, cancel);
+      auto res = jobs::run_demo(*a, [&](const jobs::PipelineProgress& p) { bar.update(p.fraction, p.stage); }, cancel);
       bar.finish();
-      const nlohmann::json j = ui::report_json(res);  // the same report as replay and the GUI export
+      const nlohmann::json j = jobs::report_json(res);  // the same report as replay and the GUI export
       if (ctx.json) {
         print_json(j);
         return;

@@ -1,5 +1,5 @@
 // `piezobench replay PATH... --out RESULTS.h5`: headless replay of recorded
-// captures (ui/replay/replay_batch.hpp) with a progress bar and ETA, and
+// captures (jobs/replay/replay_batch.hpp) with a progress bar and ETA, and
 // `piezobench replay-merge A.h5 B.h5 ... --out ALL.h5` for sharded runs.
 // Exit codes: 0 every capture replayed; 2 some captures were refused or
 // failed (each reported, the batch went on) or bad options; 1 the batch
@@ -14,10 +14,10 @@
 
 #include "acquisition/results_file.hpp"
 #include "ui/cli/cli_common.hpp"
-#include "ui/replay/merge.hpp"
-#include "ui/replay/replay_batch.hpp"
-#include "ui/report/limits.hpp"
-#include "ui/report/lot_summary.hpp"
+#include "jobs/replay/merge.hpp"
+#include "jobs/replay/replay_batch.hpp"
+#include "jobs/report/limits.hpp"
+#include "jobs/report/lot_summary.hpp"
 #include "ui/version.hpp"
 
 namespace piezo::cli {
@@ -38,7 +38,7 @@ std::string duration(double s) {
   return b;
 }
 
-std::string progress_text(const replay::ReplayProgress& p) {
+std::string progress_text(const jobs::replay::ReplayProgress& p) {
   char b[160];
   std::snprintf(b, sizeof b, "%zu/%zu ok %zu failed %zu done-before %zu | %.2f/s | ETA %s", p.done,
                 p.total, p.ok, p.failed, p.skipped, p.rate_per_s, duration(p.eta_s).c_str());
@@ -56,7 +56,7 @@ auto as_input(F&& f) {
 }
 
 // The lot against the limits: counts, then each capture that did not pass with its reasons.
-void print_lot(const report::Limits& l, const report::LotSummary& s,
+void print_lot(const jobs::report::Limits& l, const jobs::report::LotSummary& s,
                const std::optional<std::filesystem::path>& report_dir) {
   std::printf("limits %s: %zu pass, %zu fail, %zu error of %zu record(s) in the results file%s\n",
               l.source.c_str(), s.pass, s.fail, s.error, s.captures.size(),
@@ -131,12 +131,12 @@ void register_replay_commands(CLI::App& app, Context& ctx) {
   add_json_flag(r, ctx);
   r->callback([&ctx, a] {
     ctx.exit_code = run_command(ctx, [&] {
-      replay::ReplayOptions opt;
+      jobs::replay::ReplayOptions opt;
       opt.inputs = a->inputs;
       opt.out = a->out;
       opt.jobs = a->jobs;
       opt.capture_timeout_s = a->timeout_s;
-      opt.shard = replay::parse_shard(a->shard);
+      opt.shard = jobs::replay::parse_shard(a->shard);
       if (!a->report.empty()) opt.report_dir = a->report;
       if (!a->jsonl.empty()) opt.jsonl = a->jsonl;
       opt.material = a->material;
@@ -147,8 +147,8 @@ void register_replay_commands(CLI::App& app, Context& ctx) {
       opt.software = std::string("piezobench ") + kVersion + " replay";
       if (!a->limits.empty()) {  // a malformed file stops the run before any capture
         try {
-          opt.limits = report::read_limits(a->limits);
-        } catch (const report::LimitsError& e) {
+          opt.limits = jobs::report::read_limits(a->limits);
+        } catch (const jobs::report::LimitsError& e) {
           throw InputError(std::string("--limits: ") + e.what());
         }
       }
@@ -158,8 +158,8 @@ void register_replay_commands(CLI::App& app, Context& ctx) {
       const bool tty = ::isatty(STDERR_FILENO);
       ProgressBar bar("replay");
       std::size_t last_decile = 0;
-      replay::ReplayCallbacks cb;
-      cb.progress = [&](const replay::ReplayProgress& p) {
+      jobs::replay::ReplayCallbacks cb;
+      cb.progress = [&](const jobs::replay::ReplayProgress& p) {
         if (tty) {
           bar.update(p.total ? static_cast<double>(p.done) / p.total : 1.0, progress_text(p));
         } else if (p.total &&
@@ -168,7 +168,7 @@ void register_replay_commands(CLI::App& app, Context& ctx) {
           std::fprintf(stderr, "replay: %s\n", progress_text(p).c_str());
         }
       };
-      cb.issue = [&](const replay::ReplayIssue& i) {
+      cb.issue = [&](const jobs::replay::ReplayIssue& i) {
         if (tty) std::fprintf(stderr, "\n");
         const char* what = i.kind == "report" ? "report not written" : "skipped";
         if (i.message.rfind(i.path, 0) == 0)  // the message names the file already
@@ -177,7 +177,7 @@ void register_replay_commands(CLI::App& app, Context& ctx) {
           std::fprintf(stderr, "piezobench: replay: %s: %s: %s\n", what, i.path.c_str(),
                        i.message.c_str());
       };
-      auto s = as_input([&] { return replay::run_replay(opt, cb, g_stop); });
+      auto s = as_input([&] { return jobs::replay::run_replay(opt, cb, g_stop); });
       bar.finish();
       std::signal(SIGINT, SIG_DFL);
       std::signal(SIGTERM, SIG_DFL);
@@ -197,7 +197,7 @@ void register_replay_commands(CLI::App& app, Context& ctx) {
       j["issues"] = nlohmann::json::array();
       for (const auto& i : s.issues)
         j["issues"].push_back({{"path", i.path}, {"kind", i.kind}, {"message", i.message}});
-      if (s.lot) j["lot"] = report::lot_json(*opt.limits, *s.lot);
+      if (s.lot) j["lot"] = jobs::report::lot_json(*opt.limits, *s.lot);
       if (ctx.json) {
         print_json(j);
       } else {
@@ -240,14 +240,14 @@ void register_replay_commands(CLI::App& app, Context& ctx) {
   add_json_flag(m, ctx);
   m->callback([&ctx, ma] {
     ctx.exit_code = run_command(ctx, [&] {
-      replay::MergeOptions opt;
+      jobs::replay::MergeOptions opt;
       for (const auto& i : ma->inputs) opt.inputs.emplace_back(i);
       opt.out = ma->out;
       opt.overwrite = ma->overwrite;
       opt.software = std::string("piezobench ") + kVersion + " replay-merge";
       if (!ma->report.empty()) opt.report_dir = ma->report;
       if (!ma->jsonl.empty()) opt.jsonl = ma->jsonl;
-      auto s = as_input([&] { return replay::merge_results(opt); });
+      auto s = as_input([&] { return jobs::replay::merge_results(opt); });
       for (const auto& w : s.warnings)
         std::cerr << "piezobench: replay-merge: warning: " << w << "\n";
       if (ctx.json) {

@@ -2,327 +2,49 @@
 //      [--material M] [--isotropic] [--set YE11=…,nu12=…,d31=…,epsT33_rel=…]
 //      [--method cmcm|lm|both] [--overlay FILE.csv] [--damping F:ZETA,F:ZETA] [--json]`
 // Multi-physics FE model updating of the tube (seed §6.3-6.4, update/README.md).
-// Explicit features override the ones found in the file.
+// Explicit features override the ones found in the file. The CLI's room
+// (ui/cli): the work is jobs/update_features_job.hpp and, for a capture,
+// jobs/update_capture_job.hpp.
 // Exit codes: 0 converged, 2 bad input, 1 not converged / internal failure
 // (the JSON result is still printed, with "converged": false and a message).
-#include <cmath>
 #include <cstdio>
-#include <fstream>
-#include <map>
-#include <optional>
-#include <sstream>
+#include <string>
 
-#include "model/harmonic.hpp"
-#include "model/material_presets.hpp"
+#include "jobs/update_features_job.hpp"
 #include "ui/cli/cli_common.hpp"
 #include "ui/cli/cmd_update_capture.hpp"
-#include "update/impedance_file.hpp"
-#include "update/least_squares.hpp"
-#include "update/output_error.hpp"
-#include "update/rayleigh.hpp"
-#include "update/updater.hpp"
 
 namespace piezo::cli {
 
 namespace {
 
-namespace pm = piezo::model;
-namespace pu = piezo::update;
-
 struct UpdateArgs {
-  std::string file, resonances, antiresonances, low_z, material, set, method;
-  std::string overlay, damping, capacitance = "fe";
-  bool isotropic = false, cross_modes = false, transverse = false;
-  pu::OeOptions oe;  // a capture's output-error fit (the chain's tolerances)
-  int max_iterations = pu::CmcmOptions{}.max_iterations;
-  int n_radial = pm::MeshOptions{}.n_radial, n_axial = pm::MeshOptions{}.n_axial;
+  jobs::UpdateFeaturesRequest f;  // file, features, method, material, … (method empty: the default of the kind)
+  bool transverse = false;
+  update::OeOptions oe;  // a capture's output-error fit (the chain's tolerances)
 };
-
-std::map<std::string, double> parse_set(const std::string& s) {
-  std::map<std::string, double> kv;
-  std::stringstream ss(s);
-  std::string item;
-  while (std::getline(ss, item, ',')) {
-    if (item.empty()) continue;
-    const auto eq = item.find('=');
-    if (eq == std::string::npos || eq == 0)
-      throw InputError("--set: expected key=value, got '" + item + "'");
-    const std::string val = item.substr(eq + 1);
-    std::size_t used = 0;
-    double v = NAN;
-    try {
-      v = std::stod(val, &used);
-    } catch (const std::exception&) {
-      used = 0;
-    }
-    if (used != val.size() || !std::isfinite(v))
-      throw InputError("--set: bad number for " + item.substr(0, eq) + ": '" + val + "'");
-    kv[item.substr(0, eq)] = v;
-  }
-  return kv;
-}
-
-nlohmann::json params_json(const pu::MaterialClass& cls, const pu::TubeParams& p) {
-  nlohmann::json j = {
-      {"YE11", p.y_e11}, {"nu12", p.nu12}, {"d31", p.d31}, {"epsT33_rel", p.eps_t33 / pm::kEps0}};
-  try {
-    const auto e = cls.e_summary(cls.coordinates(p), p.d31 < 0 ? -1 : 1);
-    j["cE11"] = e.c_e11;
-    j["cE12"] = e.c_e12;
-    j["e31"] = e.e31;
-    j["epsS33_rel"] = e.eps_s33 / pm::kEps0;
-  } catch (const std::invalid_argument&) {
-  }
-  return j;
-}
-
-std::vector<std::complex<double>> model_impedance(pm::ModalSolver& solver,
-                                                  const pm::PiezoMaterialE& m,
-                                                  const std::vector<double>& f,
-                                                  const pm::RayleighDamping& d) {
-  pm::ModalOptions o;
-  o.n_modes = 20;
-  const auto port = solver.port_model(m, o);
-  return pm::impedance_from_admittance(pm::admittance_modal(port, f, d));
-}
 
 void run_update_features(Context& ctx, const UpdateArgs& a0, const std::string& method);
 
 void run_update(Context& ctx, const UpdateArgs& a) {
-  if (a.file.size() > 3 && a.file.compare(a.file.size() - 3, 3, ".h5") == 0) {
+  if (a.f.file.size() > 3 && a.f.file.compare(a.f.file.size() - 3, 3, ".h5") == 0) {
     // A capture: the tube's constants from the recorded samples.
-    if (a.isotropic && a.transverse) throw InputError("--isotropic and --transverse exclude each other");
-    run_update_capture(ctx, a.file, a.method.empty() ? "oe" : a.method, a.material, !a.transverse, a.oe);
+    if (a.f.isotropic && a.transverse) throw InputError("--isotropic and --transverse exclude each other");
+    run_update_capture(ctx, a.f.file, a.f.method.empty() ? "oe" : a.f.method, a.f.material, !a.transverse, a.oe);
     return;
   }
   if (a.transverse) throw InputError("--transverse is for a capture (an impedance file's default class is transversely isotropic)");
-  run_update_features(ctx, a, a.method.empty() ? "cmcm" : a.method);
+  run_update_features(ctx, a, a.f.method.empty() ? "cmcm" : a.f.method);
 }
 
 void run_update_features(Context& ctx, const UpdateArgs& a0, const std::string& method) {
-  UpdateArgs a = a0;
+  jobs::UpdateFeaturesRequest a = a0.f;
   a.method = method;
-  if (a.method != "cmcm" && a.method != "lm" && a.method != "both")
-    throw InputError("--method must be cmcm, lm or both");
-  if (a.capacitance != "fe" && a.capacitance != "analytic")
-    throw InputError("--capacitance must be fe or analytic");
-  if (a.max_iterations < 1) throw InputError("--max-iterations must be >= 1");
-  const auto& preset = pm::find_preset(a.material.empty() ? "apc850" : a.material);
-  pm::TubeGeometry geometry;
-  geometry.density_kg_m3 = preset.density_kg_m3;
-
-  // Features: file first, explicit options override.
-  pu::MeasuredFeatures mf;
-  std::optional<pu::ImpedanceCurve> curve;
-  nlohmann::json measured;
-  if (!a.file.empty()) {
-    try {
-      curve = pu::read_impedance_file(a.file);
-    } catch (const std::runtime_error& e) {
-      throw InputError(e.what());
-    }
-    const auto ex = pu::extract_features(*curve);
-    mf = ex.features;
-    measured["file"] = a.file;
-    measured["low_z_phase_deg"] = ex.low_z_phase_deg;
-  }
-  if (!a.resonances.empty()) mf.resonances_hz = pu::parse_list(a.resonances);
-  if (!a.antiresonances.empty()) mf.antiresonances_hz = pu::parse_list(a.antiresonances);
-  if (!a.low_z.empty()) std::tie(mf.low_z_ohm, mf.low_z_hz) = pu::parse_ohm_at_hz(a.low_z);
-  if (mf.resonances_hz.empty() || mf.antiresonances_hz.empty() || !(mf.low_z_ohm > 0))
-    throw InputError("need an impedance file or --resonances, --antiresonances and --low-z");
-  mf.validate();
-  measured["resonances_hz"] = mf.resonances_hz;
-  measured["antiresonances_hz"] = mf.antiresonances_hz;
-  measured["low_z_ohm"] = mf.low_z_ohm;
-  measured["low_z_hz"] = mf.low_z_hz;
-
-  // Original model: the four sensitive parameters of the preset, --set overrides.
-  pu::TubeParams p0 = pm::isotropic_params(preset.material);
-  auto kv = parse_set(a.set);
-  auto take = [&](const char* key, double& field, double scale = 1.0) {
-    if (auto it = kv.find(key); it != kv.end()) {
-      field = it->second * scale;
-      kv.erase(it);
-    }
-  };
-  take("YE11", p0.y_e11);
-  take("nu12", p0.nu12);
-  take("d31", p0.d31);
-  take("epsT33", p0.eps_t33);
-  take("epsT33_rel", p0.eps_t33, pm::kEps0);
-  if (!kv.empty())
-    throw InputError("--set: '" + kv.begin()->first +
-                     "' is not an updated parameter (YE11, nu12, d31, epsT33_rel)");
-  const pu::MaterialClass cls = a.isotropic
-                                    ? pu::MaterialClass::isotropic()
-                                    : pu::MaterialClass::transversely_isotropic(preset.material);
-  (void)cls.e_form(p0);  // non-physical original → std::invalid_argument → exit 2
-
-  pm::MeshOptions mesh;
-  mesh.n_radial = a.n_radial;
-  mesh.n_axial = a.n_axial;
-  pm::TubeModel tube(geometry, mesh);
-  pm::ModalSolver solver(tube);
-
-  pu::UpdateOptions uo;
-  uo.cmcm.max_iterations = a.max_iterations;
-  uo.cmcm.cross_modes = a.cross_modes;
-  uo.capacitance =
-      a.capacitance == "fe" ? pu::CapacitanceModel::fe : pu::CapacitanceModel::analytic;
-
-  nlohmann::json out;
-  out["method"] = a.method;
-  out["model_class"] = pu::to_string(cls.kind());
-  out["material"] = preset.name;
-  out["original"] = params_json(cls, p0);
-  out["measured"] = measured;
-  bool converged = false;
-  pu::TubeParams updated = p0;
-  auto alpha_json = [&](const pu::TubeParams& p) {
-    const auto q0 = cls.coordinates(p0), q = cls.coordinates(p);
-    return nlohmann::json{{"alpha1", q.c1 / q0.c1 - 1},
-                          {"alpha2", q.c2 / q0.c2 - 1},
-                          {"alpha3", q.a / pu::a_from_d31(p0.d31, q.c1 + q.c2, p0.eps_t33) - 1}};
-  };
-  nlohmann::json lm_json;
-  if (a.method == "lm" || a.method == "both") {
-    pu::LmOptions lo;
-    const auto lm = pu::update_lm(tube, solver, cls, p0, mf, lo);
-    lm_json = {{"updated", params_json(cls, lm.updated)},
-               {"converged", lm.ok()},
-               {"status", pu::to_string(lm.status)},
-               {"message", lm.message},
-               {"iterations", lm.iterations},
-               {"evaluations", lm.evaluations},
-               {"cost", lm.cost},
-               {"residuals", lm.residuals},
-               {"model_after",
-                {{"resonances_hz", lm.model_resonances_hz},
-                 {"antiresonances_hz", lm.model_antiresonances_hz}}},
-               {"seconds", lm.seconds}};
-    try {
-      lm_json["alpha"] = alpha_json(lm.updated);
-    } catch (const std::invalid_argument&) {
-    }
-    if (a.method == "lm") {
-      converged = lm.ok();
-      updated = lm.updated;
-      out["updated"] = lm_json["updated"];
-      if (lm_json.contains("alpha")) out["alpha"] = lm_json["alpha"];
-      // LM updates all four parameters jointly: one iteration count for both groups.
-      out["iterations"] = {
-          {"elastic", lm.iterations}, {"piezo", lm.iterations}, {"lm", lm.iterations}};
-      out["converged"] = converged;
-      out["status"] = pu::to_string(lm.status);
-      out["message"] = lm.message;
-      out["model_after"] = lm_json["model_after"];
-      out["seconds"] = lm.seconds;
-    } else {
-      out["lm"] = lm_json;
-    }
-  }
-  if (a.method != "lm") {
-    const auto r = pu::update_cmcm(tube, solver, cls, p0, mf, uo);
-    converged = r.ok();
-    updated = r.updated;
-    out["updated"] = params_json(cls, r.updated);
-    out["alpha"] = {{"alpha1", r.alpha1}, {"alpha2", r.alpha2}, {"alpha3", r.alpha3}};
-    out["iterations"] = {{"elastic", r.iterations_elastic},
-                         {"piezo", r.iterations_piezo},
-                         {"elastic_per_sweep", r.elastic_per_sweep},
-                         {"piezo_per_sweep", r.piezo_per_sweep},
-                         {"sweeps", r.sweeps}};
-    out["converged"] = converged;
-    out["status"] = pu::to_string(r.status);
-    out["message"] = r.message;
-    out["eps_t33_eq201_rel"] = r.eps_t33_eq201 / pm::kEps0;
-    out["capacitance"] = {
-        {"model", a.capacitance}, {"measured_f", r.c_measured}, {"model_after_f", r.c_model_after}};
-    out["model_before"] = {{"resonances_hz", r.model_resonances_before_hz},
-                           {"antiresonances_hz", r.model_antiresonances_before_hz}};
-    out["model_after"] = {{"resonances_hz", r.model_resonances_hz},
-                          {"antiresonances_hz", r.model_antiresonances_hz}};
-    out["seconds"] = r.seconds;
-    if (a.method == "both" && lm_json.contains("updated")) {
-      nlohmann::json diff;
-      for (const char* k : {"YE11", "nu12", "d31", "epsT33_rel"})
-        diff[k] = lm_json["updated"][k].get<double>() / out["updated"][k].get<double>() - 1.0;
-      out["lm_minus_cmcm_relative"] = diff;
-    }
-  }
-
-  pm::RayleighDamping damping;
-  damping.beta = 1e-7;  // seed ch. 5 default for the overlay when no fit is given
-  if (!a.damping.empty()) {
-    std::vector<std::pair<double, double>> fz;
-    std::stringstream ss(a.damping);
-    std::string item;
-    while (std::getline(ss, item, ',')) {
-      const auto c = item.find(':');
-      if (c == std::string::npos) throw InputError("--damping: expected F:ZETA,F:ZETA");
-      fz.emplace_back(pu::parse_list(item.substr(0, c)).at(0),
-                      pu::parse_list(item.substr(c + 1)).at(0));
-    }
-    if (fz.size() != 2) throw InputError("--damping: exactly two modes F1:ZETA1,F2:ZETA2");
-    // The two-parameter fit where physical, else the one-parameter damping
-    // the two modes support with its sigma (issue 19: no refusal).
-    const auto fit = pu::damping_from_modes(fz[0].first, fz[0].second, fz[1].first, fz[1].second);
-    auto num = [](double x) {
-      return std::isfinite(x) ? nlohmann::json(x) : nlohmann::json(nullptr);
-    };
-    out["rayleigh"] = {{"ok", fit.ok},
-                       {"message", fit.ok ? fit.note : fit.message},
-                       {"alpha", fit.damping.alpha},
-                       {"beta", fit.damping.beta},
-                       {"model", fit.model},
-                       {"alpha_sigma", num(fit.alpha_sigma)},
-                       {"beta_sigma", num(fit.beta_sigma)},
-                       {"qm", {num(fit.qm1), num(fit.qm2)}}};
-    if (fit.ok)
-      damping = fit.damping;
-    else
-      std::fprintf(stderr, "piezobench: %s\n", fit.message.c_str());
-  }
-
-  if (!a.overlay.empty()) {
-    std::vector<double> f;
-    if (curve) {
-      for (double x : curve->f_hz)
-        if (x > 0) f.push_back(x);
-    } else {
-      f = pm::frequency_grid(100, 1.2 * mf.antiresonances_hz.back(), 100);
-    }
-    const auto z0 = model_impedance(solver, cls.e_form(p0), f, damping);
-    std::vector<std::complex<double>> z1;
-    try {
-      z1 = model_impedance(solver, cls.e_form(updated), f, damping);
-    } catch (const std::invalid_argument&) {
-      z1.assign(f.size(), std::complex<double>(NAN, NAN));
-    }
-    std::ofstream os(a.overlay);
-    if (!os) throw InputError("--overlay: cannot write '" + a.overlay + "'");
-    os.precision(10);
-    os << "f_hz,original_abs_ohm,updated_abs_ohm,measured_abs_ohm,original_phase_deg,"
-          "updated_phase_deg,measured_phase_deg\n";
-    std::size_t k = 0;
-    for (std::size_t i = 0; i < f.size(); ++i) {
-      os << f[i] << ',' << std::abs(z0[i]) << ',' << std::abs(z1[i]) << ',';
-      std::complex<double> zm(NAN, NAN);
-      if (curve) {
-        while (k < curve->f_hz.size() && curve->f_hz[k] < f[i]) ++k;
-        if (k < curve->f_hz.size() && curve->f_hz[k] == f[i]) zm = curve->z_ohm[k];
-      }
-      if (std::isfinite(zm.real())) os << std::abs(zm);
-      os << ',' << std::arg(z0[i]) * 180 / M_PI << ',' << std::arg(z1[i]) * 180 / M_PI << ',';
-      if (std::isfinite(zm.real())) os << std::arg(zm) * 180 / M_PI;
-      os << '\n';
-    }
-    out["overlay"] = {{"file", a.overlay},
-                      {"points", f.size()},
-                      {"rayleigh_alpha", damping.alpha},
-                      {"rayleigh_beta", damping.beta}};
-  }
+  a.warn = [](const std::string& w) { std::fprintf(stderr, "piezobench: %s\n", w.c_str()); };
+  auto r = jobs::run_update_features(a);
+  nlohmann::json& out = r.json;
+  const bool converged = r.converged;
+  const auto& preset_name = r.material;
 
   if (ctx.json) {
     print_json(out);
@@ -330,7 +52,7 @@ void run_update_features(Context& ctx, const UpdateArgs& a0, const std::string& 
     const auto& o = out["original"];
     const auto& u = out["updated"];
     std::printf("model updating (%s, %s class, material %s): %s\n", a.method.c_str(),
-                out["model_class"].get<std::string>().c_str(), preset.name.c_str(),
+                out["model_class"].get<std::string>().c_str(), preset_name.c_str(),
                 converged ? "converged" : "NOT converged");
     if (out.contains("message") && !out["message"].get<std::string>().empty())
       std::printf("  %s\n", out["message"].get<std::string>().c_str());
@@ -360,32 +82,32 @@ void register_update_command(CLI::App& app, Context& ctx) {
   auto a = std::make_shared<UpdateArgs>();
   auto* cmd =
       app.add_subcommand("update", "FE model updating: from a capture (output-error fit) or impedance features (extended CMCM, LM)");
-  cmd->add_option("FILE", a->file,
+  cmd->add_option("FILE", a->f.file,
                   "Impedance file (CSV f_hz,re_ohm,im_ohm or Touchstone .s1p) or a capture (.h5)");
-  cmd->add_option("--resonances", a->resonances, "Resonances F1,F2,… [Hz]");
-  cmd->add_option("--antiresonances", a->antiresonances, "Anti-resonances F1,F2,… [Hz]");
-  cmd->add_option("--low-z", a->low_z, "|Z| at a low frequency, OHM@HZ (e.g. 26804@400)");
-  cmd->add_option("--material", a->material,
+  cmd->add_option("--resonances", a->f.resonances, "Resonances F1,F2,… [Hz]");
+  cmd->add_option("--antiresonances", a->f.antiresonances, "Anti-resonances F1,F2,… [Hz]");
+  cmd->add_option("--low-z", a->f.low_z, "|Z| at a low frequency, OHM@HZ (e.g. 26804@400)");
+  cmd->add_option("--material", a->f.material,
                   "Material preset of the original model (default: a capture's /setup/material, else apc850)");
-  cmd->add_flag("--isotropic", a->isotropic,
+  cmd->add_flag("--isotropic", a->f.isotropic,
                 "Isotropic-simplification class (seed §6.4.3; a capture's default)");
-  cmd->add_option("--set", a->set, "Original parameters: YE11=…,nu12=…,d31=…,epsT33_rel=…");
-  cmd->add_option("--method", a->method,
+  cmd->add_option("--set", a->f.set, "Original parameters: YE11=…,nu12=…,d31=…,epsT33_rel=…");
+  cmd->add_option("--method", a->f.method,
                   "impedance file: cmcm (default), lm or both; capture: oe (default, output-error fit of "
                   "the samples), cmcm, lm or all");
   cmd->add_flag("--transverse", a->transverse,
                 "Capture: transversely isotropic class instead of the isotropic one");
-  cmd->add_option("--overlay", a->overlay, "Write |Z| of original, updated and measured to CSV");
-  cmd->add_option("--damping", a->damping, "Rayleigh fit from two modes: F1:ZETA1,F2:ZETA2");
-  cmd->add_option("--capacitance", a->capacitance,
+  cmd->add_option("--overlay", a->f.overlay, "Write |Z| of original, updated and measured to CSV");
+  cmd->add_option("--damping", a->f.damping, "Rayleigh fit from two modes: F1:ZETA1,F2:ZETA2");
+  cmd->add_option("--capacitance", a->f.capacitance,
                   "fe (FE capacitance at f_L) or analytic (eq. 201)")
       ->capture_default_str();
-  cmd->add_option("--max-iterations", a->max_iterations, "CMCM iteration cap per phase")
+  cmd->add_option("--max-iterations", a->f.max_iterations, "CMCM iteration cap per phase")
       ->capture_default_str();
-  cmd->add_flag("--cross-modes", a->cross_modes,
+  cmd->add_flag("--cross-modes", a->f.cross_modes,
                 "Include the i != j CMCM equations (seed-faithful, slow)");
-  cmd->add_option("--nr", a->n_radial, "Elements through the wall")->capture_default_str();
-  cmd->add_option("--nz", a->n_axial, "Elements along the length")->capture_default_str();
+  cmd->add_option("--nr", a->f.n_radial, "Elements through the wall")->capture_default_str();
+  cmd->add_option("--nz", a->f.n_axial, "Elements along the length")->capture_default_str();
   add_chain_tolerance_options(cmd, a->oe);
   add_json_flag(cmd, ctx);
   cmd->callback([&ctx, a] { ctx.exit_code = run_command(ctx, [&] { run_update(ctx, *a); }); });

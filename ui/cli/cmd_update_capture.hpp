@@ -2,7 +2,7 @@
 #include <string>
 
 #include "ui/cli/cli_common.hpp"
-#include "update/output_error.hpp"
+#include "jobs/update_capture_job.hpp"  // update::OeOptions
 
 namespace piezo::cli {
 

@@ -2,7 +2,7 @@
 // The gap diagnosis as a terminal table (demo, update, replay).
 #include <ostream>
 
-#include "update/gap_diagnosis.hpp"
+#include "jobs/pipeline/pipeline.hpp"  // update::GapDiagnosis
 
 namespace piezo::cli {
 

@@ -1,48 +1,33 @@
 // What the buttons do: start or replay a job, connect to the instruments,
 // export. Each hands its work to the Job or TaskQueue thread and returns at
 // once; outcomes come back into the AppState on the UI thread.
-#include <sstream>
-
 #include "drivers/instrument_uri.hpp"
-#include "model/effects.hpp"
-#include "model/material_presets.hpp"
-#include "ui/bench_probe.hpp"
+#include "jobs/bench_probe.hpp"
+#include "jobs/export/report_export.hpp"
+#include "jobs/nominal_material.hpp"
+#include "jobs/sim_effects.hpp"
 #include "ui/gui/app_state.hpp"
 #include "ui/gui/calibration_prompt.hpp"
-#include "ui/report_export.hpp"
 
 namespace piezo::gui {
 
 namespace {
-// "series_resistance=15, channel_skew=1e-7" → an EffectSet; throws
-// std::invalid_argument naming the bad item (model/effects.hpp).
-model::EffectSet parse_sim_effects(const std::string& text) {
-  model::EffectSet set;
-  std::stringstream ss(text);
-  std::string item;
-  while (std::getline(ss, item, ',')) {
-    const auto b = item.find_first_not_of(" \t"), e = item.find_last_not_of(" \t");
-    if (b == std::string::npos) continue;
-    model::apply_effect_assignment(set, item.substr(b, e - b + 1));
-  }
-  return set;
-}
-
-// The simulated bench's spec with the panel's effects; throws like parse_sim_effects.
+// The simulated bench's spec with the panel's effects; throws std::invalid_argument
+// naming a bad item (jobs/sim_effects.hpp).
 acq::SimSpec sim_spec(const AppState& s) {
   acq::SimSpec sim = s.request.sim;
-  sim.effects = parse_sim_effects(s.instrument.sim_effects);
+  sim.effects = jobs::parse_sim_effects(s.instrument.sim_effects);  // "series_resistance=15, channel_skew=1e-7"
   return sim;
 }
 }  // namespace
 
 void start_job(AppState& s, bool replay) {
   if (s.job.running()) return;
-  ui::PipelineRequest req = s.request;  // committed copy: edits during the run do not leak in
+  jobs::PipelineRequest req = s.request;  // committed copy: edits during the run do not leak in
   req.instrument = s.instrument.awg;
   req.daq = s.instrument.daq;
   req.capture_out = s.capture_out;
-  const auto& presets = model::material_presets();
+  const auto& presets = jobs::material_presets();
   req.material = presets.at(static_cast<std::size_t>(s.material_index) % presets.size()).name;
   req.plan.setup.material = req.material;
   if (s.transducer_id[0]) req.plan.setup.transducer_id = std::string(s.transducer_id);
@@ -75,7 +60,7 @@ void start_job(AppState& s, bool replay) {
 }
 
 bool collect_job(AppState& s) {
-  std::unique_ptr<ui::PipelineResult> res;
+  std::unique_ptr<jobs::PipelineResult> res;
   std::optional<Problem> problem;
   const bool cancelled = s.job.cancel_requested();
   if (!s.job.take(res, problem)) return false;
@@ -90,7 +75,7 @@ bool collect_job(AppState& s) {
   if (s.result && s.result->mode_figures && s.result->mode_figures->error.empty())
     for (const auto& c : s.result->curves)
       if (c.label == "measured (Prony-SS)")  // the estimate the figures were computed on
-        s.nyquist = ui::mode_nyquist(c.f_hz, c.z_ohm, s.result->mode_figures->figures);
+        s.nyquist = jobs::mode_nyquist(c.f_hz, c.z_ohm, s.result->mode_figures->figures);
   auto& in = s.instrument;
   if (s.error) {
     s.log.push_back("job failed at " + s.error->stage + ": " + s.error->message);
@@ -128,20 +113,20 @@ bool collect_job(AppState& s) {
 void judge_result(AppState& s) {
   s.verdict.reset();
   if (!s.limits || !s.result) return;
-  s.verdict = report::evaluate_result(*s.limits, ui::report_json(*s.result));
+  s.verdict = jobs::report::evaluate_result(*s.limits, jobs::report_json(*s.result));
 }
 
 void load_limits(AppState& s) {
   const std::string path = s.limits_path;
   s.tasks.post("limits", [path]() -> TaskQueue::Apply {
     try {
-      auto l = std::make_shared<const report::Limits>(report::read_limits(path));
+      auto l = std::make_shared<const jobs::report::Limits>(jobs::report::read_limits(path));
       return [l](AppState& st) {
         st.limits = l;
         st.log.push_back("limits loaded: " + l->source + " (" + std::to_string(l->limits.size()) + " limit(s))");
         judge_result(st);
       };
-    } catch (const report::LimitsError& e) {  // names the file and the line
+    } catch (const jobs::report::LimitsError& e) {  // names the file and the line
       Problem pr{ErrorKind::Input, "limits", e.what(),
                  "Fix the limits file at the line named (README, 'Limits and the lot report'; "
                  "docs/limits-example.toml) and press 'Limits...' again."};
@@ -170,7 +155,7 @@ void connect_instruments(AppState& s) {
   s.instrument.problem.reset();
   s.tasks.post("connect", [awg, daq, sim, r1]() -> TaskQueue::Apply {
     try {
-      const ui::BenchProbe p = ui::probe_bench(awg, daq, sim, r1);
+      const jobs::BenchProbe p = jobs::probe_bench(awg, daq, sim, r1);
       return [p](AppState& st) {
         auto& in = st.instrument;
         in.state = InstrumentForm::State::Connected;
@@ -200,12 +185,12 @@ void export_result(AppState& s, ExportFormat f) {
                     : f == ExportFormat::Touchstone ? ".s1p"
                                                     : ".json";
   const std::string path = base + ext;
-  std::shared_ptr<const ui::PipelineResult> r = s.result;
+  std::shared_ptr<const jobs::PipelineResult> r = s.result;
   s.tasks.post("export " + path, [r, f, path]() -> TaskQueue::Apply {
     try {
-      if (f == ExportFormat::Csv) ui::export_csv(*r, path);
-      if (f == ExportFormat::Touchstone) ui::export_touchstone(*r, path);
-      if (f == ExportFormat::Json) ui::export_json(*r, path);
+      if (f == ExportFormat::Csv) jobs::export_csv(*r, path);
+      if (f == ExportFormat::Touchstone) jobs::export_touchstone(*r, path);
+      if (f == ExportFormat::Json) jobs::export_json(*r, path);
       return [path](AppState& st) { st.log.push_back("exported " + path); };
     } catch (...) {
       Problem pr = problem_from_current_exception("export");

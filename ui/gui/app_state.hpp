@@ -16,9 +16,9 @@
 #include "ui/gui/error_advice.hpp"
 #include "ui/gui/plot_widget.hpp"
 #include "ui/gui/task_queue.hpp"
-#include "ui/mode_nyquist.hpp"
-#include "ui/pipeline.hpp"
-#include "ui/report/limits.hpp"
+#include "jobs/mode_nyquist.hpp"
+#include "jobs/pipeline/pipeline.hpp"
+#include "jobs/report/limits.hpp"
 
 namespace piezo::gui {
 
@@ -26,7 +26,7 @@ namespace piezo::gui {
 class Job {
  public:
   ~Job();
-  bool start(const ui::PipelineRequest& req);  // false if one is running
+  bool start(const jobs::PipelineRequest& req);  // false if one is running
   void cancel() { cancel_ = true; }
   bool running() const { return running_; }
   // Running, or finished with an outcome not yet taken.
@@ -35,7 +35,7 @@ class Job {
   float progress() const { return progress_; }
   std::string stage() const;
   // Moves a finished result (or the problem that stopped it) out; true once per finished job.
-  bool take(std::unique_ptr<ui::PipelineResult>& result, std::optional<Problem>& problem);
+  bool take(std::unique_ptr<jobs::PipelineResult>& result, std::optional<Problem>& problem);
 
  private:
   std::thread thread_;
@@ -44,7 +44,7 @@ class Job {
   mutable std::mutex mu_;
   std::string stage_;
   std::optional<Problem> problem_;
-  std::unique_ptr<ui::PipelineResult> result_;
+  std::unique_ptr<jobs::PipelineResult> result_;
 };
 
 struct InstrumentForm {
@@ -77,9 +77,9 @@ struct DiagnosisShown {
 
 struct AppState {
   InstrumentForm instrument;
-  ui::PipelineRequest request;  // the plan panel edits this; a job gets a copy
+  jobs::PipelineRequest request;  // the plan panel edits this; a job gets a copy
   char transducer_id[64] = "";  // recorded in the capture's set-up
-  int material_index = 0;       // into model::material_presets(): the nominal model to update
+  int material_index = 0;       // into jobs::material_presets(): the nominal model to update
   char capture_out[256] = "piezobench-capture.h5";
   char replay_path[256] = "";
   char heldout_path[256] = "";  // optional: the replayed capture's held-out capture (issue 18)
@@ -87,17 +87,17 @@ struct AppState {
   // the job so that it outlives the job's thread, which may be waiting in it;
   // ~AppState declines that question before the job joins.
   CalibrationForm calibration;
-  ui::OperatorPrompt calibration_prompt;  // the worker asks, the frame loop draws the dialog
+  jobs::OperatorPrompt calibration_prompt;  // the worker asks, the frame loop draws the dialog
   ~AppState() { calibration_prompt.close(); }
   Job job;
   int jobs_started = 0;
-  // Acceptance limits (ui/report/limits.hpp, as `replay --limits`): loaded on
+  // Acceptance limits (jobs/report/limits.hpp, as `replay --limits`): loaded on
   // the task thread; each finished result is judged against them.
   char limits_path[256] = "";
-  std::shared_ptr<const report::Limits> limits;
-  std::optional<report::CaptureVerdict> verdict;  // of `result` against `limits`
+  std::shared_ptr<const jobs::report::Limits> limits;
+  std::optional<jobs::report::CaptureVerdict> verdict;  // of `result` against `limits`
   // Shared with background exports, so a new job can replace it while one runs.
-  std::shared_ptr<const ui::PipelineResult> result;
+  std::shared_ptr<const jobs::PipelineResult> result;
   std::optional<Problem> error;   // stopped the last job or export; shown with what to do
   std::vector<Problem> warnings;  // of the last result, with what to do
   std::vector<std::string> log;
@@ -107,11 +107,11 @@ struct AppState {
       residual_view{false, false};
   bool show_fft = false, show_xspec = false;
   // The per-mode figures and the admittance (Nyquist) view of one mode, in
-  // place of the residual/phase/SV row (ui/mode_nyquist.hpp; computed when a
+  // place of the residual/phase/SV row (jobs/mode_nyquist.hpp; computed when a
   // result arrives, collect_job).
   bool show_modes = false;
   int nyquist_mode = 0;  // index into `nyquist`
-  std::vector<ui::ModeNyquist> nyquist;
+  std::vector<jobs::ModeNyquist> nyquist;
   PlotView nyquist_view{false, false};
   bool residual_phase = false;  // the residual plot shows phase (deg) instead of |Z| (dB)
   DiagnosisShown diagnosis_shown;

@@ -25,8 +25,8 @@ void render_calibration_controls(CalibrationForm& f, bool busy) {
   ImGui::EndDisabled();
 }
 
-void attach_calibration(const CalibrationForm& f, ui::OperatorPrompt& prompt,
-                        ui::PipelineRequest& req) {
+void attach_calibration(const CalibrationForm& f, jobs::OperatorPrompt& prompt,
+                        jobs::PipelineRequest& req) {
   req.calibration.clear();
   if (!f.enabled) return;
   std::string list;
@@ -43,7 +43,7 @@ void attach_calibration(const CalibrationForm& f, ui::OperatorPrompt& prompt,
   req.prompt = [&prompt](const std::string& text) { return prompt.ask(text); };
 }
 
-void render_calibration_prompt(ui::OperatorPrompt& prompt) {
+void render_calibration_prompt(jobs::OperatorPrompt& prompt) {
   const auto q = prompt.question();
   constexpr const char* kTitle = "Connect the calibration standard";
   if (q && !ImGui::IsPopupOpen(kTitle)) ImGui::OpenPopup(kTitle);

@@ -2,12 +2,12 @@
 // Fixture calibration in the GUI (issue 10): the plan panel's controls
 // (which standards, the load's value) and the modal dialog that asks the
 // technician to connect each standard while the job's worker thread waits
-// (ui/operator_prompt.hpp). On the simulated bench the job switches the
+// (jobs/operator_prompt.hpp). On the simulated bench the job switches the
 // standards itself and the dialog never shows.
 #include <imgui.h>
 
-#include "ui/operator_prompt.hpp"
-#include "ui/pipeline.hpp"
+#include "jobs/operator_prompt.hpp"
+#include "jobs/pipeline/pipeline.hpp"
 
 namespace piezo::gui {
 
@@ -22,10 +22,10 @@ struct CalibrationForm {
 void render_calibration_controls(CalibrationForm& form, bool busy);
 
 // Puts the chosen standards and the prompt into a pipeline request.
-void attach_calibration(const CalibrationForm& form, ui::OperatorPrompt& prompt,
-                        ui::PipelineRequest& req);
+void attach_calibration(const CalibrationForm& form, jobs::OperatorPrompt& prompt,
+                        jobs::PipelineRequest& req);
 
 // Frame loop: the modal "Connect the standard" dialog while the worker waits.
-void render_calibration_prompt(ui::OperatorPrompt& prompt);
+void render_calibration_prompt(jobs::OperatorPrompt& prompt);
 
 }  // namespace piezo::gui

@@ -94,7 +94,7 @@ std::string advice_for(ErrorKind kind, const std::string& stage) {
          "message with the capture file.";
 }
 
-std::vector<Problem> result_problems(const ui::PipelineResult& r) {
+std::vector<Problem> result_problems(const jobs::PipelineResult& r) {
   std::vector<Problem> out;
   for (const auto& st : r.stages) {
     if (st.name == "update" && !st.ran)

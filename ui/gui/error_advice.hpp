@@ -6,7 +6,7 @@
 #include <string>
 #include <vector>
 
-#include "ui/pipeline.hpp"
+#include "jobs/pipeline/pipeline.hpp"
 
 namespace piezo::gui {
 
@@ -35,7 +35,7 @@ std::string advice_for(ErrorKind kind, const std::string& stage);
 // Conditions of a finished run that are not exceptions but need the
 // technician's action (an update that did not converge, a failed diagnosis,
 // a cancelled acquisition), each with what to do.
-std::vector<Problem> result_problems(const ui::PipelineResult& r);
+std::vector<Problem> result_problems(const jobs::PipelineResult& r);
 
 // "connection error", ..., "attention": the heading a window shows.
 const char* kind_name(ErrorKind k);

@@ -23,7 +23,7 @@ Job::~Job() {
   if (thread_.joinable()) thread_.join();
 }
 
-bool Job::start(const ui::PipelineRequest& req) {
+bool Job::start(const jobs::PipelineRequest& req) {
   if (running_) return false;
   if (thread_.joinable()) thread_.join();
   running_ = true;
@@ -36,12 +36,12 @@ bool Job::start(const ui::PipelineRequest& req) {
   }
   thread_ = std::thread([this, req] {
     lower_this_thread_priority();
-    std::unique_ptr<ui::PipelineResult> res;
+    std::unique_ptr<jobs::PipelineResult> res;
     std::optional<Problem> problem;
     try {
-      res = std::make_unique<ui::PipelineResult>(ui::run_pipeline(
+      res = std::make_unique<jobs::PipelineResult>(jobs::run_pipeline(
           req,
-          [this](const ui::PipelineProgress& p) {
+          [this](const jobs::PipelineProgress& p) {
             progress_ = static_cast<float>(p.fraction);
             std::lock_guard lock(mu_);
             stage_ = p.stage;
@@ -66,7 +66,7 @@ std::string Job::stage() const {
   return stage_;
 }
 
-bool Job::take(std::unique_ptr<ui::PipelineResult>& result, std::optional<Problem>& problem) {
+bool Job::take(std::unique_ptr<jobs::PipelineResult>& result, std::optional<Problem>& problem) {
   if (!finished_.exchange(false)) return false;
   std::lock_guard lock(mu_);
   result = std::move(result_);

@@ -1,7 +1,7 @@
 // Plan panel: R1, excitation, shots, rate, record length; transducer id,
 // geometry and nominal material; the "Measure and update" button with
 // progress and Cancel, and the replay of a recorded capture.
-#include "model/material_presets.hpp"
+#include "jobs/nominal_material.hpp"
 #include "ui/gui/windows.hpp"
 
 namespace piezo::gui {
@@ -37,7 +37,7 @@ void render_plan_window(AppState& s) {
   ImGui::Separator();
   ImGui::Text("Transducer and nominal model");
   ImGui::InputTextWithHint("Transducer id", "e.g. T-017", s.transducer_id, sizeof s.transducer_id);
-  const auto& presets = model::material_presets();
+  const auto& presets = jobs::material_presets();
   const char* current =
       presets.at(static_cast<std::size_t>(s.material_index) % presets.size()).name.c_str();
   if (ImGui::BeginCombo("Nominal material", current)) {

@@ -32,12 +32,12 @@ void impedance_specs(const AppState& s, PlotSpec& mag, PlotSpec& ph) {
   if (!s.result) return;
   // Draw order: models first (the updated one wide, as a halo), the
   // measurement last and thin on top, so curves that agree stay visible.
-  std::vector<const ui::Curve*> order;
+  std::vector<const jobs::Curve*> order;
   for (const auto& c : s.result->curves)
     if (c.label.find("model") != std::string::npos) order.push_back(&c);
   for (const auto& c : s.result->curves)
     if (c.label.find("model") == std::string::npos) order.push_back(&c);
-  for (const ui::Curve* cp : order) {
+  for (const jobs::Curve* cp : order) {
     const auto& c = *cp;
     if (c.label.find("FFT") != std::string::npos && !s.show_fft) continue;
     if (c.label.find("cross") != std::string::npos && !s.show_xspec) continue;

@@ -6,7 +6,7 @@
 // (palette.hpp), each with its share of χ² in the hover read-out. Frequency
 // in kHz.
 #include "ui/gui/plot_widget.hpp"
-#include "update/gap_diagnosis.hpp"
+#include "jobs/pipeline/pipeline.hpp"  // update::GapDiagnosis
 
 namespace piezo::gui {
 

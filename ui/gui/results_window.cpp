@@ -8,7 +8,7 @@
 namespace piezo::gui {
 
 namespace {
-void parameter_table(const ui::PipelineResult& r) {
+void parameter_table(const jobs::PipelineResult& r) {
   const bool sim = std::any_of(r.params.begin(), r.params.end(),
                                [](const auto& p) { return p.truth.has_value(); });
   const bool seed = std::any_of(r.params.begin(), r.params.end(), [](const auto& p) { return p.cmcm.has_value(); });
@@ -79,7 +79,7 @@ void parameter_table(const ui::PipelineResult& r) {
   ImGui::EndTable();
 }
 // Pass / fail against the loaded limits, with one line per reason.
-void limits_line(const report::CaptureVerdict& v, const std::string& file) {
+void limits_line(const jobs::report::CaptureVerdict& v, const std::string& file) {
   const bool pass = v.status == "pass";
   ImGui::TextColored(pass ? ImVec4(0.4f, 1.0f, 0.4f, 1) : ImVec4(1.0f, 0.4f, 0.4f, 1), "Limits: %s",
                      pass ? "PASS" : "FAIL");

@@ -1,0 +1,36 @@
+#pragma once
+// The jobs' room (jobs/): `piezobench demo` — the main job end to end on the
+// embedded simulated bench: the seed's lab measurement (R1 = 3140 Ω, 1 V
+// exp_decay at 3000 1/s, 20000 samples at 10 MS/s) of a simulated tube with
+// the seed's Table 4/5 target material, the fixture standards, a held-out
+// chirp, then every stage of the pipeline (jobs/pipeline/pipeline.hpp, the
+// same as the GUI's "Measure and update"). ui/cli/cmd_demo.cpp prints it.
+#include <atomic>
+#include <cstdint>
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "jobs/pipeline/pipeline.hpp"
+
+namespace piezo::jobs {
+
+struct DemoRequest {
+  std::string out_dir = "demo-out";
+  double noise = 0.005;
+  std::uint64_t seed = 2016;
+  std::vector<std::string> effects;  // NAME=VALUE, bench effects the simulated bench adds
+  bool no_diagnose = false;
+  std::string calibrate = "open,short,load";
+  bool no_calibrate = false;
+  int shots = 16;
+};
+
+// The pipeline's request of the demo (creates `out_dir`). Throws
+// std::invalid_argument for a bad effect or calibration list.
+PipelineRequest demo_pipeline_request(const DemoRequest& req);
+
+PipelineResult run_demo(const DemoRequest& req, const std::function<void(const PipelineProgress&)>& progress,
+                        const std::atomic<bool>& cancel);
+
+}  // namespace piezo::jobs

@@ -1,0 +1,67 @@
+#pragma once
+// The jobs' room (jobs/): `piezobench model materials|modal|impedance|sensitivity`
+// — the FE tube model from a preset, its model class and --set overrides:
+// short- and open-circuit modes, Z(f) (modal superposition or the direct
+// solve) and the seed's Appendix C.1 sensitivity study, each with its JSON.
+// ui/cli/cmd_model.cpp parses the options and prints.
+#include <complex>
+#include <nlohmann/json.hpp>
+#include <string>
+#include <vector>
+
+#include "model/material.hpp"
+#include "model/mesh.hpp"
+#include "model/sensitivity.hpp"
+#include "model/tube_geometry.hpp"
+
+namespace piezo::jobs {
+
+// The tube: material preset, model class, overrides, mesh and geometry.
+struct ModelRequest {
+  std::string material = "apc850";
+  bool isotropic = false;
+  std::string set;
+  int n_radial = model::MeshOptions{}.n_radial;
+  int n_axial = model::MeshOptions{}.n_axial;
+  model::TubeGeometry geometry;
+};
+
+// `model materials`: [{name, description, density_kg_m3}] in the presets' order.
+nlohmann::json materials_json();
+
+struct ModalJobResult {
+  nlohmann::json json;      // material, model_class, parameters, mesh, modes, C, converged
+  std::string model_class;  // "isotropic" | "full"
+  bool converged = false;
+  std::string message;      // why not, when not converged
+};
+// Throws std::invalid_argument (unknown preset, bad override), InputError (modes outside 1..200).
+ModalJobResult run_modal(ModelRequest req, int modes);
+
+struct SweepRequest {
+  double fmin = 0, fmax = 0, step = 0, alpha = 0, beta = 0;
+  double qm = 0, tan_delta = 0;
+  bool direct = false;
+  int modes = 20;
+};
+struct ModelImpedanceResult {
+  std::string model_class;
+  std::vector<double> f_hz;
+  std::vector<std::complex<double>> z_ohm;
+};
+// Throws InputError for a bad grid, std::invalid_argument for bad damping or
+// losses, std::runtime_error when the modal solve does not converge.
+ModelImpedanceResult run_model_impedance(ModelRequest req, const SweepRequest& sweep);
+// {material, model_class, method, f_hz, re_ohm, im_ohm} (null where not finite).
+nlohmann::json model_impedance_json(const ModelRequest& req, const SweepRequest& sweep,
+                                    const ModelImpedanceResult& r);
+
+struct SensitivityJobResult {
+  model::SensitivityResult result;
+  std::string model_class;
+  nlohmann::json json;
+};
+// Throws InputError for bad study options.
+SensitivityJobResult run_sensitivity(ModelRequest req, double band_hz);
+
+}  // namespace piezo::jobs

@@ -1,0 +1,39 @@
+#pragma once
+// The jobs' room (jobs/): `piezobench update Z.csv|Z.s1p [--resonances …]` —
+// multi-physics FE model updating of the tube from impedance features (seed
+// §6.3-6.4, update/README.md): extended CMCM, least squares (LM) or both, the
+// Rayleigh damping from two modes and the |Z| overlay CSV. Explicit features
+// override the ones found in the file. ui/cli/cmd_update.cpp parses the
+// options and prints.
+#include <functional>
+#include <nlohmann/json.hpp>
+#include <string>
+
+#include "model/mesh.hpp"
+#include "update/cmcm.hpp"
+
+namespace piezo::jobs {
+
+struct UpdateFeaturesRequest {
+  std::string file;  // impedance file (CSV or Touchstone), optional with explicit features
+  std::string resonances, antiresonances, low_z, material, set;
+  std::string method;  // cmcm | lm | both
+  std::string overlay, damping, capacitance = "fe";
+  bool isotropic = false, cross_modes = false;
+  int max_iterations = update::CmcmOptions{}.max_iterations;
+  int n_radial = model::MeshOptions{}.n_radial, n_axial = model::MeshOptions{}.n_axial;
+  // Said at once: a damping fit from --damping that cannot be used.
+  std::function<void(const std::string&)> warn;
+};
+
+struct UpdateFeaturesResult {
+  nlohmann::json json;     // method, model_class, material, original, measured, updated, …
+  std::string material;    // the preset's name
+  bool converged = false;
+};
+
+// Throws InputError for bad options or an unreadable file, std::invalid_argument
+// for a non-physical original model.
+UpdateFeaturesResult run_update_features(const UpdateFeaturesRequest& req);
+
+}  // namespace piezo::jobs
