@@ -2,7 +2,7 @@
 // "Measure and update", end to end: acquire (or replay a capture) → estimate
 // Z(ω) → update the FE model → diagnose the remaining gap. One implementation
 // serves the GUI's button, `piezobench demo` and headless replay. Stages that
-// have not landed yet are reported as skipped, never faked.
+// have not landed yet are reported as skipped, never faked. The pipeline's room (jobs/pipeline).
 #include <atomic>
 #include <complex>
 #include <functional>
