@@ -11,7 +11,7 @@
 // If the data hold T_true = T + δT, then e = −L·V1·δT + noise.
 //
 // Regions: windows of 1..64 bins of z = |e|²/var (scaled by its median, as
-// the fit's band test, update/output_error.cpp) whose sum is least likely
+// the fit's band test, update/output_error/lack_of_fit.cpp) whose sum is least likely
 // under noise (Gamma tail, Bonferroni over all windows tried); the most
 // significant first, trimmed and grown to the bins that stand out (z ≥ 2.5);
 // then the next one, disjoint from it and its skirts.

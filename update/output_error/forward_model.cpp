@@ -1,0 +1,158 @@
+// Problem's forward model (forward_model.hpp): the filtered, decimated output
+// error of a parameter vector, the shots' deviations, the residual's noise
+// shape and spectrum, T(f_k) of a port model. The port models themselves
+// (cache, second solver, tangent) are port_cache.cpp's.
+#include "update/output_error/forward_model.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstddef>
+
+#include "dsp/windows.hpp"
+#include "model/bench_response.hpp"
+
+namespace piezo::update::oe {
+
+Problem::Problem(model::ModalSolver& solver, const MaterialClass& cls, const Coordinates5& co,
+                 const Averaged& rec, const OeData& data, double band_hz,
+                 const model::ModalOptions& modal)
+    : solver_(solver), cls_(cls), co_(co), modal_(modal), r1_(data.circuit.r1_ohm),
+      fs_(data.sample_rate_hz), n_(rec.v1.size()),
+      nfft_(dsp::good_fft_size(std::max<std::size_t>(4 * n_, 1u << 14))), fft_(nfft_) {
+  fx_.series_resistance_ohm = data.circuit.r_lead_ohm;
+  fx_.parallel_capacitance_f = data.circuit.c_parallel_f;
+  fx_.daq_input_resistance_ohm = data.circuit.r_daq_ohm;
+  fx_.channel_skew_s = data.v2_delay_s;
+  fx_.mass_loading = modal_.end_mass_fraction;
+  const Eigen::VectorXd h = dsp::blackman_lowpass(fs_, band_hz);
+  if (static_cast<std::size_t>(h.size()) > nfft_ - n_) fail("record too short for the band");
+  kmax_ = std::min<std::size_t>(fft_.bins() - 1,
+                                static_cast<std::size_t>(std::ceil(2.5 * band_hz * double(nfft_) / fs_)));
+  std::vector<cd> hl(fft_.bins()), v1(fft_.bins()), v2(fft_.bins());
+  fft_.forward(h.data(), static_cast<std::size_t>(h.size()), hl.data());
+  fft_.forward(rec.v1.data(), n_, v1.data());
+  fft_.forward(rec.v2.data(), n_, v2.data());
+  lv1_.resize(kmax_ + 1);
+  ly_.resize(kmax_ + 1);
+  l_.resize(kmax_ + 1);
+  for (std::size_t k = 0; k <= kmax_; ++k) {
+    l_[k] = hl[k];
+    lv1_[k] = hl[k] * v1[k];
+    ly_[k] = hl[k] * v2[k];
+  }
+  decim_ = std::max<std::size_t>(1, static_cast<std::size_t>(fs_ / (2.0 * band_hz)));
+  for (std::size_t i = 0; i < n_; i += decim_) idx_.push_back(i);
+  spec_.assign(fft_.bins(), cd(0.0, 0.0));
+  buf_.resize(n_);
+  cache_.reserve(kCache);
+}
+
+std::optional<std::vector<cd>> Problem::transfer(const Eigen::VectorXd& x,
+                                                 const model::EffectSet& fx) {
+  const model::ModalPortModel* pp = port_of(x, fx.mass_loading);
+  if (!pp) return std::nullopt;
+  return transfer_of(*pp, co_.beta(x), co_.eta(x), fx);
+}
+
+Eigen::VectorXd Problem::residual_of(const std::vector<cd>& t) {
+  for (std::size_t k = 0; k <= kmax_; ++k) spec_[k] = t[k] * lv1_[k] - ly_[k];
+  return invert();
+}
+
+std::optional<Eigen::VectorXd> Problem::residual(const Eigen::VectorXd& x) {
+  const auto t = transfer(x);
+  if (!t) return std::nullopt;
+  return residual_of(*t);
+}
+
+Eigen::VectorXd Problem::deviation(const std::vector<cd>& t, const std::vector<double>& d1,
+                                   const std::vector<double>& d2) {
+  std::vector<cd> a(fft_.bins()), b(fft_.bins());
+  fft_.forward(d1.data(), n_, a.data());
+  fft_.forward(d2.data(), n_, b.data());
+  for (std::size_t k = 0; k <= kmax_; ++k) spec_[k] = l_[k] * (t[k] * a[k] - b[k]);
+  return invert();
+}
+
+Eigen::VectorXd Problem::residual_psd(const std::vector<cd>& t, double s1, double s2) const {
+  const std::size_t m = idx_.size();
+  const double fs_dec = fs_ / double(decim_);
+  Eigen::VectorXd p = Eigen::VectorXd::Zero(static_cast<Eigen::Index>(m / 2 + 1));
+  auto at = [&](double f) {
+    const auto k = static_cast<std::size_t>(std::lround(f * double(nfft_) / fs_));
+    return k <= kmax_ ? std::norm(l_[k]) * (s1 * s1 * std::norm(t[k]) + s2 * s2) : 0.0;
+  };
+  for (std::size_t j = 0; j <= m / 2; ++j) {
+    const double f = double(j) * fs_dec / double(m);
+    double v = 0;
+    for (int a = 0; a < 8; ++a) {
+      v += at(f + a * fs_dec);
+      if (a > 0) v += at(a * fs_dec - f);
+    }
+    p[static_cast<Eigen::Index>(j)] = v;
+  }
+  return p;
+}
+
+std::optional<ResidualSpectrum> Problem::residual_spectrum(const Eigen::VectorXd& x,
+                                                           const model::EffectSet& fx, double s1,
+                                                           double s2) {
+  const model::ModalPortModel* pp = port_of(x, fx.mass_loading);
+  if (!pp) return std::nullopt;
+  const model::RayleighDamping damp{0.0, co_.beta(x)};
+  const std::size_t r = std::max<std::size_t>(1, static_cast<std::size_t>(std::lround(double(nfft_) / double(n_))));
+  double lmax = 0;
+  for (std::size_t k = 0; k <= kmax_; ++k) lmax = std::max(lmax, std::abs(l_[k]));
+  ResidualSpectrum s;
+  for (std::size_t k = 2 * r; k <= kmax_; k += r) {
+    if (std::abs(l_[k]) < 0.5 * lmax) continue;
+    const double w = kTwoPi * fs_ * double(k) / double(nfft_);
+    const cd y = model::tube_admittance(*pp, damp, fx, w, co_.eta(x));
+    const cd t = model::recorded_transfer(y, fx, r1_, w);
+    const cd dy = 1e-6 * std::abs(y);
+    const cd dt = (model::recorded_transfer(y + dy, fx, r1_, w) - t) / dy;
+    const double var = double(n_) * std::norm(l_[k]) * (s1 * s1 * std::norm(t) + s2 * s2);
+    if (!(var > 0) || !std::isfinite(var)) continue;
+    s.f_hz.push_back(w / kTwoPi);
+    s.e.push_back(t * lv1_[k] - ly_[k]);
+    s.lv1.push_back(lv1_[k]);
+    s.t.push_back(t);
+    s.dt_dy.push_back(dt);
+    s.y_tube.push_back(y);
+    s.var.push_back(var);
+  }
+  return s;
+}
+
+double Problem::propagated_sigma(const std::vector<cd>& t, double s1, double s2) const {
+  double a1 = 0, a2 = 0;
+  for (std::size_t k = 0; k <= kmax_; ++k) {
+    const double w = (k == 0 || 2 * k == nfft_) ? 1.0 : 2.0;
+    a1 += w * std::norm(l_[k] * t[k]);
+    a2 += w * std::norm(l_[k]);
+  }
+  return std::sqrt((s1 * s1 * a1 + s2 * s2 * a2) / double(nfft_));
+}
+
+std::vector<cd> Problem::transfer_of(const model::ModalPortModel& port, double beta, double eta,
+                                     const model::EffectSet& fx) const {
+  const model::RayleighDamping damp{0.0, beta};
+  std::vector<cd> t(kmax_ + 1);
+  for (std::size_t k = 0; k <= kmax_; ++k) {
+    const double w = kTwoPi * fs_ * double(k) / double(nfft_);
+    const cd yt = w > 0 ? model::tube_admittance(port, damp, fx, w, eta) : cd(0.0, 0.0);
+    t[k] = model::recorded_transfer(yt, fx, r1_, w);
+  }
+  return t;
+}
+
+Eigen::VectorXd Problem::invert() {
+  for (std::size_t k = kmax_ + 1; k < spec_.size(); ++k) spec_[k] = 0.0;
+  fft_.inverse(spec_.data(), buf_.data(), n_);
+  Eigen::VectorXd r(static_cast<Eigen::Index>(idx_.size()));
+  const double scale = 1.0 / double(nfft_);
+  for (std::size_t i = 0; i < idx_.size(); ++i) r[static_cast<Eigen::Index>(i)] = buf_[idx_[i]] * scale;
+  return r;
+}
+
+}  // namespace piezo::update::oe

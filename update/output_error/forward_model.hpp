@@ -1,0 +1,249 @@
+#pragma once
+// The forward model of the output-error fit (update/output_error.hpp): the
+// coordinates θ relative to the nominal constants (Coordinates5) and Problem,
+// the filtered, decimated output error L ∗ (v̂2 − v2) of one θ, with its FE
+// port models' cache and their tangent. Problem's residuals, spectra and
+// noise propagation are in forward_model.cpp; the cache, the second solver
+// and the tangent in port_cache.cpp. Internal to update/output_error/.
+#include <Eigen/Core>
+#include <algorithm>
+#include <array>
+#include <atomic>
+#include <cmath>
+#include <cstddef>
+#include <functional>
+#include <memory>
+#include <optional>
+#include <utility>
+#include <vector>
+
+#include "dsp/fft.hpp"
+#include "model/effects.hpp"
+#include "model/modal.hpp"
+#include "update/output_error.hpp"
+#include "update/output_error/common.hpp"
+#include "update/output_error/shot_average.hpp"
+#include "update/residual_regions.hpp"
+
+namespace piezo::update::oe {
+
+// The parameter vector θ relative to the nominal constants.
+struct Coordinates5 {
+  TubeParams p0;
+  double beta0 = 1e-7;  // the loss at x[4] = 0: β (rayleigh) or η = 1/Qm (complex constants)
+  OeDamping damping = OeDamping::rayleigh;
+  TubeParams params(const Eigen::VectorXd& x) const {
+    TubeParams p = p0;
+    p.y_e11 = p0.y_e11 * std::exp(x[0]);
+    p.nu12 = p0.nu12 * (1.0 + x[1]);
+    p.d31 = p0.d31 * std::exp(x[2]);
+    p.eps_t33 = p0.eps_t33 * std::exp(x[3]);
+    return p;
+  }
+  double loss(const Eigen::VectorXd& x) const { return beta0 * std::exp(x[4]); }
+  double beta(const Eigen::VectorXd& x) const {
+    return damping == OeDamping::rayleigh ? loss(x) : 0.0;
+  }
+  double eta(const Eigen::VectorXd& x) const {
+    return damping == OeDamping::complex_constants ? loss(x) : 0.0;
+  }
+};
+
+// The filtered, decimated output error of one parameter vector.
+class Problem {
+ public:
+  Problem(model::ModalSolver& solver, const MaterialClass& cls, const Coordinates5& co,
+          const Averaged& rec, const OeData& data, double band_hz,
+          const model::ModalOptions& modal);
+
+  std::size_t samples() const { return idx_.size(); }
+  int evaluations() const { return evaluations_; }  // FE port models built
+
+  // The FE port model of the material part of x (θ without β) with an end
+  // mass, from a small cache: the Jacobian's β and effect columns, the
+  // type-B perturbations of the chain and the re-evaluations at an answer
+  // need no new modal solve. nullptr when the model cannot be built.
+  const model::ModalPortModel* port_of(const Eigen::VectorXd& x, double end_mass);
+
+  // The port models of several points at once (an exact Jacobian's columns,
+  // a grid of starts), those not cached built on `threads` threads: this
+  // solver and a second one on the same tube. A port model is a function of
+  // its key alone (each solve starts from Spectra's fixed initial vector), so
+  // the answers do not depend on the thread count.
+  void prefetch(const std::vector<std::pair<Eigen::VectorXd, double>>& points);
+  void set_threads(int n) { threads_ = std::max(1, n); }
+  int threads() const { return threads_; }
+
+  // The same problem for another thread (the effect scan): its own FFT plan
+  // and buffers, `solver` for its FE models, this one's cache and tangent.
+  // Construct and destroy it on the thread that owns this one (FFTW's planner
+  // is not thread-safe; executing distinct plans is).
+  Problem(const Problem& o, model::ModalSolver& solver);
+  Problem(const Problem&) = delete;
+  Problem& operator=(const Problem&) = delete;
+  // A second solver on the same tube (built on first use): prefetch's second
+  // thread, or a forked Problem's.
+  model::ModalSolver& second_solver();
+
+  // The bench's known effects (OeData: a measured fixture's lead R, Cp, DAQ
+  // input R and skew), as the catalogue's EffectSet (model/effects.hpp).
+  const model::EffectSet& effects() const { return fx_; }
+  // … with the free effect (scan_effects) at x's sixth coordinate.
+  model::EffectSet effects_at(const Eigen::VectorXd& x) const {
+    model::EffectSet fx = fx_;
+    if (x.size() > kParams && free_) free_(fx, x[kParams]);
+    return fx;
+  }
+
+  // T(f_k) = v2/v1 as recorded, for parameters x, with the bench's effects
+  // (model/bench_response.hpp: the same forward model as the gap diagnosis
+  // and the simulated bench's frequency-domain twin); empty when the model
+  // cannot be built.
+  std::optional<std::vector<cd>> transfer(const Eigen::VectorXd& x) { return transfer(x, effects_at(x)); }
+  // A catalogue effect as a sixth coordinate of x (scan_effects below).
+  void free_effect(std::function<void(model::EffectSet&, double)> apply) { free_ = std::move(apply); }
+  std::optional<std::vector<cd>> transfer(const Eigen::VectorXd& x, const model::EffectSet& fx);
+
+  // The port models' tangent ∂port/∂x_c (c < 4: the constants) by forward
+  // differences at x_ref, from the models an exact Jacobian built there. Near
+  // x_ref (|Δx| ≤ kTangentReach in every constant's coordinate, the same end
+  // mass) a material column of the Jacobian is then the residual at x with
+  // the port model port(x) + h·∂port/∂x_c — the frequency response still
+  // computed exactly at x, only the modal quantities' slopes taken from
+  // x_ref, a few per mille off: no FE model per column. The residuals, the
+  // costs and the answers stay exact; an optimiser's fixed point moves by that
+  // error times the residual's projection, a tiny fraction of a sigma.
+  void set_tangent(const Eigen::VectorXd& x, double h) { set_tangent(x, h, effects_at(x).mass_loading); }
+  void set_tangent(const Eigen::VectorXd& x, double h, double mass);
+  bool tangent_near(const Eigen::VectorXd& x) { return tangent_near(x, effects_at(x).mass_loading); }
+  // … and it still holds there: x's own port model is its linear prediction
+  // from x_ref to within kTangentTolerance in every electrically active mode's
+  // frequency and participation. Two modes near a veering (an avoided
+  // crossing, where a few per mille of a constant swaps their shapes and
+  // participations) fail it: their columns are computed exactly.
+  bool tangent_near(const Eigen::VectorXd& x, double mass);
+  // T at x on the tangent anchored at a point whose model is cached:
+  // port(anchor) + Σ_c (x_c − anchor_c)·∂port/∂x_c — no FE model; exact at
+  // the anchor, its slopes x_ref's (a trial step's screening). Empty when
+  // the anchor is not near x_ref or x not near the anchor.
+  std::optional<std::vector<cd>> tangent_model(const Eigen::VectorXd& anchor,
+                                               const Eigen::VectorXd& x);
+  // T at x with the constant c moved by h, through the tangent (tangent_near).
+  std::optional<std::vector<cd>> tangent_transfer(const Eigen::VectorXd& x, int c, double h) {
+    return tangent_transfer(x, c, h, effects_at(x));
+  }
+  std::optional<std::vector<cd>> tangent_transfer(const Eigen::VectorXd& x, int c, double h,
+                                                  const model::EffectSet& fx);
+
+  // Filtered output error for a given transfer.
+  Eigen::VectorXd residual_of(const std::vector<cd>& t);
+
+  // Filtered output error (volts) at the decimated samples.
+  std::optional<Eigen::VectorXd> residual(const Eigen::VectorXd& x);
+
+  // L ∗ (T ∗ d1 − d2) at the decimated samples (a shot's deviation from the mean).
+  Eigen::VectorXd deviation(const std::vector<cd>& t, const std::vector<double>& d1,
+                            const std::vector<double>& d2);
+
+  // Expected |DFT|² shape of the decimated residual (bins j = 0..M/2 of its
+  // M-point DFT) for white noise σ1 on v1 and σ2 on v2: |L|²(σ1²|T|² + σ2²),
+  // folded over the aliases of the decimation.
+  Eigen::VectorXd residual_psd(const std::vector<cd>& t, double s1, double s2) const;
+  double residual_bin_hz() const { return fs_ / double(decim_) / double(idx_.size()); }
+
+  // The residual in frequency at x (update/residual_regions.hpp): every r-th
+  // bin of the padded transform (r = nfft/n: bins about 1/T_record apart,
+  // nearly independent) in the low-pass's passband, above the lowest two
+  // (the offsets), with its variance n·|L|²(σ1²|T|² + σ2²) under white noise
+  // σ1 on v1 and σ2 on v2, the model's admittance and ∂T/∂Y.
+  std::optional<ResidualSpectrum> residual_spectrum(const Eigen::VectorXd& x, double s1, double s2) {
+    return residual_spectrum(x, effects_at(x), s1, s2);
+  }
+  std::optional<ResidualSpectrum> residual_spectrum(const Eigen::VectorXd& x, const model::EffectSet& fx, double s1,
+                                                    double s2);
+
+  // σ of the filtered error for white noise σ1 on v1 and σ2 on v2 (Parseval).
+  double propagated_sigma(const std::vector<cd>& t, double s1, double s2) const;
+
+ private:
+  // The same modes in the same order (a mode crossing the truncation or the
+  // residual pseudo-mode appearing changes the list: no tangent across it).
+  static bool same_structure(const model::ModalPortModel& a, const model::ModalPortModel& b);
+  // p += k·(plus − base), the tangent's difference (same_structure).
+  void shift(model::ModalPortModel& p, const model::ModalPortModel& plus, double k) const;
+  std::vector<cd> transfer_of(const model::ModalPortModel& port, double beta, double eta,
+                              const model::EffectSet& fx) const;
+
+  Eigen::VectorXd invert();
+
+  using Key = Eigen::Matrix<double, 5, 1>;  // the constants' coordinates, the end mass
+  struct Cached {
+    Key key;
+    std::optional<model::ModalPortModel> port;
+    unsigned long used = 0;
+  };
+  static Key key_of(const Eigen::VectorXd& x, double end_mass) {
+    Key key;
+    key << x.head<4>(), end_mass;
+    return key;
+  }
+  Cached* cached(const Key& key);
+  // One FE port model (counted; thread-safe for distinct solvers).
+  std::optional<model::ModalPortModel> build(model::ModalSolver& solver, const Key& key);
+  const model::ModalPortModel* insert(const Key& key, std::optional<model::ModalPortModel> port);
+
+  model::ModalSolver& solver_;
+  std::unique_ptr<model::ModalSolver> solver2_;  // prefetch's second thread (built on first use)
+  int threads_ = 1;
+  const MaterialClass& cls_;
+  Coordinates5 co_;
+  model::ModalOptions modal_;
+  double r1_;
+  model::EffectSet fx_;
+  std::function<void(model::EffectSet&, double)> free_;
+  double fs_;
+  std::size_t n_, nfft_;
+  dsp::RealFft fft_;
+  std::size_t kmax_ = 0, decim_ = 1;
+  std::vector<cd> l_, lv1_, ly_, spec_;
+  std::vector<double> buf_;
+  std::vector<std::size_t> idx_;
+  std::atomic<int> evaluations_{0};
+  static constexpr std::size_t kCache = 16;  // a grid's nine models, an exact Jacobian's five and the trials
+  static constexpr double kTangentReach = 0.05;
+  // The check of tangent_near: relative error of the prediction (a veering
+  // swaps participations by tens of percent, the curvature away from one
+  // moves them by well under a percent within the reach).
+  static constexpr double kTangentTolerance = 0.01;        // participation
+  static constexpr double kTangentOmegaTolerance = 1e-3;   // frequency
+  static constexpr double kActiveCoupling = 1e-4;          // p²/(ω²C0) of a mode it looks at
+  static constexpr double kScreenChange = 0.05;            // tangent_model: Σ|Δx_c|·slope_c at most
+  struct Tangent {
+    bool valid = false;
+    Eigen::Vector4d x_ref;
+    double mass = 0, h = 0;
+    model::ModalPortModel base;
+    std::array<model::ModalPortModel, 4> plus;
+    std::array<double, 4> slope{};  // largest relative slope of an active mode's ω or |p| per unit x_c
+  } tangent_;
+  std::vector<Cached> cache_;
+  unsigned long clock_ = 0;
+
+ public:
+  // What the optimiser leaves behind (the cached models, the tangent): each
+  // scanned effect starts from the optimum's, so its answer does not depend on
+  // the order of the scan or the thread it runs on.
+  struct State {
+    std::vector<Cached> cache;
+    Tangent tangent;
+    unsigned long clock = 0;
+  };
+  State state() const { return {cache_, tangent_, clock_}; }
+  void restore(const State& s) {
+    cache_ = s.cache;
+    tangent_ = s.tangent;
+    clock_ = s.clock;
+  }
+};
+
+}  // namespace piezo::update::oe

@@ -1,0 +1,93 @@
+// The record's noise and the DAQ offsets' whitening (noise.hpp).
+#include "update/output_error/noise.hpp"
+
+#include <cmath>
+
+#include "dsp/prony_ss.hpp"
+
+namespace piezo::update::oe {
+
+RecordNoise record_noise(Problem& prob, const Averaged& rec, const std::vector<cd>& t) {
+  RecordNoise out;
+  const std::size_t n = rec.v1.size();
+  if (rec.shots >= 2) {
+    double ss = 0;
+    std::size_t m = 0;
+    for (std::size_t k = 0; k < rec.dev1.size(); ++k) {
+      const Eigen::VectorXd e = prob.deviation(t, rec.dev1[k], rec.dev2[k]);
+      ss += e.squaredNorm();
+      m += static_cast<std::size_t>(e.size());
+    }
+    out.source = "shots (" + std::to_string(rec.shots) + ")";
+    out.dof = double(m) * double(rec.shots - 1) / double(rec.shots);
+    // per-shot variance ss/((K−1)·M/K·…): Σ_k ‖e_k‖² = (K−1)/K·K·M·σ², the average's σ²/K
+    const double var_shot = ss / (double(m) * double(rec.shots - 1) / double(rec.shots));
+    double q1 = 0, q2 = 0;
+    for (std::size_t k = 0; k < rec.dev1.size(); ++k)
+      for (std::size_t i = 0; i < n; ++i) {
+        q1 += rec.dev1[k][i] * rec.dev1[k][i];
+        q2 += rec.dev2[k][i] * rec.dev2[k][i];
+      }
+    out.ch1 = std::sqrt(q1 / (double(n) * double(rec.shots - 1)) / double(rec.shots));
+    out.ch2 = std::sqrt(q2 / (double(n) * double(rec.shots - 1)) / double(rec.shots));
+    out.sigma = std::sqrt(var_shot / double(rec.shots));
+    return out;
+  }
+  double s1 = 0, s2 = 0;
+  if (rec.pretrigger >= 64 && rec.pretrigger < n) {
+    for (std::size_t i = 0; i < rec.pretrigger; ++i) {
+      s1 += rec.v1[i] * rec.v1[i];
+      s2 += rec.v2[i] * rec.v2[i];
+    }
+    s1 = std::sqrt(s1 / double(rec.pretrigger - 1));
+    s2 = std::sqrt(s2 / double(rec.pretrigger - 1));
+    out.source = "pretrigger (" + std::to_string(rec.pretrigger) + " samples)";
+    out.dof = double(rec.pretrigger - 1);
+  } else {
+    const Eigen::Map<const Eigen::VectorXd> a(rec.v1.data(), static_cast<Eigen::Index>(n)),
+        b(rec.v2.data(), static_cast<Eigen::Index>(n));
+    s1 = dsp::estimate_noise_std(a);
+    s2 = dsp::estimate_noise_std(b);
+    out.source = "high-pass estimate of each channel";
+    // The median of |6th differences| of overlapping windows: about a fifth
+    // of the samples' worth of independent information.
+    out.dof = 0.2 * double(n);
+  }
+  out.ch1 = s1;
+  out.ch2 = s2;
+  out.sigma = prob.propagated_sigma(t, s1, s2);
+  return out;
+}
+
+namespace {
+
+// u = L ∗ (T ∗ 0 − 1): the filtered error of a unit offset on v2 (out of line:
+// GCC 12 inlining it into OffsetWhitening reports a false free-nonheap-object).
+[[gnu::noinline]] Eigen::VectorXd unit_offset_response(Problem& prob, std::size_t n, const std::vector<cd>& t) {
+  const std::vector<double> zero(n, 0.0), one(n, 1.0);
+  return -prob.deviation(t, zero, one);
+}
+
+}  // namespace
+
+OffsetWhitening::OffsetWhitening(Problem& prob, const Averaged& rec,
+                                 const std::vector<cd>& t_nominal, double sigma) {
+  u = unit_offset_response(prob, rec.v1.size(), t_nominal);
+  uu = u.squaredNorm();
+  if (rec.pretrigger >= 16 && rec.pretrigger < rec.v1.size()) {
+    double s1 = 0, s2 = 0;  // the (averaged) record's idle noise: its mean was removed
+    for (std::size_t i = 0; i < rec.pretrigger; ++i) {
+      s1 += rec.v1[i] * rec.v1[i];
+      s2 += rec.v2[i] * rec.v2[i];
+    }
+    const double p = double(rec.pretrigger);
+    const double tau2 = (s1 + s2) / (p - 1.0) / p;
+    shrink = 1.0 - 1.0 / std::sqrt(1.0 + tau2 * uu / (sigma * sigma));
+    dof = 0;
+    model = "pretrigger mean removed, its error marginalised";
+  } else {
+    model = "unknown (no pretrigger): projected out";
+  }
+}
+
+}  // namespace piezo::update::oe

@@ -1,0 +1,191 @@
+// Problem's FE port models (forward_model.hpp): the small cache keyed by the
+// constants' coordinates and the end mass, the second solver on a second
+// thread, the fork for another thread, and the port models' tangent that
+// spares an FE model per Jacobian column near its anchor.
+#include "update/output_error/forward_model.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <exception>
+#include <thread>
+
+namespace piezo::update::oe {
+
+const model::ModalPortModel* Problem::port_of(const Eigen::VectorXd& x, double end_mass) {
+  const Key key = key_of(x, end_mass);
+  if (Cached* c = cached(key)) return c->port ? &*c->port : nullptr;
+  return insert(key, build(solver_, key));
+}
+
+void Problem::prefetch(const std::vector<std::pair<Eigen::VectorXd, double>>& points) {
+  std::vector<Key> todo;
+  for (const auto& [x, mass] : points) {
+    const Key key = key_of(x, mass);
+    if (!cached(key) && std::find(todo.begin(), todo.end(), key) == todo.end()) todo.push_back(key);
+  }
+  if (todo.empty()) return;
+  std::vector<std::optional<model::ModalPortModel>> built(todo.size());
+  if (threads_ > 1 && todo.size() > 1) {
+    model::ModalSolver& second = second_solver();
+    // The second thread takes the odd points (one FE model each, equal work).
+    std::thread other([&] {
+      for (std::size_t i = 1; i < todo.size(); i += 2) built[i] = build(second, todo[i]);
+    });
+    for (std::size_t i = 0; i < todo.size(); i += 2) built[i] = build(solver_, todo[i]);
+    other.join();
+  } else {
+    for (std::size_t i = 0; i < todo.size(); ++i) built[i] = build(solver_, todo[i]);
+  }
+  for (std::size_t i = 0; i < todo.size(); ++i) insert(todo[i], std::move(built[i]));
+}
+
+Problem::Problem(const Problem& o, model::ModalSolver& solver)
+    : solver_(solver), cls_(o.cls_), co_(o.co_), modal_(o.modal_), r1_(o.r1_), fx_(o.fx_), free_(o.free_),
+      fs_(o.fs_), n_(o.n_), nfft_(o.nfft_), fft_(o.nfft_), kmax_(o.kmax_), decim_(o.decim_), l_(o.l_),
+      lv1_(o.lv1_), ly_(o.ly_), spec_(o.spec_), buf_(o.buf_), idx_(o.idx_), tangent_(o.tangent_),
+      cache_(o.cache_), clock_(o.clock_) {}
+
+model::ModalSolver& Problem::second_solver() {
+  if (!solver2_) solver2_ = std::make_unique<model::ModalSolver>(solver_.model());
+  return *solver2_;
+}
+
+void Problem::set_tangent(const Eigen::VectorXd& x, double h, double mass) {
+  tangent_.valid = false;
+  const model::ModalPortModel* base = port_of(x, mass);
+  if (!base) return;
+  const model::ModalPortModel b = *base;
+  for (int c = 0; c < 4; ++c) {
+    Eigen::VectorXd xp = x;
+    xp[c] += h;
+    const model::ModalPortModel* p = port_of(xp, mass);
+    if (!p || !same_structure(*p, b)) return;
+    // The largest relative slope of an active mode's ω or |p| in this constant.
+    double slope = 0;
+    for (std::size_t i = 0; i < b.modes.size(); ++i) {
+      const auto &mb = b.modes[i], &mp = p->modes[i];
+      const double pa = std::abs(mb.participation);
+      if (!(mb.omega > 0) || pa * pa < kActiveCoupling * mb.omega * mb.omega * b.c_clamped) continue;
+      slope = std::max({slope, std::abs(std::abs(mp.participation) - pa) / (pa * h),
+                        std::abs(mp.omega - mb.omega) / (mb.omega * h)});
+    }
+    tangent_.slope[static_cast<std::size_t>(c)] = slope;
+    tangent_.plus[static_cast<std::size_t>(c)] = *p;
+  }
+  tangent_.base = b;
+  tangent_.x_ref = x.head<4>();
+  tangent_.mass = mass;
+  tangent_.h = h;
+  tangent_.valid = true;
+}
+
+bool Problem::tangent_near(const Eigen::VectorXd& x, double mass) {
+  if (!tangent_.valid || mass != tangent_.mass ||
+      (x.head<4>() - tangent_.x_ref).cwiseAbs().maxCoeff() > kTangentReach)
+    return false;
+  const model::ModalPortModel* at = port_of(x, mass);
+  if (!at || !same_structure(*at, tangent_.base)) return false;
+  model::ModalPortModel q = tangent_.base;
+  for (int c = 0; c < 4; ++c) shift(q, tangent_.plus[static_cast<std::size_t>(c)], (x[c] - tangent_.x_ref[c]) / tangent_.h);
+  for (std::size_t i = 0; i < q.modes.size(); ++i) {
+    const auto &a = at->modes[i], &b = q.modes[i];
+    const double pa = std::abs(a.participation);
+    if (!(a.omega > 0) || pa * pa < kActiveCoupling * a.omega * a.omega * at->c_clamped) continue;
+    if (std::abs(b.omega - a.omega) > kTangentOmegaTolerance * a.omega ||
+        std::abs(b.participation - pa) > kTangentTolerance * pa)
+      return false;
+  }
+  return true;
+}
+
+std::optional<std::vector<cd>> Problem::tangent_model(const Eigen::VectorXd& anchor,
+                                                      const Eigen::VectorXd& x) {
+  const model::EffectSet fx = effects_at(x);
+  if (!tangent_near(anchor, fx.mass_loading) || effects_at(anchor).mass_loading != fx.mass_loading ||
+      (x.head<4>() - anchor.head<4>()).cwiseAbs().maxCoeff() > kTangentReach)
+    return std::nullopt;
+  // … and only as far as its slopes say the modes move by a few percent:
+  // near a veering a participation changes by 6 % per 1e-4 of a constant
+  // (refsim-like tube, dielectric loss 0.03), and a screen extrapolated to a
+  // 1 % step refused every good step of the loss's run.
+  double change = 0;
+  for (int c = 0; c < 4; ++c) change += std::abs(x[c] - anchor[c]) * tangent_.slope[static_cast<std::size_t>(c)];
+  if (!(change <= kScreenChange)) return std::nullopt;
+  const model::ModalPortModel* at = port_of(anchor, fx.mass_loading);
+  if (!at || !same_structure(*at, tangent_.base)) return std::nullopt;
+  model::ModalPortModel p = *at;
+  for (int c = 0; c < 4; ++c) shift(p, tangent_.plus[static_cast<std::size_t>(c)], (x[c] - anchor[c]) / tangent_.h);
+  return transfer_of(p, co_.beta(x), co_.eta(x), fx);
+}
+
+std::optional<std::vector<cd>> Problem::tangent_transfer(const Eigen::VectorXd& x, int c, double h,
+                                                         const model::EffectSet& fx) {
+  const model::ModalPortModel* at = port_of(x, fx.mass_loading);
+  if (!at || !same_structure(*at, tangent_.base)) return std::nullopt;
+  model::ModalPortModel p = *at;
+  shift(p, tangent_.plus[static_cast<std::size_t>(c)], h / tangent_.h);
+  return transfer_of(p, co_.beta(x), co_.eta(x), fx);
+}
+
+bool Problem::same_structure(const model::ModalPortModel& a, const model::ModalPortModel& b) {
+  if (a.modes.size() != b.modes.size()) return false;
+  for (std::size_t i = 0; i < a.modes.size(); ++i)
+    if (a.modes[i].symmetric != b.modes[i].symmetric || a.modes[i].residual != b.modes[i].residual) return false;
+  return true;
+}
+
+void Problem::shift(model::ModalPortModel& p, const model::ModalPortModel& plus, double k) const {
+  const model::ModalPortModel& base = tangent_.base;
+  p.c_clamped += k * (plus.c_clamped - base.c_clamped);
+  p.c_static += k * (plus.c_static - base.c_static);
+  p.c_residual += k * (plus.c_residual - base.c_residual);
+  p.eps_t_over_s += k * (plus.eps_t_over_s - base.eps_t_over_s);
+  for (std::size_t i = 0; i < p.modes.size(); ++i) {
+    auto& m = p.modes[i];
+    const auto &mp = plus.modes[i], &mb = base.modes[i];
+    m.omega += k * (mp.omega - mb.omega);
+    m.kappa += k * (mp.kappa - mb.kappa);
+    // p_k = gᵀφ_k: its sign is the eigenvector's, arbitrary per solve.
+    m.participation = std::abs(m.participation) + k * (std::abs(mp.participation) - std::abs(mb.participation));
+  }
+}
+
+Problem::Cached* Problem::cached(const Key& key) {
+  for (auto& c : cache_)
+    if (c.key == key) {
+      c.used = ++clock_;
+      return &c;
+    }
+  return nullptr;
+}
+
+std::optional<model::ModalPortModel> Problem::build(model::ModalSolver& solver, const Key& key) {
+  ++evaluations_;
+  try {
+    model::ModalOptions mo = modal_;
+    mo.end_mass_fraction = key[4];
+    Eigen::VectorXd x = Eigen::VectorXd::Zero(kParams);
+    x.head<4>() = key.head<4>();
+    auto port = solver.port_model(cls_.e_form(co_.params(x)), mo);
+    if (port.converged) return port;
+  } catch (const std::exception&) {
+  }
+  return std::nullopt;
+}
+
+const model::ModalPortModel* Problem::insert(const Key& key,
+                                             std::optional<model::ModalPortModel> port) {
+  Cached* slot = nullptr;
+  if (cache_.size() < kCache) {
+    slot = &cache_.emplace_back();
+  } else {
+    slot = &*std::min_element(cache_.begin(), cache_.end(),
+                              [](const Cached& a, const Cached& b) { return a.used < b.used; });
+  }
+  slot->key = key;
+  slot->port = std::move(port);
+  slot->used = ++clock_;
+  return slot->port ? &*slot->port : nullptr;
+}
+
+}  // namespace piezo::update::oe

@@ -1,0 +1,25 @@
+#pragma once
+// The record the output-error fit works on: a capture's shots of equal length
+// and pretrigger averaged, each shot's deviation from the average kept (for
+// the noise estimate, noise.hpp), and the DAQ offsets removed with the
+// pretrigger's mean. Internal to update/output_error/.
+#include <cstddef>
+#include <vector>
+
+#include "update/output_error.hpp"
+
+namespace piezo::update::oe {
+
+// Shots averaged per (length, pretrigger) group; the largest group is used.
+struct Averaged {
+  std::vector<double> v1, v2;
+  std::size_t pretrigger = 0;
+  std::vector<std::vector<double>> dev1, dev2;  // each shot minus the average (K ≥ 2)
+  int shots = 0;
+};
+
+// Throws std::invalid_argument (fail) for no shots, v1 and v2 of different
+// lengths, or non-finite samples.
+Averaged average(const OeData& d);
+
+}  // namespace piezo::update::oe
