@@ -5,6 +5,8 @@
 #include <numbers>
 #include <stdexcept>
 
+#include "dsp/levenberg_marquardt.hpp"
+
 namespace piezo::dsp {
 
 namespace {
@@ -95,11 +97,11 @@ struct Model {
   double scale(Eigen::Index k) const {  // per component
     return sigma.size() ? sigma[k] / std::sqrt(2.0) : std::abs(z[k]);
   }
-  static BvdParams params(const Eigen::Vector4d& t) {
+  static BvdParams params(const Eigen::VectorXd& t) {
     return {std::exp(t[0]), std::exp(t[1]), std::exp(t[2]), std::exp(t[3])};
   }
   // Residuals (Z_model − Z)/scale as [Re; Im] per point, and the Jacobian in ln p.
-  void eval(const Eigen::Vector4d& t, Eigen::VectorXd& r, Eigen::MatrixXd* jac) const {
+  void eval(const Eigen::VectorXd& t, Eigen::VectorXd& r, Eigen::MatrixXd* jac) const {
     const BvdParams p = params(t);
     r.resize(2 * n);
     if (jac) jac->resize(2 * n, 4);
@@ -147,51 +149,43 @@ BvdFit fit_bvd(const Eigen::VectorXd& f, const Eigen::VectorXcd& z, const Eigen:
   BvdFit out;
   out.points = static_cast<std::size_t>(n);
   out.weighted = z_sigma.size() > 0;
-  Eigen::Vector4d t(std::log(start.r1_ohm), std::log(start.l1_h), std::log(start.c1_f),
-                    std::log(start.c0_f));
-  Eigen::VectorXd r, r_try;
-  Eigen::MatrixXd jac;
-  m.eval(t, r, &jac);
-  double cost = r.squaredNorm();
-  // Levenberg–Marquardt with Marquardt's diagonal scaling.
-  double lambda = 1e-3;
-  for (out.iterations = 0; out.iterations < opt.max_iterations; ++out.iterations) {
-    const Eigen::Matrix4d h = jac.transpose() * jac;
-    const Eigen::Vector4d g = jac.transpose() * r;
-    bool accepted = false;
-    Eigen::Vector4d step = Eigen::Vector4d::Zero();
-    for (int tries = 0; tries < 40 && !accepted; ++tries) {
-      Eigen::Matrix4d a = h;
-      for (int j = 0; j < 4; ++j) a(j, j) += lambda * std::max(h(j, j), 1e-300);
-      step = a.ldlt().solve(-g);
-      m.eval(t + step, r_try, nullptr);
-      const double c_try = r_try.squaredNorm();
-      if (std::isfinite(c_try) && c_try <= cost) {
-        accepted = true;
-        t += step;
-        cost = c_try;
-        lambda = std::max(lambda / 10, 1e-12);
-      } else {
-        lambda *= 10;
-      }
-    }
-    // No step lowers the cost even at λ → ∞: a minimum to rounding.
-    if (!accepted) {
-      out.converged = true;
-      break;
-    }
-    m.eval(t, r, &jac);
-    if (step.cwiseAbs().maxCoeff() < opt.step_tolerance) {
-      out.converged = true;
-      break;
-    }
-  }
+  Eigen::VectorXd t(4);
+  t << std::log(start.r1_ohm), std::log(start.l1_h), std::log(start.c1_f), std::log(start.c0_f);
+  LmProblem pb;
+  pb.residual = [&](const Eigen::VectorXd& x) -> std::optional<Eigen::VectorXd> {
+    Eigen::VectorXd r;
+    m.eval(x, r, nullptr);
+    return r;
+  };
+  pb.jacobian = [&](const Eigen::VectorXd& x, const Eigen::VectorXd&, Eigen::MatrixXd& j,
+                    const LmJacobianCall&) {
+    Eigen::VectorXd r;
+    m.eval(x, r, &j);
+    return j.allFinite();
+  };
+  LmSettings ls;  // the damping of this fit before the shared engine (its figures were measured so)
+  ls.max_iterations = opt.max_iterations;
+  ls.max_tries = 40;
+  ls.mu_down = 10;
+  ls.mu_up = 10;
+  ls.accept_equal = true;
+  ls.step_tolerance = opt.step_tolerance;
+  ls.tiny_rejected_step_converges = false;
+  ls.on_stall = LmSettings::Stall::converged;  // no step lowers the cost even at μ → ∞: a minimum to rounding
+  const LmRun run = levenberg_marquardt(pb, t, ls);
+  if (run.stop == LmRun::Stop::bad_start)
+    throw std::invalid_argument("fit_bvd: the start values give a non-finite impedance");
+  out.iterations = run.iterations;
+  out.converged = run.converged;
   if (!out.converged) out.message = "iteration limit reached";
+  t = run.x;
+  const Eigen::MatrixXd& jac = run.j;
+  const double cost = 2.0 * run.cost;  // ‖r‖²
   out.p = Model::params(t);
   // Covariance (Jacobian at the solution): (JᵀJ)⁻¹ for whitened residuals; with
   // relative weights the scale of the noise is unknown and the residual sets it.
   const Eigen::Index dof = 2 * n - 4;
-  Eigen::Matrix4d cov = (jac.transpose() * jac).completeOrthogonalDecomposition().pseudoInverse();
+  Eigen::Matrix4d cov = lm_covariance(jac);
   if (out.weighted) {
     out.chi2_per_dof = dof > 0 ? cost / double(dof) : kNaN;
   } else {

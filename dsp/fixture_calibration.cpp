@@ -6,6 +6,8 @@
 #include <numbers>
 #include <stdexcept>
 
+#include "dsp/levenberg_marquardt.hpp"
+
 namespace piezo::dsp {
 
 namespace {
@@ -122,8 +124,24 @@ FixtureCalibration fit_fixture(const CalibrationStandards& s) {
     }
     return r;
   };
-  auto jacobian = [&](const std::array<double, kParams>& t) {
-    Eigen::MatrixXd j(nr, np);
+  // The free parameters in units of their scales, from the start th0.
+  const auto th0 = th;
+  auto params = [&](const Eigen::VectorXd& u) {
+    auto t = th0;
+    for (Eigen::Index c = 0; c < np; ++c)
+      t[idx[static_cast<std::size_t>(c)]] += u[c] * scale[idx[static_cast<std::size_t>(c)]];
+    return t;
+  };
+  LmProblem pb;
+  pb.residual = [&](const Eigen::VectorXd& u) -> std::optional<Eigen::VectorXd> {
+    const auto t = params(u);
+    if (t[kRs] < 0 || t[kRho] <= 0 || t[kU] <= 0) return std::nullopt;  // not a physical fixture
+    return residual(t);
+  };
+  pb.jacobian = [&](const Eigen::VectorXd& u, const Eigen::VectorXd&, Eigen::MatrixXd& j,
+                    const LmJacobianCall&) {
+    const auto t = params(u);
+    j.resize(nr, np);
     for (Eigen::Index c = 0; c < np; ++c) {
       const int i = idx[static_cast<std::size_t>(c)];
       auto tp = t, tm = t;
@@ -133,51 +151,29 @@ FixtureCalibration fit_fixture(const CalibrationStandards& s) {
       j.col(c) =
           (residual(tp) - residual(tm)) / (2 * h) * scale[i];  // per unit of scaled parameter
     }
-    return j;
+    return j.allFinite();
   };
-  Eigen::VectorXd r = residual(th);
-  double cost = r.squaredNorm(), lambda = 1e-3;
-  Eigen::MatrixXd jm;
-  for (out.iterations = 0; out.iterations < 200; ++out.iterations) {
-    jm = jacobian(th);
-    const Eigen::MatrixXd jtj = jm.transpose() * jm;
-    const Eigen::VectorXd g = jm.transpose() * r;
-    bool improved = false;
-    for (int tries = 0; tries < 20 && !improved; ++tries) {
-      Eigen::MatrixXd a = jtj;
-      a.diagonal() += lambda * jtj.diagonal().cwiseMax(1e-30);
-      const Eigen::VectorXd step = a.ldlt().solve(-g);
-      auto tn = th;
-      for (Eigen::Index c = 0; c < np; ++c)
-        tn[idx[static_cast<std::size_t>(c)]] += step[c] * scale[idx[static_cast<std::size_t>(c)]];
-      if (tn[kRs] < 0 || tn[kRho] <= 0 || tn[kU] <= 0) {
-        lambda *= 10;
-        continue;
-      }
-      const Eigen::VectorXd rn = residual(tn);
-      const double cn = rn.squaredNorm();
-      if (cn < cost) {
-        const double rel = (cost - cn) / cost;
-        th = tn;
-        r = rn;
-        cost = cn;
-        lambda = std::max(lambda / 10, 1e-12);
-        improved = true;
-        if (rel < 1e-12) out.converged = true;
-      } else {
-        lambda *= 10;
-      }
-    }
-    if (!improved) {
-      out.converged = true;  // no step lowers the cost: a minimum (to rounding)
-      break;
-    }
-    if (out.converged) break;
-  }
+  LmSettings ls;  // this fit's damping before the shared engine
+  ls.max_iterations = 200;
+  ls.max_tries = 20;
+  ls.mu_down = 10;
+  ls.mu_up = 10;
+  ls.diag_floor = 1e-30;
+  ls.relative_cost_tolerance = 1e-12;
+  ls.tiny_rejected_step_converges = false;
+  ls.on_stall = LmSettings::Stall::converged;  // no step lowers the cost: a minimum (to rounding)
+  const LmRun run = levenberg_marquardt(pb, Eigen::VectorXd::Zero(np), ls);
+  if (run.stop == LmRun::Stop::bad_start)
+    throw std::invalid_argument("fit_fixture: the starting fixture model gives a non-finite transfer");
+  out.iterations = run.iterations;
+  out.converged = run.converged;
+  th = params(run.x);
+  const double cost = 2.0 * run.cost;  // ‖r‖²
+  const Eigen::MatrixXd& jm = run.j;
   const double dof = std::max<double>(1.0, double(nr - np));
   out.chi2_reduced = cost / dof;
   // Covariance of the scaled free parameters, inflated by χ²_red when the model misfits.
-  Eigen::MatrixXd cov = (jm.transpose() * jm).inverse() * std::max(1.0, out.chi2_reduced);
+  Eigen::MatrixXd cov = lm_covariance(jm) * std::max(1.0, out.chi2_reduced);
   std::array<double, kParams> sd{};
   for (Eigen::Index c = 0; c < np; ++c) {
     const int i = idx[static_cast<std::size_t>(c)];

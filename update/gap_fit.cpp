@@ -7,6 +7,7 @@
 #include <limits>
 #include <stdexcept>
 
+#include "dsp/levenberg_marquardt.hpp"
 
 namespace piezo::update {
 
@@ -97,46 +98,56 @@ GapFit fit_gap(GapModel& m, const GapData& d, const std::vector<double>& x0, con
   for (std::size_t j = 0; j < x0.size(); ++j) fit.x[j] = std::clamp(x0[j], info[j].lower, info[j].upper);
   fit.n = static_cast<int>(2 * d.size());
   fit.dof = fit.n - p;
-  auto clamp_all = [&](std::vector<double>& x) {
-    for (std::size_t j = 0; j < x.size(); ++j) x[j] = std::clamp(x[j], info[j].lower, info[j].upper);
-  };
   Eigen::MatrixXd jtj;
   for (int outer = 0; outer <= opt.max_relinearisations; ++outer) {
-    double chi = gap_chi2(m, d, fit.x), lambda = 1e-3;
-    bool done = false;
-    for (int it = 0; it < opt.max_iterations && !done; ++it) {
-      ++fit.iterations;
-      const auto r = gap_residuals(m, d, fit.x);
-      const auto jc = gap_jacobian(m, d, fit.x, cols);
-      Eigen::MatrixXd j(fit.n, p);
-      for (int c = 0; c < p; ++c) j.col(c) = Eigen::Map<const Eigen::VectorXd>(jc[static_cast<std::size_t>(c)].data(), fit.n);
-      const Eigen::VectorXd rv = Eigen::Map<const Eigen::VectorXd>(r.data(), fit.n);
-      jtj = j.transpose() * j;
-      const Eigen::VectorXd g = j.transpose() * rv;
-      bool accepted = false;
-      for (int tries = 0; tries < 12 && !accepted; ++tries) {
-        Eigen::MatrixXd a = jtj;
-        for (int c = 0; c < p; ++c) a(c, c) += lambda * std::max(jtj(c, c), 1e-12);
-        const Eigen::VectorXd step = a.ldlt().solve(-g);
-        std::vector<double> xn = fit.x;
-        for (int c = 0; c < p; ++c) xn[static_cast<std::size_t>(cols[static_cast<std::size_t>(c)])] += step(c);
-        clamp_all(xn);
-        const double cn = gap_chi2(m, d, xn);
-        if (std::isfinite(cn) && cn <= chi) {
-          const double rel = (chi - cn) / std::max(chi, 1e-300);
-          fit.x = xn;
-          chi = cn;
-          lambda = std::max(lambda / 3, 1e-9);
-          accepted = true;
-          if (rel < opt.chi2_tolerance || chi - cn < 1e-6 * std::max(1.0, static_cast<double>(fit.n))) done = true;
-        } else {
-          lambda *= 4;
-        }
+    // Levenberg–Marquardt (dsp/levenberg_marquardt) over the free columns.
+    auto full = [&](const Eigen::VectorXd& u) {
+      std::vector<double> x = fit.x;
+      for (int c = 0; c < p; ++c) x[static_cast<std::size_t>(cols[static_cast<std::size_t>(c)])] = u[c];
+      return x;
+    };
+    Eigen::VectorXd u0(p);
+    for (int c = 0; c < p; ++c) u0[c] = fit.x[static_cast<std::size_t>(cols[static_cast<std::size_t>(c)])];
+    dsp::LmProblem pb;
+    pb.residual = [&](const Eigen::VectorXd& u) -> std::optional<Eigen::VectorXd> {
+      try {
+        const auto r = gap_residuals(m, d, full(u));
+        return Eigen::Map<const Eigen::VectorXd>(r.data(), fit.n);
+      } catch (const std::invalid_argument&) {  // a non-physical material (coupling > 1, …): not a step to take
+        return std::nullopt;
       }
-      if (!accepted) done = true;  // no descent at any damping: a (local) minimum
-    }
-    fit.chi2 = chi;
-    fit.converged = done;
+    };
+    pb.jacobian = [&](const Eigen::VectorXd& u, const Eigen::VectorXd&, Eigen::MatrixXd& j,
+                      const dsp::LmJacobianCall&) {
+      const auto jc = gap_jacobian(m, d, full(u), cols);  // throws where u itself is not physical
+      j.resize(fit.n, p);
+      for (int c = 0; c < p; ++c)
+        j.col(c) = Eigen::Map<const Eigen::VectorXd>(jc[static_cast<std::size_t>(c)].data(), fit.n);
+      return true;
+    };
+    pb.project = [&](Eigen::VectorXd& u) {
+      for (int c = 0; c < p; ++c) {
+        const auto& pi = info[static_cast<std::size_t>(cols[static_cast<std::size_t>(c)])];
+        u[c] = std::clamp(u[c], pi.lower, pi.upper);
+      }
+    };
+    dsp::LmSettings ls;  // this fit's damping before the shared engine
+    ls.max_iterations = opt.max_iterations;
+    ls.max_tries = 12;
+    ls.mu_min = 1e-9;
+    ls.diag_floor = 1e-12;
+    ls.accept_equal = true;
+    ls.relative_cost_tolerance = opt.chi2_tolerance;
+    ls.cost_tolerance = 0.5e-6 * std::max(1.0, static_cast<double>(fit.n));  // Δχ² < 1e-6 per residual
+    ls.tiny_rejected_step_converges = false;
+    ls.on_stall = dsp::LmSettings::Stall::converged;  // no descent at any damping: a (local) minimum
+    const dsp::LmRun run = dsp::levenberg_marquardt(pb, u0, ls);
+    if (run.stop == dsp::LmRun::Stop::bad_start) (void)gap_residuals(m, d, fit.x);  // throws the reason
+    fit.iterations += run.iterations;
+    fit.x = full(run.x);
+    if (run.j.rows() == fit.n) jtj = run.j.transpose() * run.j;
+    fit.chi2 = 2.0 * run.cost;
+    fit.converged = run.converged;
 
     // The linearised port model is accurate near its reference only.
     bool far = false;

@@ -6,6 +6,7 @@
 #include <optional>
 #include <stdexcept>
 
+#include "dsp/levenberg_marquardt.hpp"
 #include "update/condensed_stiffness.hpp"
 #include "update/updater.hpp"
 
@@ -176,45 +177,57 @@ LmResult update_lm(const model::TubeModel& tube, model::ModalSolver& solver,
     res.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     return res;
   };
-  Eigen::Vector4d x = Eigen::Vector4d::Zero();
-  std::string why;
-  auto cur = prob.evaluate(x, true, why);
-  if (!cur) return done(UpdateStatus::non_physical, "original model: " + why);
-  double mu = opt.lambda0;
-  bool converged = false;
-  for (int it = 1; it <= opt.max_iterations && !converged; ++it) {
-    res.iterations = it;
-    const Eigen::Matrix4d jtj = cur->j.transpose() * cur->j;
-    const Eigen::Vector4d g = cur->j.transpose() * cur->r;
-    bool accepted = false;
-    for (int tries = 0; tries < 12 && !accepted; ++tries) {
-      Eigen::Matrix4d a = jtj;
-      for (int k = 0; k < kNp; ++k) a(k, k) += mu * std::max(jtj(k, k), 1e-30);
-      const Eigen::Vector4d step = a.ldlt().solve(-g);
-      std::string w;
-      auto trial = prob.evaluate(x + step, true, w);
-      if (trial && trial->cost < cur->cost) {
-        x += step;
-        cur = std::move(trial);
-        mu = std::max(mu / 3.0, 1e-12);
-        accepted = true;
-        if (step.cwiseAbs().maxCoeff() < opt.step_tolerance) converged = true;
-      } else {
-        mu *= 4.0;
-        if (step.cwiseAbs().maxCoeff() < opt.step_tolerance) {  // no decrease possible any more
-          accepted = true;
-          converged = true;
-        }
-      }
-    }
-    if (!accepted) break;
+  // The engine asks for r at trials and then for J at the accepted one; one
+  // evaluation gives both (Hellmann–Feynman), so the last ones are kept.
+  std::vector<std::pair<Eigen::VectorXd, Evaluation>> evaluated;
+  std::string why_start;
+  auto evaluation = [&](const Eigen::VectorXd& x, std::string& why) -> const Evaluation* {
+    for (const auto& [xe, ev] : evaluated)
+      if (xe == x) return &ev;
+    auto ev = prob.evaluate(Eigen::Vector4d(x), true, why);
+    if (!ev) return nullptr;
+    if (evaluated.size() >= 2) evaluated.erase(evaluated.begin());
+    evaluated.emplace_back(x, std::move(*ev));
+    return &evaluated.back().second;
+  };
+  dsp::LmProblem pb;
+  bool first = true;
+  pb.residual = [&](const Eigen::VectorXd& x) -> std::optional<Eigen::VectorXd> {
+    std::string w;
+    const Evaluation* ev = evaluation(x, first ? why_start : w);
+    first = false;
+    if (!ev) return std::nullopt;
+    return ev->r;
+  };
+  pb.jacobian = [&](const Eigen::VectorXd& x, const Eigen::VectorXd&, Eigen::MatrixXd& j,
+                    const dsp::LmJacobianCall&) {
+    std::string w;
+    const Evaluation* ev = evaluation(x, w);
+    if (!ev) return false;
+    j = ev->j;
+    return true;
+  };
+  dsp::LmSettings ls;  // this updater's damping before the shared engine
+  ls.max_iterations = opt.max_iterations;
+  ls.max_tries = 12;
+  ls.mu0 = opt.lambda0;
+  ls.diag_floor = 1e-30;
+  ls.step_tolerance = opt.step_tolerance;
+  ls.on_stall = dsp::LmSettings::Stall::failed;
+  const dsp::LmRun run = dsp::levenberg_marquardt(pb, Eigen::VectorXd::Zero(kNp), ls);
+  if (run.stop == dsp::LmRun::Stop::bad_start)
+    return done(UpdateStatus::non_physical, "original model: " + why_start);
+  res.iterations = run.iterations;
+  std::string w;
+  const Evaluation* cur = evaluation(run.x, w);
+  res.updated = prob.params(Eigen::Vector4d(run.x));
+  res.cost = run.cost;
+  res.residuals.assign(run.r.data(), run.r.data() + run.r.size());
+  if (cur) {
+    res.model_resonances_hz = cur->f_sc;
+    res.model_antiresonances_hz = cur->f_oc;
   }
-  res.updated = prob.params(x);
-  res.cost = cur->cost;
-  res.residuals.assign(cur->r.data(), cur->r.data() + cur->r.size());
-  res.model_resonances_hz = cur->f_sc;
-  res.model_antiresonances_hz = cur->f_oc;
-  if (!converged)
+  if (!run.converged)
     return done(UpdateStatus::max_iterations, "Levenberg-Marquardt did not converge in " +
                                                   std::to_string(opt.max_iterations) +
                                                   " iterations");

@@ -7,6 +7,7 @@
 #include <optional>
 #include <stdexcept>
 
+#include "dsp/levenberg_marquardt.hpp"
 #include "dsp/windows.hpp"
 #include "model/transient.hpp"
 
@@ -273,62 +274,61 @@ PortFitResult fit_port_model(std::span<const double> v1, std::span<const double>
   if (!r) throw std::invalid_argument(std::string(fn) + ": the starting model cannot be simulated");
   double cost = 0.5 * r->squaredNorm();
   Eigen::MatrixXd j;
-  // Levenberg–Marquardt over the parameters in `free`; true when converged.
+  // Levenberg–Marquardt (dsp/levenberg_marquardt) over the parameters in
+  // `free`, the others held; true when converged.
   auto levenberg_marquardt = [&](const std::vector<int>& free, int max_iterations) {
+    auto full = [&](const Eigen::VectorXd& u) {
+      Eigen::VectorXd t = th;
+      for (std::size_t c = 0; c < free.size(); ++c) t[free[c]] = u[static_cast<Eigen::Index>(c)];
+      return t;
+    };
+    Eigen::VectorXd u0(static_cast<Eigen::Index>(free.size()));
+    for (std::size_t c = 0; c < free.size(); ++c) u0[static_cast<Eigen::Index>(c)] = th[free[c]];
+    dsp::LmProblem pb;
+    pb.residual = [&](const Eigen::VectorXd& u) { return residual(full(u)); };
+    pb.jacobian = [&](const Eigen::VectorXd& u, const Eigen::VectorXd&, Eigen::MatrixXd& jac,
+                      const dsp::LmJacobianCall&) { return jacobian(full(u), free, jac); };
+    // Converged also when the features stop moving: C_e and the pseudo-mode's
+    // static share trade off along a nearly flat valley that LM crawls through
+    // without changing them.
     Eigen::VectorXd f_prev = features_of(th);
-    double mu = 1e-3;
-    for (int it = 1; it <= max_iterations; ++it) {
-      ++res.iterations;
-      if (!jacobian(th, free, j)) {
+    pb.converged_after_step = [&](const dsp::LmState& st) {
+      const Eigen::VectorXd f_now = features_of(full(st.x));
+      const double moved = ((f_now - f_prev).array() / f_prev.array()).abs().maxCoeff();
+      f_prev = f_now;
+      return moved < opt.feature_tolerance;
+    };
+    dsp::LmSettings ls;  // this fit's damping before the shared engine
+    ls.max_iterations = max_iterations;
+    ls.max_tries = 16;
+    ls.step_tolerance = opt.step_tolerance;
+    ls.jacobian_at_answer = false;  // the covariance below takes its own J at the answer
+    const dsp::LmRun run = dsp::levenberg_marquardt(pb, u0, ls);
+    res.iterations += run.iterations;
+    if (run.stop == dsp::LmRun::Stop::bad_start) {
+      res.message = "the model could not be simulated at the current estimate";
+      return false;
+    }
+    th = full(run.x);
+    r = run.r;
+    cost = run.cost;
+    switch (run.stop) {
+      case dsp::LmRun::Stop::converged:
+        return true;
+      case dsp::LmRun::Stop::jacobian_failed:
         res.message = "the model could not be simulated near the current estimate";
         return false;
-      }
-      const Eigen::MatrixXd jtj = j.transpose() * j;
-      const Eigen::VectorXd g = j.transpose() * *r;
-      bool accepted = false, done = false;
-      for (int tries = 0; tries < 16 && !accepted; ++tries) {
-        Eigen::MatrixXd a = jtj;
-        for (Eigen::Index p = 0; p < a.rows(); ++p) a(p, p) += mu * std::max(jtj(p, p), 1e-300);
-        const Eigen::VectorXd step = a.ldlt().solve(-g);
-        Eigen::VectorXd trial = th;
-        for (std::size_t c = 0; c < free.size(); ++c)
-          trial[free[c]] += step[static_cast<Eigen::Index>(c)];
-        const auto rt = residual(trial);
-        const double ct = rt ? 0.5 * rt->squaredNorm() : INFINITY;
-        if (ct < cost) {
-          th = trial;
-          r = rt;
-          cost = ct;
-          mu = std::max(mu / 3.0, 1e-12);
-          accepted = true;
-          // Converged when the step is negligible, or when the features stop
-          // moving: C_e and the pseudo-mode's static share trade off along a
-          // nearly flat valley that LM crawls through without changing them.
-          const Eigen::VectorXd f_now = features_of(th);
-          const double moved = ((f_now - f_prev).array() / f_prev.array()).abs().maxCoeff();
-          f_prev = f_now;
-          done = step.cwiseAbs().maxCoeff() < opt.step_tolerance || moved < opt.feature_tolerance;
-        } else {
-          mu *= 4.0;
-          if (step.cwiseAbs().maxCoeff() < opt.step_tolerance) accepted = done = true;
-        }
-      }
-      if (!accepted) {
-        // No step lowers the error any more: a minimum to round-off if the
-        // residual is orthogonal to every Jacobian column (cosine < 1e-4).
-        double cosine = 0;
-        for (Eigen::Index p = 0; p < g.size(); ++p)
-          cosine = std::max(cosine, std::abs(g[p]) / std::sqrt(jtj(p, p) * 2.0 * cost + 1e-300));
-        if (cosine < 1e-4) return true;
+      case dsp::LmRun::Stop::stalled:
+        // No step lowers the error any more, and the residual is not orthogonal
+        // to the Jacobian's columns (cosine >= 1e-4): not a minimum.
         res.message =
             "no decrease of the output error (Levenberg-Marquardt stalled, gradient cosine " +
-            std::to_string(cosine) + ")";
+            std::to_string(run.stall_cosine) + ")";
         return false;
-      }
-      if (done) return true;
+      default:
+        res.message = "did not converge in " + std::to_string(max_iterations) + " iterations";
+        return false;
     }
-    res.message = "did not converge in " + std::to_string(max_iterations) + " iterations";
-    return false;
   };
   // Stage 1 holds the resonances at Prony's values and fits the amplitudes,
   // dampings and capacitances (from the rough start, letting ω move at once can

@@ -1,0 +1,618 @@
+#include "dsp/equivalent_circuit.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <functional>
+#include <limits>
+#include <numbers>
+#include <sstream>
+#include <stdexcept>
+
+#include "dsp/levenberg_marquardt.hpp"
+
+namespace piezo::dsp {
+
+namespace {
+
+using cd = std::complex<double>;
+constexpr double kTwoPi = 2.0 * std::numbers::pi;
+
+std::string fmt(double v, int prec = 5) {
+  std::ostringstream s;
+  s.precision(prec);
+  s << v;
+  return s.str();
+}
+
+// Golden-section search for the minimum of g on [a, b].
+double golden_min(const std::function<double(double)>& g, double a, double b, int iterations = 80) {
+  const double r = (std::sqrt(5.0) - 1.0) / 2.0;
+  double c = b - r * (b - a), d = a + r * (b - a);
+  double gc = g(c), gd = g(d);
+  for (int i = 0; i < iterations && (b - a) > 1e-12 * std::abs(b); ++i) {
+    if (gc < gd) {
+      b = d;
+      d = c;
+      gd = gc;
+      c = b - r * (b - a);
+      gc = g(c);
+    } else {
+      a = c;
+      c = d;
+      gc = gd;
+      d = a + r * (b - a);
+      gd = g(d);
+    }
+  }
+  return 0.5 * (a + b);
+}
+
+// The extremum of g on [a, b]: a grid, then golden section around the best point.
+double grid_min(const std::function<double(double)>& g, double a, double b, int n = 400) {
+  if (!(b > a)) return kNaN;
+  double best = a, gb = g(a);
+  for (int i = 1; i <= n; ++i) {
+    const double x = a + (b - a) * i / n;
+    const double gx = g(x);
+    if (gx < gb) gb = gx, best = x;
+  }
+  const double h = (b - a) / n;
+  return golden_min(g, std::max(a, best - h), std::min(b, best + h));
+}
+
+// A root of g between a and b (g(a), g(b) of opposite signs) by bisection.
+double bisect(const std::function<double(double)>& g, double a, double b) {
+  double ga = g(a);
+  for (int i = 0; i < 200 && (b - a) > 1e-13 * std::abs(b); ++i) {
+    const double m = 0.5 * (a + b);
+    const double gm = g(m);
+    if ((gm < 0) == (ga < 0)) {
+      a = m;
+      ga = gm;
+    } else {
+      b = m;
+    }
+  }
+  return 0.5 * (a + b);
+}
+
+// Parameter layout: ln C0, ln tanδ, [ln Rs], then ln R, ln L, ln C per branch.
+struct Layout {
+  bool rs = false;
+  std::size_t branches = 0;
+  int first_branch() const { return rs ? 3 : 2; }
+  int size() const { return first_branch() + 3 * static_cast<int>(branches); }
+};
+
+EquivalentCircuit circuit_of(const Layout& lay, const Eigen::VectorXd& t) {
+  EquivalentCircuit c;
+  c.c0_f = std::exp(t[0]);
+  c.tan_delta = std::exp(t[1]);
+  c.rs_ohm = lay.rs ? std::exp(t[2]) : 0.0;
+  for (std::size_t k = 0; k < lay.branches; ++k) {
+    const int b = lay.first_branch() + 3 * static_cast<int>(k);
+    c.branches.push_back({std::exp(t[b]), std::exp(t[b + 1]), std::exp(t[b + 2])});
+  }
+  return c;
+}
+
+Eigen::VectorXd theta_of(const Layout& lay, const EquivalentCircuit& c) {
+  Eigen::VectorXd t(lay.size());
+  t[0] = std::log(c.c0_f);
+  t[1] = std::log(c.tan_delta);
+  if (lay.rs) t[2] = std::log(c.rs_ohm);
+  for (std::size_t k = 0; k < lay.branches; ++k) {
+    const int b = lay.first_branch() + 3 * static_cast<int>(k);
+    t[b] = std::log(c.branches[k].r_ohm);
+    t[b + 1] = std::log(c.branches[k].l_h);
+    t[b + 2] = std::log(c.branches[k].c_f);
+  }
+  return t;
+}
+
+struct Data {
+  const Eigen::VectorXd& f;
+  const Eigen::VectorXcd& z;
+  Eigen::VectorXd scale;  // per component (complex residuals) or of ln|Z|
+  bool magnitude = false;
+  Eigen::Index n() const { return f.size(); }
+  Eigen::Index rows() const { return magnitude ? n() : 2 * n(); }
+
+  Eigen::VectorXd residual(const Layout& lay, const Eigen::VectorXd& t, Eigen::MatrixXd* jac) const {
+    const EquivalentCircuit c = circuit_of(lay, t);
+    Eigen::VectorXd r(rows());
+    if (jac) jac->resize(rows(), lay.size());
+    std::vector<cd> dy(static_cast<std::size_t>(lay.size()));
+    for (Eigen::Index i = 0; i < n(); ++i) {
+      const double w = kTwoPi * f[i];
+      const cd s(0.0, w);
+      const cd y0 = s * c.c0_f * cd(1.0, -c.tan_delta);
+      cd y = y0;
+      for (std::size_t k = 0; k < c.branches.size(); ++k) {
+        const auto& b = c.branches[k];
+        const cd yb = 1.0 / (b.r_ohm + s * b.l_h + 1.0 / (s * b.c_f));
+        y += yb;
+        if (jac) {
+          const int p = lay.first_branch() + 3 * static_cast<int>(k);
+          const cd yb2 = yb * yb;
+          dy[static_cast<std::size_t>(p)] = -yb2 * b.r_ohm;
+          dy[static_cast<std::size_t>(p + 1)] = -yb2 * s * b.l_h;
+          dy[static_cast<std::size_t>(p + 2)] = yb2 / (s * b.c_f);
+        }
+      }
+      const cd zy = 1.0 / y;
+      const cd zm = zy + c.rs_ohm;
+      if (magnitude) {
+        r[i] = (std::log(std::abs(zm)) - std::log(std::abs(z[i]))) / scale[i];
+      } else {
+        const cd e = (zm - z[i]) / scale[i];
+        r[2 * i] = e.real();
+        r[2 * i + 1] = e.imag();
+      }
+      if (!jac) continue;
+      dy[0] = y0;
+      dy[1] = cd(w * c.c0_f * c.tan_delta, 0.0);
+      for (int p = 0; p < lay.size(); ++p) {
+        cd dz;
+        if (lay.rs && p == 2)
+          dz = c.rs_ohm;
+        else
+          dz = -zy * zy * dy[static_cast<std::size_t>(p)];
+        if (magnitude) {
+          (*jac)(i, p) = (dz / zm).real() / scale[i];  // d ln|Z| = Re(dZ/Z)
+        } else {
+          (*jac)(2 * i, p) = dz.real() / scale[i];
+          (*jac)(2 * i + 1, p) = dz.imag() / scale[i];
+        }
+      }
+    }
+    return r;
+  }
+};
+
+struct Trial {
+  Layout lay;
+  Eigen::VectorXd t;
+  Eigen::MatrixXd j;
+  double chi2 = kNaN, bic = kNaN;
+  bool converged = false;
+};
+
+Trial fit_layout(const Data& d, const Layout& lay, const Eigen::VectorXd& t0, int max_iterations) {
+  LmProblem pb;
+  pb.residual = [&](const Eigen::VectorXd& t) -> std::optional<Eigen::VectorXd> {
+    for (Eigen::Index p = 0; p < t.size(); ++p)
+      if (!(std::abs(t[p]) < 700)) return std::nullopt;
+    return d.residual(lay, t, nullptr);
+  };
+  pb.jacobian = [&](const Eigen::VectorXd& t, const Eigen::VectorXd&, Eigen::MatrixXd& j,
+                    const LmJacobianCall&) {
+    d.residual(lay, t, &j);
+    return j.allFinite();
+  };
+  LmSettings s;
+  s.max_iterations = max_iterations;
+  s.step_tolerance = 1e-10;
+  s.relative_cost_tolerance = 1e-12;
+  s.max_step = 2.0;  // no element moves by more than e² in one step
+  const LmRun run = levenberg_marquardt(pb, t0, s);
+  Trial tr;
+  tr.lay = lay;
+  tr.t = run.x;
+  tr.j = run.j;
+  tr.converged = run.converged;
+  tr.chi2 = 2.0 * run.cost;
+  return tr;
+}
+
+double bic_of(double chi2, Eigen::Index rows, int params, bool weighted) {
+  const double n = static_cast<double>(rows);
+  if (weighted) return chi2 + params * std::log(n);
+  // Relative weights: the residual's own scale, floored at 1 ppm of |Z| (an
+  // analyzer file prints 6-7 digits; below that, extra branches fit rounding).
+  return n * std::log(std::max(chi2, n * 1e-12) / n) + params * std::log(n);
+}
+
+// A branch resonating at f0 with quality q whose conductance peak is g_peak.
+CircuitBranch branch_at(double f0, double g_peak, double q) {
+  CircuitBranch b;
+  b.r_ohm = 1.0 / std::max(g_peak, 1e-12);
+  b.l_h = q * b.r_ohm / (kTwoPi * f0);
+  b.c_f = 1.0 / (std::pow(kTwoPi * f0, 2) * b.l_h);
+  return b;
+}
+
+// Quality of a peak of g (samples on f) at index i: f_i over the half-height width.
+double peak_q(const Eigen::VectorXd& f, const Eigen::VectorXd& g, Eigen::Index i) {
+  const double half = 0.5 * g[i];
+  Eigen::Index lo = i, hi = i;
+  while (lo > 0 && g[lo] > half) --lo;
+  while (hi + 1 < f.size() && g[hi] > half) ++hi;
+  const double width = f[hi] - f[lo];
+  if (!(width > 0)) return 1000.0;
+  return std::clamp(f[i] / width, 3.0, 1e4);
+}
+
+}  // namespace
+
+double CircuitBranch::fs_hz() const { return 1.0 / (kTwoPi * std::sqrt(l_h * c_f)); }
+double CircuitBranch::qm() const { return kTwoPi * fs_hz() * l_h / r_ohm; }
+
+cd EquivalentCircuit::admittance_without_rs(double f_hz) const {
+  const cd s(0.0, kTwoPi * f_hz);
+  cd y = s * c0_f * cd(1.0, -tan_delta);
+  for (const auto& b : branches) y += 1.0 / (b.r_ohm + s * b.l_h + 1.0 / (s * b.c_f));
+  return y;
+}
+
+cd EquivalentCircuit::impedance(double f_hz) const { return 1.0 / admittance_without_rs(f_hz) + rs_ohm; }
+
+double EquivalentCircuit::lossless_susceptance(double f_hz) const {
+  const double w = kTwoPi * f_hz;
+  double b = w * c0_f;
+  for (const auto& br : branches) b -= 1.0 / (w * br.l_h - 1.0 / (w * br.c_f));
+  return b;
+}
+
+namespace {
+
+// The parallel resonances fp_k of the lossless network, one above each fs_k:
+// its susceptance runs from −∞ just above fs_k to +∞ just below fs_{k+1} (or
+// as ωC0 → ∞ above the last): one zero between (Foster's reactance theorem).
+std::vector<double> parallel_resonances(const EquivalentCircuit& c) {
+  std::vector<double> fp;
+  auto bsus = [&](double f) { return c.lossless_susceptance(f); };
+  for (std::size_t k = 0; k < c.branches.size(); ++k) {
+    const double fs = c.branches[k].fs_hz();
+    const double lo = fs * (1 + 1e-12);
+    double hi = k + 1 < c.branches.size() ? c.branches[k + 1].fs_hz() * (1 - 1e-12) : 2 * fs;
+    if (k + 1 == c.branches.size())
+      while (bsus(hi) < 0 && hi < fs * 1e6) hi *= 2;
+    fp.push_back(hi > lo && bsus(lo) < 0 && bsus(hi) > 0 ? bisect(bsus, lo, hi) : kNaN);
+  }
+  return fp;
+}
+
+// The window of branch k: half-way to the neighbours (fp of the one below, fs
+// of the one above); the outer modes open to the band's ends.
+std::pair<double, double> mode_window(const EquivalentCircuit& c, const std::vector<double>& fp, std::size_t k) {
+  const double fs = c.branches[k].fs_hz();
+  const double lo = k > 0 && std::isfinite(fp[k - 1]) ? 0.5 * (fp[k - 1] + fs) : 0.0;
+  const double hi = k + 1 < c.branches.size() && std::isfinite(fp[k])
+                        ? 0.5 * (fp[k] + c.branches[k + 1].fs_hz())
+                        : std::numeric_limits<double>::infinity();
+  return {lo, hi};
+}
+
+CircuitModeFigures figures_of(const EquivalentCircuit& c, const std::vector<double>& fps, std::size_t k) {
+  CircuitModeFigures m;
+  const auto& b = c.branches[k];
+  const double fs = b.fs_hz(), q = b.qm(), fp = fps[k];
+  m.fs_hz.value = fs;
+  m.fp_hz.value = fp;
+  m.qm_branch.value = q;
+  m.r1_ohm.value = b.r_ohm;
+  m.l1_h.value = b.l_h;
+  m.c1_f.value = b.c_f;
+  std::tie(m.window_lo_hz, m.window_hi_hz) = mode_window(c, fps, k);
+  if (!std::isfinite(fp)) return m;
+  m.k_eff_ieee176.value = std::sqrt(std::max(0.0, 1.0 - std::pow(fs / fp, 2)));
+  // |Z| extrema of the lossy network: the minimum below fp, the maximum above it.
+  const double span = (fp - fs) + 3.0 * fs / q;
+  const double a = std::max(std::max(m.window_lo_hz, 1e-9 * fs), fs - span);
+  const double next_fs = k + 1 < c.branches.size() ? c.branches[k + 1].fs_hz() : kNaN;
+  const double z_hi = std::isfinite(next_fs) ? next_fs : fp + span;
+  auto absz = [&](double f) { return std::abs(c.impedance(f)); };
+  m.fm_hz.value = grid_min(absz, a, fp);
+  const double fm = m.fm_hz.value;
+  m.fn_hz.value = grid_min([&](double f) { return -absz(f); }, fm, z_hi);
+  const double fn = m.fn_hz.value;
+  if (std::isfinite(fm) && std::isfinite(fn) && fn > fm)
+    m.k_eff_en50324.value = std::sqrt(std::max(0.0, 1.0 - std::pow(fm / fn, 2)));
+  // Zero phase: Im Z rises through 0 near fm (fr) and falls through 0 near fn (fa).
+  if (std::isfinite(fm) && std::isfinite(fn) && fn > fm) {
+    auto imz = [&](double f) { return c.impedance(f).imag(); };
+    const double g0 = fm - 0.5 * (fn - fm), g1 = fn + 0.5 * (fn - fm);
+    const int n = 800;
+    double prev_f = std::max(g0, 1e-9 * fs), prev = imz(prev_f);
+    for (int i = 1; i <= n; ++i) {
+      const double f = g0 + (g1 - g0) * i / n;
+      if (f <= prev_f) continue;
+      const double v = imz(f);
+      if (prev < 0 && v >= 0 && !std::isfinite(m.fr_hz.value)) m.fr_hz.value = bisect(imz, prev_f, f);
+      if (prev > 0 && v <= 0 && std::isfinite(m.fr_hz.value) && !std::isfinite(m.fa_hz.value))
+        m.fa_hz.value = bisect([&](double x) { return -imz(x); }, prev_f, f);
+      prev_f = f;
+      prev = v;
+    }
+  }
+  // Bandwidth Qm: the conductance peak near fs and its half-power points.
+  auto g = [&](double f) { return (1.0 / c.impedance(f)).real(); };
+  const double fg = grid_min([&](double f) { return -g(f); }, a, fp);
+  if (std::isfinite(fg)) {
+    const double half = 0.5 * g(fg);
+    auto above = [&](double f) { return g(f) - half; };
+    double l = fg, h = fg;
+    const double step = std::max(fs / q / 8.0, 1e-6 * fs);
+    int guard = 0;
+    while (l > a && above(l) > 0 && guard++ < 100000) l -= step;
+    guard = 0;
+    while (h < z_hi && above(h) > 0 && guard++ < 100000) h += step;
+    if (above(l) < 0 && above(h) < 0) {
+      const double f1 = bisect(above, l, fg), f2 = bisect([&](double x) { return -above(x); }, fg, h);
+      if (f2 > f1) m.qm_bandwidth.value = fg / (f2 - f1);
+    }
+  }
+  return m;
+}
+
+// Every figure of every mode, in one vector (for the finite differences).
+std::vector<double> figure_vector(const std::vector<CircuitModeFigures>& ms) {
+  std::vector<double> v;
+  for (const auto& m : ms)
+    for (const Figure* f : {&m.fs_hz, &m.fp_hz, &m.fm_hz, &m.fn_hz, &m.fr_hz, &m.fa_hz, &m.k_eff_ieee176,
+                            &m.k_eff_en50324, &m.qm_branch, &m.qm_bandwidth, &m.r1_ohm, &m.l1_h, &m.c1_f})
+      v.push_back(f->value);
+  return v;
+}
+
+std::vector<Figure*> figure_slots(std::vector<CircuitModeFigures>& ms) {
+  std::vector<Figure*> v;
+  for (auto& m : ms)
+    for (Figure* f : {&m.fs_hz, &m.fp_hz, &m.fm_hz, &m.fn_hz, &m.fr_hz, &m.fa_hz, &m.k_eff_ieee176,
+                      &m.k_eff_en50324, &m.qm_branch, &m.qm_bandwidth, &m.r1_ohm, &m.l1_h, &m.c1_f})
+      v.push_back(f);
+  return v;
+}
+
+std::vector<CircuitModeFigures> all_figures(const EquivalentCircuit& c) {
+  const auto fp = parallel_resonances(c);
+  std::vector<CircuitModeFigures> ms;
+  for (std::size_t k = 0; k < c.branches.size(); ++k) ms.push_back(figures_of(c, fp, k));
+  return ms;
+}
+
+}  // namespace
+
+CircuitModeFigures circuit_mode_figures(const EquivalentCircuit& c, std::size_t k) {
+  if (k >= c.branches.size()) throw std::invalid_argument("circuit_mode_figures: no such branch");
+  return figures_of(c, parallel_resonances(c), k);
+}
+
+CircuitFit fit_equivalent_circuit(const Eigen::VectorXd& f, const Eigen::VectorXcd& z,
+                                  const Eigen::VectorXd& z_sigma, const CircuitFitOptions& opt) {
+  const Eigen::Index n = f.size();
+  if (z.size() != n || (z_sigma.size() && z_sigma.size() != n))
+    throw std::invalid_argument("fit_equivalent_circuit: f, z and z_sigma sizes differ");
+  if (n < 8) throw std::invalid_argument("fit_equivalent_circuit: need at least 8 points");
+  for (Eigen::Index i = 0; i < n; ++i) {
+    if (!(f[i] > 0) || (i > 0 && !(f[i] > f[i - 1])))
+      throw std::invalid_argument("fit_equivalent_circuit: frequencies must be > 0 and ascending (point " +
+                                  std::to_string(i) + ")");
+    if (!std::isfinite(z[i].real()) || !std::isfinite(z[i].imag()) || z[i] == 0.0)
+      throw std::invalid_argument("fit_equivalent_circuit: non-finite or zero impedance at point " +
+                                  std::to_string(i));
+    if (z_sigma.size() && !(z_sigma[i] > 0))
+      throw std::invalid_argument("fit_equivalent_circuit: z_sigma must be > 0 (point " + std::to_string(i) + ")");
+  }
+  CircuitFit out;
+  out.points = static_cast<int>(n);
+  out.weighted = z_sigma.size() > 0;
+  int negative = 0;
+  for (Eigen::Index i = 0; i < n; ++i) negative += z[i].real() < 0;
+  out.magnitude_only = opt.magnitude_only || negative > n / 2;
+  if (out.magnitude_only && !opt.magnitude_only)
+    out.notes.push_back("Re Z < 0 at " + std::to_string(negative) + " of " + std::to_string(n) +
+                        " points (not a passive part: the phase cannot be trusted): |Z| fitted alone");
+  Data d{f, z, Eigen::VectorXd(n), out.magnitude_only};
+  for (Eigen::Index i = 0; i < n; ++i) {
+    if (out.magnitude_only)
+      d.scale[i] = out.weighted ? z_sigma[i] / std::abs(z[i]) : 1.0;
+    else
+      d.scale[i] = out.weighted ? z_sigma[i] / std::sqrt(2.0) : std::abs(z[i]);
+  }
+
+  // Seeds: the given resonances, else the conductance peaks of the data (the
+  // strongest first), each with R from its peak and Q from its width.
+  Eigen::VectorXd g(n);
+  for (Eigen::Index i = 0; i < n; ++i) g[i] = out.magnitude_only ? 1.0 / std::abs(z[i]) : (1.0 / z[i]).real();
+  std::vector<std::pair<double, Eigen::Index>> peaks;  // (height, index)
+  if (!opt.seed_fs_hz.empty()) {
+    for (double fs : opt.seed_fs_hz) {
+      if (!(fs > f[0] && fs < f[n - 1])) continue;
+      const Eigen::Index i = std::lower_bound(f.data(), f.data() + n, fs) - f.data();
+      peaks.push_back({g[i], i});
+    }
+  } else {
+    std::vector<std::pair<double, Eigen::Index>> all;
+    for (Eigen::Index i = 1; i + 1 < n; ++i)
+      if (g[i] > g[i - 1] && g[i] >= g[i + 1]) all.push_back({g[i], i});
+    std::sort(all.begin(), all.end(), [](auto& a, auto& b) { return a.first > b.first; });
+    // The strongest first; a maximum inside a stronger one's half-power width
+    // is that peak's noise, not a mode.
+    for (const auto& [h, i] : all) {
+      const double wi = f[i] / peak_q(f, g, i);
+      bool apart = true;
+      for (const auto& [h2, j] : peaks) apart &= std::abs(f[i] - f[j]) > std::max(wi, f[j] / peak_q(f, g, j));
+      if (apart) peaks.push_back({h, i});
+      if (peaks.size() >= static_cast<std::size_t>(opt.max_branches)) break;
+    }
+  }
+  if (peaks.size() > static_cast<std::size_t>(opt.max_branches)) peaks.resize(static_cast<std::size_t>(opt.max_branches));
+  EquivalentCircuit c0;
+  {
+    const double w0 = kTwoPi * f[0];
+    const cd y0 = 1.0 / z[0];
+    c0.c0_f = out.magnitude_only ? 1.0 / (w0 * std::abs(z[0])) : std::max(y0.imag() / w0, 1e-3 / (w0 * std::abs(z[0])));
+    c0.tan_delta = out.magnitude_only ? 0.01 : std::clamp(y0.real() / std::max(y0.imag(), 1e-300), 1e-4, 0.2);
+  }
+  for (const auto& [h, i] : peaks) c0.branches.push_back(branch_at(f[i], h, peak_q(f, g, i)));
+  std::sort(c0.branches.begin(), c0.branches.end(), [](auto& a, auto& b) { return a.fs_hz() < b.fs_hz(); });
+  double cb = 0;
+  for (const auto& b : c0.branches) cb += b.c_f;
+  if (c0.c0_f > 2 * cb) c0.c0_f -= cb;
+
+  const Eigen::Index rows = d.rows();
+  auto score = [&](Trial& tr) {
+    tr.bic = std::isfinite(tr.chi2) ? bic_of(tr.chi2, rows, tr.lay.size(), out.weighted) : INFINITY;
+  };
+  auto run = [&](const EquivalentCircuit& c, bool rs) {
+    Layout lay{rs, c.branches.size()};
+    EquivalentCircuit cc = c;
+    if (rs && !(cc.rs_ohm > 0)) cc.rs_ohm = 1e-3 * d.z.cwiseAbs().minCoeff();
+    Trial tr = fit_layout(d, lay, theta_of(lay, cc), opt.max_iterations);
+    score(tr);
+    return tr;
+  };
+  auto sorted = [](EquivalentCircuit c) {
+    std::sort(c.branches.begin(), c.branches.end(), [](auto& a, auto& b) { return a.fs_hz() < b.fs_hz(); });
+    return c;
+  };
+
+  Trial best = run(c0, false);
+  // Backward: drop branches that leave the band or whose removal lowers the criterion.
+  for (bool changed = true; changed && best.lay.branches > 0;) {
+    changed = false;
+    const EquivalentCircuit cur = sorted(circuit_of(best.lay, best.t));
+    for (std::size_t k = 0; k < cur.branches.size(); ++k) {
+      EquivalentCircuit less = cur;
+      less.branches.erase(less.branches.begin() + static_cast<std::ptrdiff_t>(k));
+      const double fs = cur.branches[k].fs_hz();
+      const bool outside = !(fs > f[0] && fs < f[n - 1]);
+      Trial tr = run(less, best.lay.rs);
+      if (outside || tr.bic < best.bic) {
+        out.notes.push_back("dropped the branch at " + fmt(fs) + " Hz (" +
+                            (outside ? std::string("outside the data") : "information criterion " + fmt(best.bic, 6) + " -> " + fmt(tr.bic, 6)) + ")");
+        best = tr;
+        changed = true;
+        break;
+      }
+    }
+  }
+  // Forward: a branch where the residual stands out most, kept while the criterion falls.
+  while (static_cast<int>(best.lay.branches) < opt.max_branches) {
+    const Eigen::VectorXd r = d.residual(best.lay, best.t, nullptr);
+    Eigen::VectorXd e(n);
+    for (Eigen::Index i = 0; i < n; ++i) e[i] = d.magnitude ? r[i] * r[i] : r[2 * i] * r[2 * i] + r[2 * i + 1] * r[2 * i + 1];
+    Eigen::VectorXd sm = e;
+    for (Eigen::Index i = 0; i < n; ++i) {
+      double s = 0;
+      int cnt = 0;
+      for (Eigen::Index j = std::max<Eigen::Index>(0, i - 2); j <= std::min(n - 1, i + 2); ++j) s += e[j], ++cnt;
+      sm[i] = s / cnt;
+    }
+    Eigen::Index at = 0;
+    sm.maxCoeff(&at);
+    const EquivalentCircuit cur = circuit_of(best.lay, best.t);
+    // The residual admittance there gives the new branch's size.
+    Eigen::VectorXd dg(n);
+    for (Eigen::Index i = 0; i < n; ++i)
+      dg[i] = d.magnitude ? std::abs(1.0 / std::abs(z[i]) - 1.0 / std::abs(cur.impedance(f[i])))
+                          : std::abs(1.0 / z[i] - 1.0 / cur.impedance(f[i]));
+    EquivalentCircuit more = cur;
+    more.branches.push_back(branch_at(f[at], dg[at], peak_q(f, dg, at)));
+    Trial tr = run(sorted(more), best.lay.rs);
+    if (!(tr.bic < best.bic)) break;
+    out.notes.push_back("added a branch at " + fmt(f[at]) + " Hz (information criterion " + fmt(best.bic, 6) + " -> " +
+                        fmt(tr.bic, 6) + ")");
+    best = tr;
+  }
+  if (opt.try_series_resistance && !best.lay.rs) {
+    Trial tr = run(circuit_of(best.lay, best.t), true);
+    if (tr.bic < best.bic) {
+      out.notes.push_back("series resistance kept (information criterion " + fmt(best.bic, 6) + " -> " + fmt(tr.bic, 6) + ")");
+      best = tr;
+    }
+  }
+  // Out-of-band branches that the forward steps may have placed: never a mode without data.
+  {
+    EquivalentCircuit cur = circuit_of(best.lay, best.t);
+    const auto before = cur.branches.size();
+    std::erase_if(cur.branches, [&](const CircuitBranch& b) { return !(b.fs_hz() > f[0] && b.fs_hz() < f[n - 1]); });
+    if (cur.branches.size() != before) {
+      out.notes.push_back(std::to_string(before - cur.branches.size()) + " branch(es) outside the data dropped");
+      best = run(cur, best.lay.rs);
+    }
+  }
+  // Ascending fs, and the parameter vector and Jacobian in that order.
+  {
+    const EquivalentCircuit cur = sorted(circuit_of(best.lay, best.t));
+    best.t = theta_of(best.lay, cur);
+    d.residual(best.lay, best.t, &best.j);
+  }
+  out.converged = best.converged;
+  out.circuit = circuit_of(best.lay, best.t);
+  out.parameters = best.lay.size();
+  out.chi2 = best.chi2;
+  out.bic = best.bic;
+  const double dof = static_cast<double>(rows - out.parameters);
+  out.chi2_per_dof = dof > 0 ? out.chi2 / dof : kNaN;
+  // Covariance of ln θ: (JᵀJ)⁺, scaled by the lack of fit (χ²/ν above 1) or, with
+  // relative weights, by the residual's own scale.
+  Eigen::MatrixXd cov = lm_covariance(best.j);
+  const double inflate = out.weighted ? std::max(1.0, out.chi2_per_dof) : out.chi2_per_dof;
+  cov *= std::isfinite(inflate) ? inflate : kNaN;
+
+  out.modes = all_figures(out.circuit);
+  {  // σ of every figure by central differences in ln θ
+    const std::vector<double> v0 = figure_vector(out.modes);
+    const int p = out.parameters;
+    Eigen::MatrixXd dv(static_cast<Eigen::Index>(v0.size()), p);
+    for (int c = 0; c < p; ++c) {
+      const double h = 1e-6;
+      Eigen::VectorXd tp = best.t, tm = best.t;
+      tp[c] += h;
+      tm[c] -= h;
+      const auto vp = figure_vector(all_figures(circuit_of(best.lay, tp)));
+      const auto vm = figure_vector(all_figures(circuit_of(best.lay, tm)));
+      for (std::size_t i = 0; i < v0.size(); ++i)
+        dv(static_cast<Eigen::Index>(i), c) = vp.size() == v0.size() && vm.size() == v0.size() ? (vp[i] - vm[i]) / (2 * h) : kNaN;
+    }
+    const Eigen::VectorXd var = (dv * cov * dv.transpose()).diagonal();
+    auto slots = figure_slots(out.modes);
+    for (std::size_t i = 0; i < slots.size(); ++i)
+      if (std::isfinite(slots[i]->value) && std::isfinite(var[static_cast<Eigen::Index>(i)]))
+        slots[i]->sigma = std::sqrt(std::max(0.0, var[static_cast<Eigen::Index>(i)]));
+  }
+  out.c0_f = {out.circuit.c0_f, out.circuit.c0_f * std::sqrt(std::max(0.0, cov(0, 0)))};
+  out.tan_delta = {out.circuit.tan_delta, out.circuit.tan_delta * std::sqrt(std::max(0.0, cov(1, 1)))};
+  if (best.lay.rs) out.rs_ohm = {out.circuit.rs_ohm, out.circuit.rs_ohm * std::sqrt(std::max(0.0, cov(2, 2)))};
+  else out.rs_ohm = {0.0, kNaN};
+  {  // C^T = C0 + Σ C_k, σ by its gradient in ln θ
+    Eigen::VectorXd gct = Eigen::VectorXd::Zero(out.parameters);
+    double ct = out.circuit.c0_f;
+    gct[0] = out.circuit.c0_f;
+    for (std::size_t k = 0; k < out.circuit.branches.size(); ++k) {
+      ct += out.circuit.branches[k].c_f;
+      gct[best.lay.first_branch() + 3 * static_cast<int>(k) + 2] = out.circuit.branches[k].c_f;
+    }
+    out.free_capacitance_f = {ct, std::sqrt(std::max(0.0, gct.dot(cov * gct)))};
+  }
+  // Misfits: over the band, and per mode in its window.
+  double sz = 0, sa = 0, sy = 0;
+  std::vector<double> mode_s(out.modes.size(), 0.0);
+  std::vector<int> mode_n(out.modes.size(), 0);
+  for (Eigen::Index i = 0; i < n; ++i) {
+    const cd zm = out.circuit.impedance(f[i]);
+    const double rel = std::norm((zm - z[i]) / z[i]);
+    sz += rel;
+    sa += std::pow(std::abs(zm) / std::abs(z[i]) - 1.0, 2);
+    sy += std::pow(std::abs(z[i]) / std::abs(zm) - 1.0, 2);
+    for (std::size_t k = 0; k < out.modes.size(); ++k)
+      if (f[i] >= out.modes[k].window_lo_hz && f[i] < out.modes[k].window_hi_hz) {
+        mode_s[k] += out.magnitude_only ? std::pow(std::abs(zm) / std::abs(z[i]) - 1.0, 2) : rel;
+        ++mode_n[k];
+      }
+  }
+  out.misfit_rel_rms = std::sqrt(sz / double(n));
+  out.misfit_abs_rel_rms = std::sqrt(sa / double(n));
+  out.misfit_admittance_abs_rel_rms = std::sqrt(sy / double(n));
+  for (std::size_t k = 0; k < out.modes.size(); ++k) {
+    out.modes[k].points = mode_n[k];
+    out.modes[k].misfit_rel_rms = mode_n[k] ? std::sqrt(mode_s[k] / mode_n[k]) : kNaN;
+  }
+  if (!out.converged) out.notes.push_back("the least-squares fit did not converge");
+  return out;
+}
+
+}  // namespace piezo::dsp

@@ -1,0 +1,117 @@
+#pragma once
+// A multi-mode equivalent circuit fitted to a complex impedance Z(f) (issue
+// 34): the modified Butterworth–Van Dyke network of IEEE Std 176-1987 and
+// EN 50324-2 extended to every mode in the band —
+//
+//   Z(f) = Rs + 1 / ( jωC0(1 − j·tanδ) + Σ_k 1/(R_k + jωL_k + 1/(jωC_k)) )
+//
+// one clamped capacitance C0 with its dielectric loss (a constant tan δ: the
+// loss conductance ωC0·tanδ, i.e. R0 = 1/(ωC0·tanδ) at each frequency), an
+// optional series resistance Rs (leads, electrodes), and one motional R-L-C
+// branch per mode. All branches are fitted jointly, by weighted least squares
+// on Re and Im of Z (the shared engine, dsp/levenberg_marquardt), in the logs
+// of the elements. The number of branches is chosen by the Bayesian
+// information criterion: a branch is added where the residual stands out and
+// kept only if the criterion falls; a branch whose removal lowers it, or whose
+// resonance leaves the data's band, is dropped — so close pairs are resolved
+// and no mode appears where there are no data.
+//
+// The figures of each mode follow from the fitted network (IEEE 176 and
+// EN 50324-2 definitions, each named), with σ from the fit's covariance
+// inflated by its lack of fit (χ²/ν when above 1), propagated by finite
+// differences.
+#include <Eigen/Core>
+#include <complex>
+#include <string>
+#include <vector>
+
+#include "dsp/impedance_types.hpp"
+
+namespace piezo::dsp {
+
+struct CircuitBranch {
+  double r_ohm = kNaN, l_h = kNaN, c_f = kNaN;
+  double fs_hz() const;  // 1/(2π√(LC))
+  double qm() const;     // 2π·fs·L/R
+};
+
+struct EquivalentCircuit {
+  double c0_f = kNaN;
+  double tan_delta = 0;  // of C0
+  double rs_ohm = 0;     // 0: no series resistance in the model
+  std::vector<CircuitBranch> branches;  // ascending fs
+  std::complex<double> admittance_without_rs(double f_hz) const;
+  std::complex<double> impedance(double f_hz) const;
+  // The same network without losses (R_k = 0, tanδ = 0, Rs = 0): its
+  // susceptance, whose zeros are the parallel resonances fp (Foster).
+  double lossless_susceptance(double f_hz) const;
+};
+
+struct Figure {
+  double value = kNaN;
+  double sigma = kNaN;  // 1σ, including the fit's lack of fit
+};
+
+struct CircuitModeFigures {
+  // Motional branch (IEEE 176 "series" and "parallel" resonance of the
+  // lossless network): fs = 1/(2π√(L_kC_k)); fp = the zero of the lossless
+  // susceptance between fs_k and fs_{k+1}.
+  Figure fs_hz, fp_hz;
+  // |Z| minimum and maximum of the fitted network (IEEE 176 fm, fn).
+  Figure fm_hz, fn_hz;
+  // Zero-phase frequencies near fm and fn (IEEE 176 fr, fa); NaN when the
+  // mode's phase never reaches zero (low Q, strong background).
+  Figure fr_hz, fa_hz;
+  Figure k_eff_ieee176;    // √(1 − (fs/fp)²), IEEE 176 dynamic coupling
+  Figure k_eff_en50324;    // √(1 − (fm/fn)²), EN 50324-2's form from the |Z| extrema
+  Figure qm_branch;        // 2π·fs·L/R
+  Figure qm_bandwidth;     // f_G/(f2 − f1), the network's conductance half-power points
+  Figure r1_ohm, l1_h, c1_f;
+  double window_lo_hz = kNaN, window_hi_hz = kNaN;  // the mode's share of the band
+  double misfit_rel_rms = kNaN;  // √mean(|Z_fit − Z|²/|Z|²) in that window
+  int points = 0;                // data points in the window
+};
+
+struct CircuitFitOptions {
+  int max_branches = 12;
+  // Modes to seed the search with (fs, Q; from dsp/mode_figures or the
+  // |Z| minima); empty: the conductance peaks of the data.
+  std::vector<double> seed_fs_hz;
+  // Try the series resistance Rs (kept if the criterion falls).
+  bool try_series_resistance = true;
+  // Fit |Z| only (ln|Z| residuals): for files whose phase cannot be trusted
+  // (a passive part with Re Z < 0). Set automatically when most points have
+  // Re Z < 0.
+  bool magnitude_only = false;
+  int max_iterations = 200;
+};
+
+struct CircuitFit {
+  EquivalentCircuit circuit;
+  std::vector<CircuitModeFigures> modes;  // one per branch, ascending fs
+  Figure c0_f, tan_delta, rs_ohm;
+  Figure free_capacitance_f;  // C^T = C0 + Σ C_k: the network's capacitance as f → 0
+  double chi2 = kNaN;         // Σ r² (weighted) or the residual sum of squares (relative)
+  int points = 0, parameters = 0;
+  double chi2_per_dof = kNaN;
+  double bic = kNaN;
+  bool weighted = false;       // per-point σ given
+  bool magnitude_only = false;
+  bool converged = false;
+  double misfit_rel_rms = kNaN;        // of Z over the band
+  double misfit_abs_rel_rms = kNaN;    // of |Z| over the band
+  double misfit_admittance_abs_rel_rms = kNaN;  // of |Y| over the band
+  std::vector<std::string> notes;      // order selection, dropped modes, assumptions
+};
+
+// f ascending, z the measured impedance, z_sigma per point sqrt(E|δZ|²) or
+// empty (relative weights; the residual then sets the noise scale). Throws
+// std::invalid_argument on sizes that differ, fewer than 8 points, a
+// non-positive or non-ascending frequency, or a non-finite Z.
+CircuitFit fit_equivalent_circuit(const Eigen::VectorXd& f_hz, const Eigen::VectorXcd& z,
+                                  const Eigen::VectorXd& z_sigma, const CircuitFitOptions& opt = {});
+
+// Figures of branch k of a circuit (values only; fit_equivalent_circuit adds σ).
+CircuitModeFigures circuit_mode_figures(const EquivalentCircuit& c, std::size_t k);
+
+}  // namespace piezo::dsp
