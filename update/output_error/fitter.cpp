@@ -7,6 +7,8 @@
 #include <cmath>
 #include <utility>
 
+#include "dsp/levenberg_marquardt.hpp"
+
 namespace piezo::update::oe {
 
 std::optional<Eigen::VectorXd> Fitter::weighted(const Eigen::VectorXd& x) {
@@ -71,151 +73,82 @@ double Fitter::tangent_cost(const Eigen::VectorXd& anchor, const Eigen::VectorXd
 
 LmOutcome Fitter::levenberg_marquardt(Eigen::VectorXd x, const LmOutcome* lead,
                                       const Eigen::MatrixXd* j0, bool freeze_material) {
-  LmOutcome o;
-  auto r = weighted(x);
-  if (!r) {
-    o.message = "the start cannot be simulated";
-    o.cost = INFINITY;
-    o.x = x;
-    return o;
-  }
-  double cost = 0.5 * r->squaredNorm();
-  double mu = 1e-3, last_drop = INFINITY;
+  dsp::LmProblem pb;
+  pb.residual = [&](const Eigen::VectorXd& xt) { return weighted(xt); };
   // J by forward differences at every iterate: four FE port models (β's
-  // column reuses the cached one), or none near the last exact J (the
-  // port models' tangent, Problem::set_tangent). Broyden's rank-one updates
-  // instead were measured on the corpus: fewer models on the first start,
-  // but later starts crawl and can look stalled where the exact J joins the
-  // best optimum.
-  Eigen::MatrixXd j;
-  // An iteration that finds no lower cost (its J perhaps through the
-  // tangent or j0's frozen columns, its trials screened) runs again on the
-  // exact J, unscreened, before the run gives up.
-  bool strict = false;
-  for (int it = 1; it <= opt.max_iterations; ++it) {
-    o.iterations = it;
-    const double mu_it = mu;
-    int exact_tries = 0;  // none: every try was refused by the tangent's screen
-    const bool have_j0 = j0 && j0->rows() == r->size() && j0->cols() == x.size();
-    bool j_ok = true;
-    if (strict) {
-      j_ok = jacobian(x, *r, j, 0, true);
-    } else if (it == 1 && have_j0) {
+  // column reuses the cached one), or none near the last exact J (the port
+  // models' tangent, Problem::set_tangent). Broyden's rank-one updates instead
+  // were measured on the corpus: fewer models on the first start, but later
+  // starts crawl and can look stalled where the exact J joins the best optimum.
+  // A retry (the engine's retry_exact: an iteration that found no lower cost
+  // through the tangent, j0's frozen columns or the screen) is exact.
+  pb.jacobian = [&](const Eigen::VectorXd& xt, const Eigen::VectorXd& r, Eigen::MatrixXd& j,
+                    const dsp::LmJacobianCall& call) {
+    const bool have_j0 = j0 && j0->rows() == r.size() && j0->cols() == xt.size();
+    if (call.exact) return jacobian(xt, r, j, 0, true);
+    if (call.iteration == 1 && have_j0) {
       j = *j0;
-    } else if (freeze_material && have_j0) {
-      j = *j0;
-      j_ok = jacobian(x, *r, j, 4);
-    } else {
-      j_ok = jacobian(x, *r, j);
+      return true;
     }
-    if (!j_ok) {
+    if (freeze_material && have_j0) {
+      j = *j0;
+      return jacobian(xt, r, j, 4);
+    }
+    return jacobian(xt, r, j);
+  };
+  // A trial near x is screened on the tangent anchored at x first (its model
+  // exact at x, the slopes x_ref's): a step it says raises the cost is
+  // rejected without an FE model; one it says lowers it is computed.
+  pb.screen = [&](const Eigen::VectorXd& anchor, const Eigen::VectorXd& xt) { return tangent_cost(anchor, xt); };
+  // A later start stops early inside the lead's optimum, or stalled far above it.
+  pb.after_iteration = [&](const dsp::LmState& st) {
+    dsp::LmVerdict v;
+    if (!lead || lead->jtj.rows() != st.x.size() || lead->x.size() != st.x.size()) return v;
+    const Eigen::VectorXd dx = st.x - lead->x;
+    const double gap = st.cost - lead->cost;
+    if (gap >= 0 && dx.dot(lead->jtj * dx) < 9.0) return dsp::LmVerdict{true, true, "joined the first start's optimum"};
+    const double s2 = std::max(1.0, 2.0 * lead->cost / dof_fit);
+    if (st.iteration >= 2 && gap > std::max(50.0, 10.0 * s2) && st.last_drop < 0.1 * gap)
+      return dsp::LmVerdict{true, false, "stalled far above the first start's optimum"};
+    return v;
+  };
+  dsp::LmSettings ls;  // this fit's damping, as measured on the corpus before the shared engine
+  ls.max_iterations = opt.max_iterations;
+  ls.max_tries = 14;
+  ls.max_step = 0.3;  // trust region: no constant moves by more than 30 % in one step
+  // The cost is ½χ²: a decrease below 1e-2 leaves the estimate within ~0.15
+  // of its sigma of the optimum.
+  ls.step_tolerance = opt.step_tolerance;
+  ls.cost_tolerance = opt.cost_tolerance;
+  ls.retry_exact = true;
+  // Along a curved valley (resonances sliding into place) the Gauss-Newton
+  // step is far shorter than the way to the minimum: go on along it, doubling.
+  ls.extend_steps = 4;
+  ls.jacobian_at_answer = false;  // finish() computes the exact J of the run that is used
+  const dsp::LmRun run = dsp::levenberg_marquardt(pb, std::move(x), ls);
+  LmOutcome o;
+  o.x = run.x;
+  o.iterations = run.iterations;
+  o.converged = run.converged;
+  o.message = run.message;
+  switch (run.stop) {
+    case dsp::LmRun::Stop::bad_start:
+      o.message = "the start cannot be simulated";
+      o.cost = INFINITY;
+      return o;
+    case dsp::LmRun::Stop::jacobian_failed:
       o.message = "the model could not be simulated near the estimate";
       break;
-    }
-    const Eigen::MatrixXd jtj = j.transpose() * j;
-    const Eigen::VectorXd g = j.transpose() * *r;
-    bool accepted = false, done = false;
-    // A trial near x is screened on the tangent anchored at x first (its
-    // model exact at x, the slopes x_ref's): a step it says raises the cost
-    // is rejected without an FE model; one it says lowers it is computed.
-    auto screen = [&](const Eigen::VectorXd& anchor, const Eigen::VectorXd& xt) {
-      return strict ? NAN : tangent_cost(anchor, xt);
-    };
-    for (int tries = 0; tries < 14 && !accepted; ++tries) {
-      Eigen::MatrixXd a = jtj;
-      for (Eigen::Index p = 0; p < a.rows(); ++p) a(p, p) += mu * std::max(jtj(p, p), 1e-300);
-      Eigen::VectorXd step = a.ldlt().solve(-g);
-      // Trust region: no constant moves by more than 30 % in one step.
-      const double big = step.cwiseAbs().maxCoeff();
-      if (big > 0.3) step *= 0.3 / big;
-      const Eigen::VectorXd trial = x + step;
-      if (screen(x, trial) >= cost) {
-        mu *= 4.0;
-        // The screen alone never ends a run (its slopes are x_ref's): the
-        // exact J decides (strict, below).
-        if (step.cwiseAbs().maxCoeff() < opt.step_tolerance) break;
-        continue;
-      }
-      ++exact_tries;
-      const auto rt = weighted(trial);
-      const double ct = rt ? 0.5 * rt->squaredNorm() : INFINITY;
-      if (ct < cost) {
-        const Eigen::VectorXd x_old = x;
-        x = trial;
-        r = rt;
-        double c_new = ct;
-        // Along a curved valley (resonances sliding into place) the
-        // Gauss-Newton step is far shorter than the way to the minimum: go
-        // on along it, doubling, while the cost keeps falling (one model per
-        // try instead of a Jacobian per step; screened as above).
-        Eigen::VectorXd ext = step;
-        for (int d = 0; d < 4 && mu < 1e-2; ++d) {
-          ext *= 2.0;
-          if (ext.cwiseAbs().maxCoeff() > 0.3) break;
-          const Eigen::VectorXd xe = x_old + ext;
-          if (screen(x, xe) >= c_new) break;
-          const auto re = weighted(xe);
-          const double ce = re ? 0.5 * re->squaredNorm() : INFINITY;
-          if (!(ce < c_new)) break;
-          x = xe;
-          r = re;
-          c_new = ce;
-        }
-        const double drop = cost - c_new;
-        last_drop = drop;
-        cost = c_new;
-        mu = std::max(mu / 3.0, 1e-12);
-        accepted = true;
-        // The cost is ½χ²: a decrease below 1e-2 leaves the estimate
-        // within ~0.15 of its sigma of the optimum.
-        done = step.cwiseAbs().maxCoeff() < opt.step_tolerance || drop < opt.cost_tolerance;
-      } else {
-        mu *= 4.0;
-        if (step.cwiseAbs().maxCoeff() < opt.step_tolerance) accepted = done = true;
-      }
-    }
-    if (done) {
-      o.converged = true;
+    case dsp::LmRun::Stop::stalled:
+      o.message = "no decrease of the output error (gradient cosine " + std::to_string(run.stall_cosine) + ")";
       break;
-    }
-    if (!accepted) {
-      if (!strict) {
-        strict = true;
-        if (exact_tries == 0) mu = mu_it;  // (the screen's refusals grew mu, not the data)
-        --it;
-        continue;
-      }
-      double cosine = 0;
-      for (Eigen::Index p = 0; p < g.size(); ++p)
-        cosine = std::max(cosine, std::abs(g[p]) / std::sqrt(jtj(p, p) * 2.0 * cost + 1e-300));
-      if (cosine < 1e-4) {
-        o.converged = true;
-      } else {
-        o.message = "no decrease of the output error (gradient cosine " + std::to_string(cosine) + ")";
-      }
+    default:
       break;
-    }
-    strict = false;
-    if (lead && lead->jtj.rows() == x.size() && lead->x.size() == x.size()) {
-      const Eigen::VectorXd dx = x - lead->x;
-      const double gap = cost - lead->cost;
-      if (gap >= 0 && dx.dot(lead->jtj * dx) < 9.0) {
-        o.converged = true;
-        o.message = "joined the first start's optimum";
-        break;
-      }
-      const double s2 = std::max(1.0, 2.0 * lead->cost / dof_fit);
-      if (it >= 2 && gap > std::max(50.0, 10.0 * s2) && last_drop < 0.1 * gap) {
-        o.message = "stalled far above the first start's optimum";
-        break;
-      }
-    }
   }
   if (!o.converged && o.message.empty())
     o.message = "did not converge in " + std::to_string(opt.max_iterations) + " iterations";
-  o.x = x;
-  o.cost = cost;
-  o.r = *r;
+  o.cost = run.cost;
+  o.r = run.r;
   return o;
 }
 
