@@ -1,11 +1,12 @@
 #include "update/impedance_file.hpp"
 
 #include <algorithm>
-#include <cctype>
 #include <cmath>
 #include <fstream>
-#include <sstream>
 #include <stdexcept>
+
+#include "dsp/impedance_files/read_any.hpp"
+#include "dsp/impedance_files/touchstone.hpp"
 
 namespace piezo::update {
 
@@ -15,11 +16,6 @@ std::ifstream open_in(const std::string& path, const char* fn) {
   std::ifstream in(path);
   if (!in) throw std::runtime_error(std::string(fn) + ": cannot open '" + path + "'");
   return in;
-}
-
-std::string lower(std::string s) {
-  for (auto& ch : s) ch = static_cast<char>(std::tolower(static_cast<unsigned char>(ch)));
-  return s;
 }
 
 void check_curve(const ImpedanceCurve& c, const std::string& path, const char* fn) {
@@ -39,22 +35,14 @@ void check_curve(const ImpedanceCurve& c, const std::string& path, const char* f
   }
 }
 
-bool parse_numbers(const std::string& line, char sep, std::vector<double>& out) {
-  out.clear();
-  std::string item;
-  std::stringstream ss(line);
-  while (sep == ' ' ? static_cast<bool>(ss >> item)
-                    : static_cast<bool>(std::getline(ss, item, sep))) {
-    std::size_t used = 0;
-    try {
-      out.push_back(std::stod(item, &used));
-    } catch (const std::exception&) {
-      return false;
-    }
-    while (used < item.size() && std::isspace(static_cast<unsigned char>(item[used]))) ++used;
-    if (used != item.size()) return false;
-  }
-  return true;
+// The dsp readers check what a file can hold (finite, ascending); check_curve
+// adds what the features need (5 points, finite |Z|).
+ImpedanceCurve from_dsp(dsp::ImportedImpedance&& d, const std::string& path, const char* fn) {
+  ImpedanceCurve c;
+  c.f_hz = std::move(d.f_hz);
+  c.z_ohm = std::move(d.z_ohm);
+  check_curve(c, path, fn);
+  return c;
 }
 
 // Vertex of the parabola through (x0,y0), (x1,y1), (x2,y2) (non-uniform spacing).
@@ -76,32 +64,7 @@ ImpedanceCurve read_impedance_csv(const std::string& path) {
 }
 
 ImpedanceCurve parse_impedance_csv(std::istream& in, const std::string& path) {
-  const char* fn = "read_impedance_csv";
-  ImpedanceCurve c;
-  std::string line;
-  std::vector<double> v;
-  int lineno = 0;
-  bool header_seen = false;
-  while (std::getline(in, line)) {
-    ++lineno;
-    if (!line.empty() && line.back() == '\r') line.pop_back();
-    if (line.empty() || line[0] == '#') continue;
-    if (!parse_numbers(line, ',', v)) {
-      if (!header_seen && c.f_hz.empty()) {
-        header_seen = true;  // one header line is allowed
-        continue;
-      }
-      throw std::invalid_argument(std::string(fn) + ": line " + std::to_string(lineno) +
-                                  " is not f_hz,re_ohm,im_ohm");
-    }
-    if (v.size() < 3)  // further columns (the uncertainty band of `impedance --csv`) are not needed here
-      throw std::invalid_argument(std::string(fn) + ": line " + std::to_string(lineno) +
-                                  " needs 3 columns f_hz,re_ohm,im_ohm");
-    c.f_hz.push_back(v[0]);
-    c.z_ohm.emplace_back(v[1], v[2]);
-  }
-  check_curve(c, path, fn);
-  return c;
+  return from_dsp(dsp::read_impedance_any(in, path), path, "read_impedance_csv");
 }
 
 ImpedanceCurve read_touchstone_s1p(const std::string& path) {
@@ -110,70 +73,12 @@ ImpedanceCurve read_touchstone_s1p(const std::string& path) {
 }
 
 ImpedanceCurve parse_touchstone_s1p(std::istream& in, const std::string& path) {
-  const char* fn = "read_touchstone_s1p";
-  double unit = 1e9, z0 = 50;
-  std::string param = "s", format = "ma";
-  bool option_seen = false;
-  ImpedanceCurve c;
-  std::string line;
-  std::vector<double> v;
-  int lineno = 0;
-  while (std::getline(in, line)) {
-    ++lineno;
-    if (auto bang = line.find('!'); bang != std::string::npos) line.resize(bang);
-    if (line.find_first_not_of(" \t\r") == std::string::npos) continue;
-    if (line.find_first_not_of(" \t") != std::string::npos &&
-        line[line.find_first_not_of(" \t")] == '#') {
-      if (option_seen) continue;  // only the first option line counts
-      option_seen = true;
-      std::stringstream ss(line.substr(line.find('#') + 1));
-      std::string tok;
-      while (ss >> tok) {
-        tok = lower(tok);
-        if (tok == "hz")
-          unit = 1;
-        else if (tok == "khz")
-          unit = 1e3;
-        else if (tok == "mhz")
-          unit = 1e6;
-        else if (tok == "ghz")
-          unit = 1e9;
-        else if (tok == "s" || tok == "z")
-          param = tok;
-        else if (tok == "ri" || tok == "ma" || tok == "db")
-          format = tok;
-        else if (tok == "r") {
-          if (!(ss >> z0) || !(z0 > 0))
-            throw std::invalid_argument(std::string(fn) + ": bad reference impedance");
-        } else
-          throw std::invalid_argument(std::string(fn) + ": unsupported option '" + tok +
-                                      "' (one-port S or Z only)");
-      }
-      continue;
-    }
-    if (!parse_numbers(line, ' ', v) || v.size() != 3)
-      throw std::invalid_argument(std::string(fn) + ": line " + std::to_string(lineno) +
-                                  " is not 'f a b' of a one-port file");
-    std::complex<double> x;
-    if (format == "ri")
-      x = {v[1], v[2]};
-    else {
-      const double mag = format == "ma" ? v[1] : std::pow(10.0, v[1] / 20.0);
-      x = std::polar(mag, v[2] * M_PI / 180.0);
-    }
-    std::complex<double> z = param == "z" ? x * z0 : z0 * (1.0 + x) / (1.0 - x);
-    c.f_hz.push_back(v[0] * unit);
-    c.z_ohm.push_back(z);
-  }
-  check_curve(c, path, fn);
-  return c;
+  return from_dsp(dsp::read_touchstone(in, path), path, "read_touchstone_s1p");
 }
 
 ImpedanceCurve read_impedance_file(const std::string& path) {
-  const auto dot = path.rfind('.');
-  if (dot != std::string::npos && lower(path.substr(dot)) == ".s1p")
-    return read_touchstone_s1p(path);
-  return read_impedance_csv(path);
+  auto in = open_in(path, "read_impedance_file");
+  return from_dsp(dsp::read_impedance_any(in, path), path, "read_impedance_file");
 }
 
 void write_impedance_csv(const std::string& path, const ImpedanceCurve& c) {

@@ -3,8 +3,10 @@
 // needs from them (seed §6.4.1): resonances = |Z| minima, anti-resonances =
 // |Z| maxima (each refined below the grid by a parabola through the three
 // samples around it, in dB), and |Z| at one frequency in the capacitive region.
-//   CSV:        f_hz,re_ohm,im_ohm   (header line and '#' comments allowed)
-//   Touchstone: .s1p, option line "# <Hz|kHz|MHz|GHz> <S|Z> <RI|MA|DB> R <Z0>"
+// The readers are dsp/impedance_files/ (read_any.hpp): Touchstone 1.x/2.0 one-port
+// (S, Z or Y), HP 4294A text, Keysight E4990A CSV, Bode 100 CSV and any table
+// with a header (f_hz,re_ohm,im_ohm and the rest); the format is found from the
+// content. Here a curve must also have at least 5 points.
 #include <complex>
 #include <istream>
 #include <string>
@@ -20,12 +22,14 @@ struct ImpedanceCurve {
 };
 
 // Throw std::invalid_argument (bad content) or std::runtime_error (cannot open).
+// read_impedance_csv and read_impedance_file read any format (detected from the
+// content); read_touchstone_s1p insists on Touchstone.
 ImpedanceCurve read_impedance_csv(const std::string& path);
 ImpedanceCurve read_touchstone_s1p(const std::string& path);
 // The same from a stream; `name` stands for the file in messages.
 ImpedanceCurve parse_impedance_csv(std::istream& in, const std::string& name);
 ImpedanceCurve parse_touchstone_s1p(std::istream& in, const std::string& name);
-ImpedanceCurve read_impedance_file(const std::string& path);  // by extension (.s1p, else CSV)
+ImpedanceCurve read_impedance_file(const std::string& path);
 void write_impedance_csv(const std::string& path, const ImpedanceCurve& c);
 
 struct FeatureOptions {

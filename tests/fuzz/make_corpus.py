@@ -5,7 +5,8 @@ Deterministic (fixed seeds); run from anywhere:
     /usr/bin/python3 tests/fuzz/make_corpus.py
 Small valid inputs, a few KB each: instrument byte streams and replies, the
 README's plan and one per excitation, CSV and Touchstone impedance files of a
-Butterworth-Van Dyke resonator, and capture recipes (fuzz_capture reads its
+Butterworth-Van Dyke resonator (and the same in every format dsp/impedance_files
+reads), and capture recipes (fuzz_capture reads its
 input as decisions; a zero byte is always the ordinary valid choice, so the
 empty recipe is a valid one-shot capture and sparse recipes are mostly valid).
 """
@@ -129,6 +130,144 @@ impedance = {
     "minimal.csv": "1,1,-1\n2,1,-0.5\n3,1,-0.3\n4,1,-0.2\n5,1,-0.1\n",
 }
 
+# ---------------------------------------------------------------- impedance file readers
+# Seeds of fuzz_touchstone, fuzz_hp4294a, fuzz_e4990a, fuzz_bode100 and
+# fuzz_impedance_table (dsp/impedance_files/): the BVD above in each format,
+# 10-20 points each (under libFuzzer's 4 KB), plus a cut of a real 4294A file.
+few = [40000.0 + 1000.0 * k for k in range(0, 21, 2)]  # 40..60 kHz, resonance at 50 kHz
+
+
+def ts_value(z, param, form, r, v2):
+    x = (z - r) / (z + r) if param == "S" else z if param == "Z" else 1 / z
+    if not v2 and param == "Z":
+        x /= r
+    if not v2 and param == "Y":
+        x *= r
+    if form == "RI":
+        return f"{x.real:.9g} {x.imag:.9g}"
+    mag = abs(x) if form == "MA" else 20 * math.log10(abs(x))
+    return f"{mag:.9g} {math.degrees(cmath.phase(x)):.9g}"
+
+
+touchstone = {
+    "v1_s_ma.s1p": "! VNA one port\n# kHz S MA R 50\n" + "".join(
+        f"{f / 1e3:.6g} {ts_value(bvd(f), 'S', 'MA', 50, False)}\n" for f in few),
+    "v1_y_db.s1p": "# Hz Y DB R 75 ! normalized admittance\n" + "".join(
+        f"{f:.6g}\t{ts_value(bvd(f), 'Y', 'DB', 75, False)}\n" for f in few),
+    "v1_z_ri.s1p": "# MHz Z RI R 1\n" + "".join(
+        f"  {f / 1e6:.9g}  {ts_value(bvd(f), 'Z', 'RI', 1, False)}\n" for f in few),
+    "v2_s_db.ts": f"[Version] 2.0\n# GHz S DB R 50\n[Number of Ports] 1\n[Number of Frequencies] {len(few)}\n"
+                  "[Reference]\n75\n[Begin Information]\nanything\n[End Information]\n[Network Data]\n" + "".join(
+        f"{f / 1e9:.9g} {ts_value(bvd(f), 'S', 'DB', 75, True)}\n" for f in few) + "[End]\n",
+    "v2_y_ri.ts": f"[Version] 2.0\n# Hz Y RI R 50\n[Number of Ports] 1\n[Two-Port Data Order] 12_21\n"
+                  f"[Number of Frequencies] {len(few)}\n[Matrix Format] Full\n[Network Data]\n" + "".join(
+        f"{f:.9g}\n  {ts_value(bvd(f), 'Y', 'RI', 50, True)} ! split\n" for f in few) + "[End]\n",
+    "no_option.s1p": "".join(f"{f / 1e9:.6g} {ts_value(bvd(f), 'S', 'MA', 50, False)}\n" for f in few[:5]),
+}
+
+
+def hp4294a(parameter, first, second, memory=False, n=None):
+    fs = few if n is None else few[:n]
+    s = (f'4294A REV1.11\n"DATE:     52 -100"\n\n\n"MEASURE PARAMETER: {parameter}"\n"ADAPTER: 7mm"\n'
+         f'"SWEEP TYPE: LOG FREQ"\n"NUMBER of POINTS: {len(fs)}"\n"BW: 5"\n\n\n')
+    for name, value in (("A", first), ("B", second)):
+        s += f'"TRACE: {name}"\n"FORMAT: LOG"\n\n"Frequency"\t"Data Trace Real"\t"Data Trace Imag"'
+        s += '\t"Memory Trace Real"\t"Memory Trace Imag"\n' if memory else "\n"
+        for f in fs:
+            s += f"{f:.11e}\t{value(f, bvd(f)):.6e}\t{0.0:.6e}"
+            s += f"\t{1.0:.6e}\t{0.0:.6e}\n" if memory else "\n"
+        s += "\n\n"
+    return s
+
+
+def real_cut(path, rows):
+    """The settings of a real 4294A file and its first rows of each trace."""
+    out, kept, trace = [], 0, None
+    for line in open(path).read().split("\n"):
+        if line.startswith('"NUMBER of POINTS'):
+            line = f'"NUMBER of POINTS: {rows}"'
+        if line.startswith('"TRACE:'):
+            trace, kept = line, 0
+        if trace and line[:1].isdigit():
+            kept += 1
+            if kept > rows:
+                continue
+        out.append(line)
+    return "\n".join(out)
+
+
+FIXTURES = os.path.join(HERE, "..", "..", "fixtures", "eqcirc3")
+hp4294a_files = {
+    "z_mag_phase.txt": hp4294a("IMPEDANCE MAG PHASE (DEG)", lambda f, z: abs(z),
+                               lambda f, z: math.degrees(cmath.phase(z))),
+    "y_mag_phase_memory.txt": hp4294a("ADMITTANCE MAG PHASE (DEG)", lambda f, z: 1 / abs(z),
+                                      lambda f, z: -math.degrees(cmath.phase(z)), memory=True),
+    "r_x.txt": hp4294a("R-X", lambda f, z: z.real, lambda f, z: z.imag, n=6),
+    "cp_d.txt": hp4294a("CP-D", lambda f, z: (1 / z).imag / (2 * math.pi * f),
+                        lambda f, z: (1 / z).real / abs((1 / z).imag), n=6),
+    "md1_cut.txt": real_cut(os.path.join(FIXTURES, "MD1.txt"), 8),
+    "rb5100_cut.txt": real_cut(os.path.join(FIXTURES, "RB5100.txt"), 6),
+}
+
+
+def e4990a(header, row, instrument="!Agilent Technologies,E4990A,MY521012345,A.02.10\n", extra=""):
+    s = instrument + "!Date: Fri Apr 03 13:41:16 2015\nBEGIN CH1_DATA\n" + extra + header + "\n"
+    s += "".join(row(f, bvd(f)) + "\n" for f in few) + "END\n"
+    return s
+
+
+e4990a_files = {
+    "z_theta.csv": e4990a("Frequency(Hz), |Z|(Ohm)-data, theta-z(deg)-data, theta-z(deg)-mem",
+                          lambda f, z: f"{f:+.11e}, {abs(z):+.11e}, {math.degrees(cmath.phase(z)):+.11e}, +1.0e+000",
+                          extra="Title label, TEST DATA\nDCV(V), +5.230e-005, DCI(A), +2.335e-005\n")
+                   + "BEGIN CH2_DATA\nFrequency(Hz), Z-Real(Ohm)-data, Z-Imag(Ohm)-data\n+1e+006, +1, +2\nEND\n",
+    "r_x.csv": e4990a("Frequency(Hz), R(Ohm)-data, X(Ohm)-data",
+                      lambda f, z: f"{f:+.11e}, {z.real:+.11e}, {z.imag:+.11e}"),
+    "cp_d.csv": e4990a("Frequency(Hz), Cp(F)-data, D()-data",
+                       lambda f, z: f"{f:+.6e}, {(1 / z).imag / (2 * math.pi * f):+.6e}, "
+                                    f"{(1 / z).real / abs((1 / z).imag):+.6e}"),
+    "decimal_comma.csv": e4990a("Frequency(Hz), |Z|(Ohm)-data, theta-z(deg)-data",
+                                lambda f, z: f"{f:+.6e},{abs(z):+.6e},{math.degrees(cmath.phase(z)):+.6e}".replace(".", ",")),
+    "pna_s11.csv": e4990a("Freq(Hz),S11(REAL),S11(IMAG)",
+                          lambda f, z: f"{f:.9g},{s11(bvd(f)).real:.9g},{s11(bvd(f)).imag:.9g}",
+                          instrument="!CSV A.01.01\n!Keysight Technologies,E5061B,MY1,A.03\n"),
+}
+
+OHM, DEG = "\u2126", "\u00b0"
+bode100 = {
+    "real_imag.csv": ("\ufeffFrequency (Hz);Trace 1: Impedance: Real (" + OHM + ");Trace 1: Impedance: Imaginary ("
+                      + OHM + ");Trace 1: Impedance: Real (" + OHM + ")\r\n" + "".join(
+                          f"{f:.10g};{bvd(f).real:.15g};{bvd(f).imag:.15g};{bvd(f).real:.15g}\r\n" for f in few) + "\r\n"),
+    "mag_phase_comma.csv": ("Frequency (Hz);Trace 1: Impedance: Magnitude (\u03a9);Trace 2: Impedance: Phase (" + DEG
+                            + ")\n" + "".join(f"{f:.10g};{abs(bvd(f)):.12g};{math.degrees(cmath.phase(bvd(f))):.12g}\n"
+                                              .replace(".", ",") for f in few)),
+    "admittance.csv": ("Frequency (Hz),Trace 1: Admittance: Magnitude (S),Trace 2: Admittance: Phase (" + DEG + ")\n"
+                       + "".join(f"{f:.10g},{1 / abs(bvd(f)):.12g},{-math.degrees(cmath.phase(bvd(f))):.12g}\n"
+                                 for f in few)),
+    "gain.csv": "Frequency (Hz);Trace 1: Gain: Magnitude (dB);Trace 1: Gain: Phase (" + DEG + ")\n1000;-3;45\n2000;-6;60\n",
+}
+
+table = {
+    "f_re_im.csv": "f_hz,re_ohm,im_ohm\n" + "".join(f"{f:.10g},{bvd(f).real:.10g},{bvd(f).imag:.10g}\n" for f in few),
+    "band.csv": "f_hz,re_ohm,im_ohm,abs_ohm,abs_sigma_ohm,phase_deg,phase_sigma_deg,coverage_factor\n" + "".join(
+        f"{f:.10g},{bvd(f).real:.10g},{bvd(f).imag:.10g},{abs(bvd(f)):.10g},{abs(bvd(f)) * 1e-3:.6g},"
+        f"{math.degrees(cmath.phase(bvd(f))):.8g},0.05,1.96\n" for f in few[:6]),
+    "khz_kohm_deg.csv": "Frequency (kHz),|Z| (kOhm),Phase (deg)\n" + "".join(
+        f"{f / 1e3:.9g},{abs(bvd(f)) / 1e3:.9g},{math.degrees(cmath.phase(bvd(f))):.9g}\n" for f in few),
+    "g_b_tab.tsv": "f [MHz]\tG [mS]\tB [mS]\n" + "".join(
+        f"{f / 1e6:.9g}\t{(1 / bvd(f)).real * 1e3:.9g}\t{(1 / bvd(f)).imag * 1e3:.9g}\n" for f in few),
+    "spaces_rad.txt": "# sweep\nFrequency (Hz)   |Y| (uS)   Phase (rad)\n" + "".join(
+        f"{f:.9g}   {1e6 / abs(bvd(f)):.9g}   {-cmath.phase(bvd(f)):.9g}\n" for f in few),
+    "semicolon_comma.csv": "freq;R (Ohm);X (Ohm)\n" + "".join(
+        f"{f:.9g};{bvd(f).real:.9g};{bvd(f).imag:.9g}\n".replace(".", ",") for f in few),
+    "db.csv": "f_hz,Z_dB,phase_deg\n" + "".join(
+        f"{f:.9g},{20 * math.log10(abs(bvd(f))):.9g},{math.degrees(cmath.phase(bvd(f))):.9g}\n" for f in few),
+    "comment_header.csv": "! CMT S2VNA\n! Stimulus(Hz), Re(S11), Im(S11)\n" + "".join(
+        f"{f:.9g}, {s11(bvd(f)).real:.9g}, {s11(bvd(f)).imag:.9g}\n" for f in few[:5]),
+    "headerless.csv": "1,1,-1\n2,1,-0.5\n3,1,-0.3\n",
+}
+
+
 # ---------------------------------------------------------------- capture
 def recipes():
     rng = random.Random(16)
@@ -153,6 +292,10 @@ def main():
         write("impedance_file", name, data)
     for name, data in recipes().items():
         write("capture", name, data)
+    for harness, files in (("touchstone", touchstone), ("hp4294a", hp4294a_files), ("e4990a", e4990a_files),
+                           ("bode100", bode100), ("impedance_table", table)):
+        for name, data in files.items():
+            write(harness, name, data)
 
 
 if __name__ == "__main__":

@@ -77,6 +77,16 @@ TEST(ImpedanceFile, TouchstoneFormats) {
   fs::remove(p);
 }
 
+// Every format of dsp/impedance_files/ reaches the updater: a real 4294A export.
+// Its sweep (74-316 kHz) has no capacitive point below 5 % of the first
+// resonance, so extract_features refuses it, naming that.
+TEST(ImpedanceFile, AnalyzerExportThroughTheDspReaders) {
+  const auto c = read_impedance_file(PIEZO_SOURCE_DIR "/fixtures/eqcirc3/RB5100.txt");
+  EXPECT_EQ(c.f_hz.size(), 601u);
+  EXPECT_DOUBLE_EQ(c.f_hz.front(), 74000.0);
+  EXPECT_THROW(extract_features(c), std::invalid_argument);
+}
+
 class FileUpdate : public test::TubeFixture {
  protected:
 };

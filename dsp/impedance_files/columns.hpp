@@ -1,0 +1,32 @@
+#pragma once
+// The meaning of one column header of an impedance table, from its words and
+// its unit: "f_hz", "Frequency(Hz)", "Frequency (Hz)", "|Z|(Ohm)-data",
+// "theta-z(deg)-data", "Trace 1: Impedance: Real (Ω)", "re_ohm", "G (mS)",
+// "Phase [rad]", "Cp(F)-data", "S11(REAL)", "abs_sigma_ohm", ...
+//   units:  Hz kHz MHz GHz (any case); Ω/ohm with m k M G prefixes (mΩ milli,
+//           MΩ mega); S with m u µ n p prefixes; deg ° rad; dB; H and F with
+//           prefixes; U or () for a pure number.
+//   ignored: memory traces ("-mem", "Memory"), quantities that are not an
+//           impedance (gain, S21, return loss, voltage, current, ...), and
+//           names that say nothing we know.
+#include <string>
+#include <string_view>
+
+#include "dsp/impedance_files/quantities.hpp"
+
+namespace piezo::dsp::zfiles {
+
+enum class Role { Ignored, Frequency, Value, SigmaMag, SigmaPhase, Coverage };
+
+struct ColumnMeaning {
+  Role role = Role::Ignored;
+  Quantity quantity = Quantity::Unknown;  // Unknown: fits a partner of either
+  Part part = Part::None;
+  double scale = 1.0;       // file unit -> Hz, ohm, S, rad, H, F (dB values stay dB)
+  bool unit_given = false;  // false: Hz, ohm/S, degrees assumed
+  std::string why;          // why a column is ignored
+};
+
+ColumnMeaning classify_column(std::string_view header);
+
+}  // namespace piezo::dsp::zfiles

@@ -1,0 +1,47 @@
+#pragma once
+// Any delimited table of an impedance sweep with a header line: a frequency
+// column and a pair of columns of Z, Y or S11 (columns.hpp names them), read
+// whatever the tool that wrote it:
+//   separators  ',' ';' tab or blanks (found from the header and first row);
+//               decimal commas with ';', tab or blank separators, and the
+//               "+1,5e+006,+2,0e+002" of a comma-locale instrument (every
+//               field split in two: twice the header's columns)
+//   lines       blank lines anywhere; '#' and '!' comments; text before the
+//               header (titles, settings) skipped with a note; a header in the
+//               last comment line before the data ("! Stimulus(Hz), ...") when
+//               there is no other; no header at all: f_hz, re_ohm, im_ohm
+//   columns     the first usable pair, in this order: Z real/imaginary,
+//               |Z|/phase (linear or dB), Y real/imaginary, |Y|/phase, S11,
+//               series Ls/Cs with Rs/D/Q, parallel Cp/Lp with G/Rp/D/Q; the
+//               uncertainty band of dsp/impedance_io (abs_sigma_ohm,
+//               phase_sigma_deg, coverage_factor) when present
+// Errors name the file, the line and what was found:
+//   "x.csv: no frequency column among [Freq2, Foo, Bar]"
+//   "x.csv: line 12: 2 columns, the header has 3"
+#include <istream>
+#include <string>
+#include <vector>
+
+#include "dsp/impedance_files/imported_impedance.hpp"
+#include "dsp/impedance_files/text.hpp"
+
+namespace piezo::dsp {
+
+ImportedImpedance read_impedance_table(std::istream& in, const std::string& name);
+
+namespace zfiles {
+
+struct TableOptions {
+  const char* fn = "read_impedance_table";  // names the reader in messages
+  ImpedanceFileFormat format = ImpedanceFileFormat::Table;
+  std::string format_name = "table";
+  bool allow_headerless = true;
+};
+
+// The table reader on lines already split (the E4990A reader hands it one
+// BEGIN ... END block, the Bode 100 reader the whole file).
+ImportedImpedance read_table(const std::vector<TextLine>& lines, const std::string& name,
+                             const TableOptions& opt);
+
+}  // namespace zfiles
+}  // namespace piezo::dsp
