@@ -262,6 +262,16 @@ void write_double_attr(hid_t obj, const char* name, double v) {
                              h5::last_error());
 }
 
+void write_double_array_attr(hid_t obj, const char* name, const std::vector<double>& v) {
+  const hsize_t n = v.size();
+  h5::Id space = h5::dataspace(H5Screate_simple(1, &n, nullptr));
+  h5::Id a = h5::attribute(
+      H5Acreate2(obj, name, H5T_IEEE_F64LE, space.get(), H5P_DEFAULT, H5P_DEFAULT));
+  if (!a || (n > 0 && H5Awrite(a.get(), H5T_NATIVE_DOUBLE, v.data()) < 0))
+    throw std::runtime_error(std::string("HDF5: cannot write attribute ") + name + ": " +
+                             h5::last_error());
+}
+
 void write_int_attr(hid_t obj, const char* name, std::int64_t v) {
   h5::Id space = h5::dataspace(H5Screate(H5S_SCALAR));
   h5::Id a =
@@ -494,8 +504,10 @@ std::string CaptureWriter::append(const Shot& shot) {
   return name;
 }
 
-void CaptureWriter::write_truth(const std::vector<std::pair<std::string, double>>& numbers,
-                                const std::vector<std::pair<std::string, std::string>>& strings) {
+void CaptureWriter::write_truth(
+    const std::vector<std::pair<std::string, double>>& numbers,
+    const std::vector<std::pair<std::string, std::string>>& strings,
+    const std::vector<std::pair<std::string, std::vector<double>>>& series) {
   if (impl_->closed) throw std::logic_error("CaptureWriter::write_truth: writer is closed");
   std::lock_guard lock(h5::h5_mutex());
   hid_t f = impl_->file.get();
@@ -510,6 +522,10 @@ void CaptureWriter::write_truth(const std::vector<std::pair<std::string, double>
   for (const auto& [k, v] : strings) {
     if (H5Aexists(g.get(), k.c_str()) > 0) H5Adelete(g.get(), k.c_str());
     write_string_attr(g.get(), k.c_str(), v);
+  }
+  for (const auto& [k, v] : series) {
+    if (H5Aexists(g.get(), k.c_str()) > 0) H5Adelete(g.get(), k.c_str());
+    write_double_array_attr(g.get(), k.c_str(), v);
   }
   g.reset();
   impl_->flush_to_disk();

@@ -49,8 +49,11 @@ class CaptureWriter {
 
   // Simulated captures only: ground truth under /truth, as attributes. No
   // estimator, updater or diagnosis reads it (the reader ignores the group).
+  // `series` are 1-D double attributes (one value per shot, e.g. the
+  // disturbances each shot got). A name written again replaces the old value.
   void write_truth(const std::vector<std::pair<std::string, double>>& numbers,
-                   const std::vector<std::pair<std::string, std::string>>& strings = {});
+                   const std::vector<std::pair<std::string, std::string>>& strings = {},
+                   const std::vector<std::pair<std::string, std::vector<double>>>& series = {});
 
   std::size_t shots_written() const;
   const std::filesystem::path& final_path() const;

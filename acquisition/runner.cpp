@@ -41,6 +41,10 @@ RunResult run_measurement(Bench& bench, const MeasurementPlan& plan, const std::
   wo.software = opt.software;
   wo.overwrite = opt.overwrite;
   CaptureWriter writer(out, plan.setup, wo);  // destroyed on any exit: keeps every written shot
+  // The simulated bench's disturbances (drivers/sim/disturbances.hpp): their
+  // settings go to /truth with the rest, what each shot got after each shot.
+  const bool disturbed = opt.record_truth && bench.sim && bench.sim->disturbances().any();
+  std::vector<drivers::sim::ShotDisturbances> applied;
   if (opt.record_truth && bench.sim) {
     auto numbers = bench.sim->physics().truth();
     const auto& imp = bench.sim->imperfections();
@@ -49,7 +53,16 @@ RunResult run_measurement(Bench& bench, const MeasurementPlan& plan, const std::
     numbers.emplace_back("noise_rel_v1", imp.noise_rel[0]);
     numbers.emplace_back("noise_rel_v2", imp.noise_rel[1]);
     numbers.emplace_back("seed", static_cast<double>(bench.sim->seed()));
-    writer.write_truth(numbers, {{"physics", bench.sim->physics().description()}});
+    std::vector<std::pair<std::string, std::string>> strings = {
+        {"physics", bench.sim->physics().description()}};
+    if (disturbed) {
+      const auto& d = bench.sim->disturbances();
+      for (auto& kv : drivers::sim::disturbance_truth(d, bench.sim->channel_offset_v(1),
+                                                      bench.sim->channel_offset_v(2)))
+        numbers.push_back(std::move(kv));
+      strings.emplace_back("disturbances", drivers::sim::to_string(d));
+    }
+    writer.write_truth(numbers, strings);
   }
 
   drivers::DaqConfig dc;
@@ -83,6 +96,8 @@ RunResult run_measurement(Bench& bench, const MeasurementPlan& plan, const std::
           break;
         }
         report("configure");
+        // The simulated bench's drift and step follow the capture's shots.
+        if (bench.sim) bench.sim->set_capture_position(k, res.shots_planned);
         if (!loaded) {
           bench.awg->load(w);
           loaded = true;
@@ -136,6 +151,10 @@ RunResult run_measurement(Bench& bench, const MeasurementPlan& plan, const std::
         report("write");
         writer.append(s);
         ++res.shots_written;
+        if (disturbed) {
+          applied.push_back(bench.sim->last_disturbances());
+          writer.write_truth({}, {}, drivers::sim::disturbance_series(applied));
+        }
         if (clipped) {
           res.clipped_shots.push_back(k);
           if (opt.stop_on_clipping) {

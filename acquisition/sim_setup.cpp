@@ -1,7 +1,9 @@
 #include "acquisition/sim_setup.hpp"
 
+#include <array>
 #include <cmath>
 #include <cstdio>
+#include <map>
 #include <stdexcept>
 
 #include "acquisition/divider_state_space.hpp"
@@ -14,12 +16,30 @@ namespace piezo::acq {
 namespace {
 
 // The FE tube reduced to its port, in the divider with the circuit effects.
+// The drift and step disturbances change the transducer's YE11, εT33 and d31
+// between shots: the port model is rebuilt by the same modal solve for the
+// scaled material (cached per distinct set of factors; a rebuild costs one
+// shift-invert Lanczos solve, ~0.1 s for the default mesh). Scaling follows
+// model/material_spec.cpp's overrides: YE11 scales sE11 and sE12 (ν12 kept;
+// the isotropic class scales its one Young's modulus), εT33 and d31 scale
+// themselves. The fixture, the parasitic branches and the device selection
+// stay as they are.
 class FePhysics : public drivers::sim::BenchPhysics {
  public:
-  FePhysics(const model::ModalPortModel& port, const BenchCircuit& circuit,
+  struct Transducer {  // what the port model is solved from
+    std::unique_ptr<model::TubeModel> tube;
+    std::unique_ptr<model::ModalSolver> solver;  // refers to *tube
+    model::PiezoMaterialD material;
+    bool isotropic = false;
+    model::ModalOptions options;
+  };
+
+  FePhysics(Transducer transducer, const model::ModalPortModel& port, const BenchCircuit& circuit,
             std::vector<std::pair<std::string, double>> truth, std::string description)
-      : port_(port), circuit_(circuit), ss_(port, circuit), truth_(std::move(truth)),
-        description_(std::move(description)) {}
+      : transducer_(std::move(transducer)), port_(port), circuit_(circuit), ss_(port, circuit),
+        truth_(std::move(truth)), description_(std::move(description)) {
+    ports_.emplace(key(factors_), port);
+  }
 
   std::vector<double> respond(const drivers::sim::PiecewiseLinear& v1,
                               std::span<const double> times) override {
@@ -36,15 +56,54 @@ class FePhysics : public drivers::sim::BenchPhysics {
     } catch (const std::exception& e) {
       return e.what();
     }
+    circuit_.dut = d;
+    return {};
+  }
+  std::string set_constant_factors(const drivers::sim::ConstantFactors& f) override {
+    if (f == factors_) return {};
+    try {
+      auto it = ports_.find(key(f));
+      if (it == ports_.end()) it = ports_.emplace(key(f), solve_port(f)).first;
+      ss_ = DividerStateSpace(it->second, circuit_);
+      port_ = it->second;
+      factors_ = f;
+    } catch (const std::exception& e) {
+      return std::string("the transducer's constants scaled by YE11 ") + std::to_string(f.y_e11) +
+             ", epsT33 " + std::to_string(f.eps_t33) + ", d31 " + std::to_string(f.d31) + ": " +
+             e.what();
+    }
     return {};
   }
 
  private:
-  model::ModalPortModel port_;
+  using Key = std::array<double, 3>;
+  static Key key(const drivers::sim::ConstantFactors& f) { return {f.y_e11, f.eps_t33, f.d31}; }
+
+  model::ModalPortModel solve_port(const drivers::sim::ConstantFactors& f) {
+    model::PiezoMaterialD d = transducer_.material;
+    if (transducer_.isotropic) {
+      model::IsotropicPiezoParams ip = model::isotropic_params(d);
+      ip.y_e11 *= f.y_e11;
+      ip.eps_t33 *= f.eps_t33;
+      ip.d31 *= f.d31;
+      d = model::to_d_form(ip);
+    } else {
+      d.s_e11 /= f.y_e11;
+      d.s_e12 /= f.y_e11;
+      d.eps_t33 *= f.eps_t33;
+      d.d31 *= f.d31;
+    }
+    return transducer_.solver->port_model(model::to_e_form(d), transducer_.options);
+  }
+
+  Transducer transducer_;
+  model::ModalPortModel port_;  // the current constants'
   BenchCircuit circuit_;
   DividerStateSpace ss_;
   std::vector<std::pair<std::string, double>> truth_;
   std::string description_;
+  drivers::sim::ConstantFactors factors_;
+  std::map<Key, model::ModalPortModel> ports_;
 };
 
 }  // namespace
@@ -68,14 +127,17 @@ std::shared_ptr<drivers::sim::SimBench> make_sim_bench(const SimSpec& spec, doub
   model::TubeGeometry g = true_geometry(spec);
   g.density_kg_m3 = mat.density_kg_m3;
   g.validate();
-  model::TubeModel tube(g);
-  model::ModalSolver solver(tube);
-  model::ModalOptions mo;
+  FePhysics::Transducer tr;
+  tr.tube = std::make_unique<model::TubeModel>(g);
+  tr.solver = std::make_unique<model::ModalSolver>(*tr.tube);
+  tr.material = mat.d;
+  tr.isotropic = spec.isotropic;
+  model::ModalOptions& mo = tr.options;
   mo.n_modes = spec.modes;
   mo.end_mass_fraction = fx.mass_loading;  // end-face masses: M + f·ΔM (model/end_mass.hpp)
   mo.outer_surface_impedance = un.acoustic_impedance_pa_s_m;  // validated by port_model
   const auto e = model::to_e_form(mat.d);
-  model::ModalPortModel port = solver.port_model(e, mo);
+  model::ModalPortModel port = tr.solver->port_model(e, mo);
 
   BenchCircuit c;
   c.r1_ohm = nominal_r1_ohm * (1.0 + fx.r1_tolerance);
@@ -132,10 +194,11 @@ std::shared_ptr<drivers::sim::SimBench> make_sim_bench(const SimSpec& spec, doub
   imp.noise_v[0] = imp.noise_v[1] = spec.noise_v;
   imp.adc_bits = spec.adc_bits;
   auto physics = std::make_unique<FePhysics>(
-      port, c, std::move(truth),
+      std::move(tr), port, c, std::move(truth),
       "FE tube " + mat.description + ", " + std::to_string(static_cast<int>(port.modes.size())) +
           " modes" + what);
-  return std::make_shared<drivers::sim::SimBench>(std::move(physics), imp, spec.seed, spec.faults);
+  return std::make_shared<drivers::sim::SimBench>(std::move(physics), imp, spec.seed, spec.faults,
+                                                  spec.disturbances);
 }
 
 }  // namespace piezo::acq

@@ -1,7 +1,8 @@
 #pragma once
 // Builds the embedded simulated bench: a tube of a given material and
 // geometry (the FE model, reduced to its electrical port), the divider with
-// the catalogue's circuit effects, and a DAQ with its own imperfections.
+// the catalogue's circuit effects, a DAQ with its own imperfections, and
+// optionally a real bench's slow disturbances (drivers/sim/disturbances.hpp).
 #include <cstdint>
 #include <memory>
 #include <string>
@@ -54,6 +55,10 @@ struct SimSpec {
   drivers::sim::FaultPlan faults;
   int modes = 24;  // short-circuit modes kept in the port model
   UnmodelledEffects unmodelled;  // issue 21: causes outside the catalogue (simulator only)
+  // Issue 33: offsets, mains hum, pink noise, drift and step of the tube's
+  // constants, trigger jitter (parse_disturbances reads the option string).
+  // All off by default, and off the bench is as it was, sample for sample.
+  drivers::sim::Disturbances disturbances;
 };
 
 // The tube the simulated bench really has: SimSpec::geometry with the

@@ -28,6 +28,15 @@ struct DutSelection {
   double load_parallel_f = 0.0;  // Load: its parallel capacitance (>= 0)
 };
 
+// Multipliers of the transducer's YE11, εT33 and d31 against their nominal
+// values: the drift and step disturbances (drivers/sim/disturbances.hpp).
+struct ConstantFactors {
+  double y_e11 = 1.0;
+  double eps_t33 = 1.0;
+  double d31 = 1.0;
+  bool operator==(const ConstantFactors&) const = default;
+};
+
 class BenchPhysics {
  public:
   virtual ~BenchPhysics() = default;
@@ -39,6 +48,12 @@ class BenchPhysics {
   virtual std::string description() const = 0;
   // Swaps the device at the terminals. Returns "" on success, else why not.
   virtual std::string select_dut(const DutSelection&) { return "this simulated bench cannot swap its device"; }
+  // Changes the transducer's constants (all factors 1: the nominal
+  // transducer); the device at the terminals stays selected. Returns "" on
+  // success, else why not.
+  virtual std::string set_constant_factors(const ConstantFactors&) {
+    return "this simulated bench cannot change its transducer's constants";
+  }
 };
 
 }  // namespace piezo::drivers::sim

@@ -3,15 +3,42 @@
 #include <algorithm>
 #include <cmath>
 #include <numeric>
+#include <stdexcept>
 
 namespace piezo::drivers::sim {
 
 SimBench::SimBench(std::unique_ptr<BenchPhysics> physics, DaqImperfections daq, std::uint64_t seed,
-                   FaultPlan faults)
-    : physics_(std::move(physics)), imp_(daq), seed_(seed), rng_(seed), faults_(faults) {
+                   FaultPlan faults, Disturbances disturbances)
+    : physics_(std::move(physics)), imp_(daq), seed_(seed), rng_(seed), faults_(faults),
+      dist_(disturbances), dist_rng_(seed ^ 0xD1B54A32D192ED03ull) {
   if (!physics_) throw std::invalid_argument("SimBench: null physics");
   if (imp_.adc_bits < 4 || imp_.adc_bits > 16)
     throw std::invalid_argument("SimBench: adc_bits must be 4..16");
+  dist_.validate();
+  if (dist_.offset_v > 0) {  // once per bench: a scope's offset is the same for every shot
+    std::uniform_real_distribution<double> magnitude(0.5, 1.0), unit(0.0, 1.0);
+    for (double& o : offset_v_) {
+      const double m = magnitude(dist_rng_) * dist_.offset_v;
+      o = unit(dist_rng_) < 0.5 ? -m : m;
+    }
+  }
+  if (dist_.changes_dut()) {
+    const std::string why = physics_->set_constant_factors(ConstantFactors{});
+    if (!why.empty()) throw std::invalid_argument("SimBench: drift/step disturbances: " + why);
+  }
+}
+
+void SimBench::set_capture_position(int shot, int shots) {
+  if (shot < 0 || shots < 1 || shot >= shots)
+    throw std::invalid_argument("SimBench::set_capture_position: need 0 <= shot < shots");
+  std::lock_guard lock(mu_);
+  capture_shot_ = shot;
+  capture_shots_ = shots;
+}
+
+ShotDisturbances SimBench::last_disturbances() {
+  std::lock_guard lock(mu_);
+  return last_;
 }
 
 std::string SimBench::select_dut(const DutSelection& d) {
@@ -69,11 +96,52 @@ PiecewiseLinear SimBench::generator_knots(double t_begin, double t_end) const {
   return w;
 }
 
+ShotDisturbances SimBench::draw_disturbances() {
+  ShotDisturbances sd;
+  sd.shot = capture_shot_ >= 0 ? capture_shot_ : acquisitions_;
+  if (!dist_.any()) return sd;
+  if (dist_.hum_v > 0) {
+    std::uniform_real_distribution<double> phase(0.0, 2.0 * M_PI);
+    for (double& p : sd.hum_phase_rad) p = phase(dist_rng_);
+  }
+  if (dist_.jitter_samples > 0) {
+    std::uniform_real_distribution<double> d(-dist_.jitter_samples, dist_.jitter_samples);
+    sd.jitter_samples = d(dist_rng_);
+  }
+  if (dist_.changes_dut()) {
+    sd.factors = constant_factors(dist_, sd.shot, capture_shot_ >= 0 ? capture_shots_ : 0);
+    if (!(sd.factors == factors_)) {
+      const std::string why = physics_->set_constant_factors(sd.factors);
+      if (!why.empty())
+        throw std::runtime_error("SimBench: shot " + std::to_string(sd.shot) + ": " + why);
+      factors_ = sd.factors;
+    }
+  }
+  return sd;
+}
+
+std::vector<double> SimBench::additive_disturbance(int ch, const ShotDisturbances& sd,
+                                                   const std::vector<double>& t, double clean_std) {
+  std::vector<double> a(t.size(), offset_v_[ch]);
+  if (dist_.hum_v > 0)
+    for (std::size_t k = 0; k < t.size(); ++k)
+      a[k] += dist_.hum_v * mains_waveform(t[k], dist_.mains_hz, sd.hum_phase_rad[ch]);
+  if (dist_.pink_rel > 0) {
+    const std::vector<double> p = pink_noise(t.size(), dist_rng_);
+    const double scale = dist_.pink_rel * clean_std;
+    for (std::size_t k = 0; k < t.size(); ++k) a[k] += scale * p[k];
+  }
+  return a;
+}
+
 void SimBench::fire() {
   if (!daq_.armed || !awg_.output_on) return;
   const std::size_t n = daq_.points;
   const double fs = daq_.sample_rate_hz;
-  const double t0 = daq_.position_s;  // time of sample 0 relative to the trigger
+  const ShotDisturbances sd = draw_disturbances();
+  // Time of sample 0 relative to the trigger; trigger jitter delays the record
+  // against the excitation by d samples: the DAQ samples d/fs earlier.
+  const double t0 = daq_.position_s - sd.jitter_samples / fs;
 
   // Channel 1 samples at t_k; channel 2 at t_k - skew (it records late).
   std::vector<double> t1(n), t2(n);
@@ -98,13 +166,25 @@ void SimBench::fire() {
     double mean = std::accumulate(x.begin(), x.end(), 0.0) / static_cast<double>(n);
     double var = 0;
     for (double s : x) var += (s - mean) * (s - mean);
-    double sigma = imp_.noise_rel[ch] * std::sqrt(var / static_cast<double>(n)) + imp_.noise_v[ch];
+    const double clean_std = std::sqrt(var / static_cast<double>(n));
+    double sigma = imp_.noise_rel[ch] * clean_std + imp_.noise_v[ch];
+    // Offset, hum and pink noise enter at the DAQ's input, before quantisation
+    // and clipping, on the nominal sampling instants (the hum's phase is
+    // random anyway).
+    std::vector<double> extra;
+    if (dist_.any()) {
+      std::vector<double> tn(n);
+      for (std::size_t k = 0; k < n; ++k) tn[k] = daq_.position_s + static_cast<double>(k) / fs;
+      extra = additive_disturbance(ch, sd, tn, clean_std);
+    }
     const double half_scale = 0.5 * daq_.full_scale_v[ch];
     const double lsb = half_scale / (max_code + 1.0);
     const double word_step = std::ldexp(1.0, 16 - bits);
     daq_.codes[ch].resize(n);
     for (std::size_t k = 0; k < n; ++k) {
-      double v = x[k] + (sigma > 0 ? sigma * gauss(rng_) : 0.0);
+      double v = x[k];
+      if (!extra.empty()) v += extra[k];
+      v += (sigma > 0 ? sigma * gauss(rng_) : 0.0);
       double code = std::clamp(std::round(v / lsb), -max_code - 1.0, max_code);  // range clipping
       daq_.codes[ch][k] = static_cast<std::int16_t>(code * word_step);
     }
@@ -112,6 +192,7 @@ void SimBench::fire() {
   }
   daq_.armed = false;
   daq_.done = true;
+  last_ = sd;
   ++acquisitions_;
 }
 

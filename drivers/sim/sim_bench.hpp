@@ -3,7 +3,9 @@
 // SCPI faces (sim_awg, sim_daq) only parse commands and update the state
 // here; acquire() turns a triggered burst into a DAQ record: physics for v2,
 // then the DAQ's own imperfections (channel skew and gain, white noise per
-// channel, ADC quantisation and range clipping), all seeded.
+// channel, ADC quantisation and range clipping), all seeded; optionally a
+// real bench's slow disturbances (drivers/sim/disturbances.hpp: offsets, hum,
+// pink noise, trigger jitter, drift and steps of the transducer's constants).
 #include <cstdint>
 #include <memory>
 #include <mutex>
@@ -12,6 +14,7 @@
 #include <vector>
 
 #include "drivers/sim/bench_physics.hpp"
+#include "drivers/sim/disturbances.hpp"
 
 namespace piezo::drivers::sim {
 
@@ -65,8 +68,10 @@ struct DaqState {
 
 class SimBench {
  public:
+  // Throws std::invalid_argument on invalid imperfections or disturbances, or
+  // when the disturbances change the device and the physics cannot.
   SimBench(std::unique_ptr<BenchPhysics> physics, DaqImperfections daq, std::uint64_t seed,
-           FaultPlan faults = {});
+           FaultPlan faults = {}, Disturbances disturbances = {});
 
   // Called by the AWG face on *TRG: runs one acquisition if the DAQ is armed.
   void fire();
@@ -86,9 +91,27 @@ class SimBench {
   const DaqImperfections& imperfections() const { return imp_; }
   std::uint64_t seed() const { return seed_; }
 
+  const Disturbances& disturbances() const { return dist_; }
+  // The DC offset of channel 1 or 2 (0 without the offset disturbance).
+  double channel_offset_v(int channel) const { return offset_v_[channel - 1]; }
+  // The capture's next acquisitions belong to shot `shot` (0-based) of
+  // `shots`: the drift and step disturbances follow the capture's shots (the
+  // runner calls this before each shot; unrecorded probe shots take the
+  // next shot's index). Never called: the acquisitions are counted, and no
+  // drift is applied (its N is unknown). Takes mutex().
+  void set_capture_position(int shot, int shots);
+  // What was applied to the latest acquisition (all zero/one before any).
+  ShotDisturbances last_disturbances();
+
  private:
   // The AWG output as knots, from `t_begin` (before the trigger) on.
   PiecewiseLinear generator_knots(double t_begin, double t_end) const;
+  // Draws this acquisition's disturbances and sets the physics' constants.
+  ShotDisturbances draw_disturbances();
+  // Offset + hum + pink noise of channel `ch` for samples at t_k (nominal
+  // instants), pink scaled to `clean_std`.
+  std::vector<double> additive_disturbance(int ch, const ShotDisturbances& sd,
+                                           const std::vector<double>& t, double clean_std);
 
   std::mutex mu_;
   std::unique_ptr<BenchPhysics> physics_;
@@ -96,6 +119,12 @@ class SimBench {
   std::uint64_t seed_;
   std::mt19937_64 rng_;
   FaultPlan faults_;
+  Disturbances dist_;
+  std::mt19937_64 dist_rng_;  // the disturbances' own stream: off leaves rng_'s draws as they were
+  double offset_v_[2] = {0.0, 0.0};
+  int capture_shot_ = -1, capture_shots_ = 0;  // set_capture_position (-1: not told)
+  ConstantFactors factors_;  // the physics' current constants
+  ShotDisturbances last_;
   AwgState awg_;
   DaqState daq_;
   int acquisitions_ = 0;
