@@ -51,11 +51,13 @@ double golden_min(const std::function<double(double)>& g, double a, double b, in
 double grid_min(const std::function<double(double)>& g, double a, double b, int n = 400) {
   if (!(b > a)) return kNaN;
   double best = a, gb = g(a);
+  int at = 0;
   for (int i = 1; i <= n; ++i) {
     const double x = a + (b - a) * i / n;
     const double gx = g(x);
-    if (gx < gb) gb = gx, best = x;
+    if (gx < gb) gb = gx, best = x, at = i;
   }
+  if (at == 0 || at == n) return kNaN;  // no extremum inside: a monotonic stretch (a weak mode)
   const double h = (b - a) / n;
   return golden_min(g, std::max(a, best - h), std::min(b, best + h));
 }
@@ -400,7 +402,7 @@ CircuitFit fit_equivalent_circuit(const Eigen::VectorXd& f, const Eigen::VectorX
   out.weighted = z_sigma.size() > 0;
   int negative = 0;
   for (Eigen::Index i = 0; i < n; ++i) negative += z[i].real() < 0;
-  out.magnitude_only = opt.magnitude_only || negative > n / 2;
+  out.magnitude_only = opt.magnitude_only || (opt.auto_magnitude_only && negative > n / 2);
   if (out.magnitude_only && !opt.magnitude_only)
     out.notes.push_back("Re Z < 0 at " + std::to_string(negative) + " of " + std::to_string(n) +
                         " points (not a passive part: the phase cannot be trusted): |Z| fitted alone");

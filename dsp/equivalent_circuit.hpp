@@ -83,6 +83,7 @@ struct CircuitFitOptions {
   // (a passive part with Re Z < 0). Set automatically when most points have
   // Re Z < 0.
   bool magnitude_only = false;
+  bool auto_magnitude_only = true;  // off for an estimate whose phase is defined (a capture's)
   int max_iterations = 200;
 };
 

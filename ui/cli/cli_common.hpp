@@ -67,5 +67,6 @@ void register_impedance_command(CLI::App& app, Context& ctx);
 void register_update_command(CLI::App& app, Context& ctx);
 void register_replay_commands(CLI::App& app, Context& ctx);
 void register_diagnose_command(CLI::App& app, Context& ctx);
+void register_figures_command(CLI::App& app, Context& ctx);
 
 }  // namespace piezo::cli

@@ -22,6 +22,7 @@ int main(int argc, char** argv) {
   register_update_command(app, ctx);
   register_replay_commands(app, ctx);
   register_diagnose_command(app, ctx);
+  register_figures_command(app, ctx);
   try {
     app.parse(argc, argv);
   } catch (const CLI::Success& e) {

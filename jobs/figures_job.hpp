@@ -1,0 +1,49 @@
+#pragma once
+// The jobs' room (jobs/): `piezobench figures` — per-mode figures an engineer
+// can trust (issue 34), from an impedance analyzer's or VNA's file (any
+// format of dsp/impedance_files) or from a capture (its FFT-ratio estimate
+// with the per-bin uncertainty, within the drive's band): the multi-mode
+// equivalent circuit of dsp/equivalent_circuit fitted to complex Z, each
+// figure with its σ (lack of fit included). ui/cli/cmd_figures.cpp parses the
+// options and prints.
+#include <Eigen/Core>
+#include <filesystem>
+#include <iosfwd>
+#include <nlohmann/json.hpp>
+#include <string>
+#include <vector>
+
+#include "dsp/equivalent_circuit.hpp"
+
+namespace piezo::jobs {
+
+struct FiguresRequest {
+  std::string file;
+  int max_modes = 12;         // branches at most
+  double band_lo_hz = 0;      // 0: the data's
+  double band_hi_hz = 0;      // 0: the data's (a capture: the estimate's band)
+  std::string method = "fft"; // a capture's estimator (fft, xspec, prony)
+};
+
+struct FiguresJobResult {
+  std::string source;     // "file", "capture"
+  std::string format;     // the file's format, or the capture's estimator
+  std::string quantity;   // what the numbers were
+  Eigen::VectorXd f_hz;
+  Eigen::VectorXcd z_ohm;
+  Eigen::VectorXd z_sigma_ohm;  // per point sqrt(E|δZ|²); empty when the data carry none
+  dsp::CircuitFit fit;
+  std::vector<std::string> notes;  // the reader's and the job's
+};
+
+// Throws InputError (jobs/job_error.hpp) for a file that is neither a capture
+// nor a readable impedance file, or a band with fewer than 8 points.
+FiguresJobResult run_figures(const FiguresRequest& req);
+
+nlohmann::json figures_json(const FiguresRequest& req, const FiguresJobResult& r);
+// One row per mode: mode, fs_hz, fs_sigma_hz, fp_hz, ... (value and σ columns).
+void write_figures_csv(std::ostream& os, const FiguresJobResult& r);
+// |Z| and phase of the data and the fitted network, fs/fp markers; PNG.
+void write_figures_plot(const FiguresJobResult& r, const std::filesystem::path& png);
+
+}  // namespace piezo::jobs

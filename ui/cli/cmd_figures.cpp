@@ -1,0 +1,113 @@
+// `piezobench figures FILE [--json|--csv] [--plot OUT.png] [--modes N] [--band LO:HI]`:
+// per-mode figures (fs, fp, fm, fn, fr, fa, k_eff in its IEEE 176 and EN 50324-2
+// forms, Qm two ways, R1 L1 C1, the misfit) with σ, from a capture or any
+// impedance analyzer's file. The CLI's room (ui/cli): options and printing only;
+// the work is jobs/figures_job.hpp.
+#include <algorithm>
+#include <cstdio>
+#include <iostream>
+#include <memory>
+
+#include "jobs/figures_job.hpp"
+#include "ui/cli/cli_common.hpp"
+
+namespace piezo::cli {
+
+namespace {
+
+struct FiguresArgs {
+  jobs::FiguresRequest req;
+  std::string band, plot;
+  bool csv = false;
+};
+
+void parse_band(const std::string& s, jobs::FiguresRequest& r) {
+  const auto colon = s.find(':');
+  try {
+    if (colon == std::string::npos) throw std::invalid_argument("no colon");
+    std::size_t used = 0;
+    r.band_lo_hz = std::stod(s.substr(0, colon), &used);
+    r.band_hi_hz = std::stod(s.substr(colon + 1), &used);
+  } catch (const std::exception&) {
+    throw InputError("--band: expected LO:HI in Hz, got '" + s + "'");
+  }
+}
+
+std::string pm(const nlohmann::json& f, const char* fmt_value) {
+  if (f["value"].is_null()) return "-";
+  char buf[96];
+  if (f["sigma"].is_null()) {
+    std::snprintf(buf, sizeof buf, fmt_value, f["value"].get<double>());
+    return buf;
+  }
+  char v[48], s[48];
+  std::snprintf(v, sizeof v, fmt_value, f["value"].get<double>());
+  std::snprintf(s, sizeof s, fmt_value, f["sigma"].get<double>());
+  return std::string(v) + " +/- " + s;
+}
+
+void print_text(const nlohmann::json& j) {
+  std::printf("%s\n  source          %s: %s (%s)\n", j["file"].get<std::string>().c_str(),
+              j["source"].get<std::string>().c_str(), j["format"].get<std::string>().c_str(),
+              j["quantity"].get<std::string>().c_str());
+  const auto& fit = j["fit"];
+  std::printf("  fit             %d points, %zu modes, %d parameters, chi2/dof %s, |Z| misfit %.3g %%%s\n",
+              j["points"].get<int>(), j["modes"].size(), fit["parameters"].get<int>(),
+              fit["chi2_per_dof"].is_null() ? "-" : std::to_string(fit["chi2_per_dof"].get<double>()).c_str(),
+              fit["misfit_abs_rel_rms"].get<double>() * 100, j["magnitude_only"].get<bool>() ? " (|Z| only)" : "");
+  const auto& c = j["circuit"];
+  std::printf("  C0              %s F, tan d %s, Rs %s ohm, C^T %s F\n", pm(c["c0_f"], "%.5g").c_str(),
+              pm(c["tan_delta"], "%.3g").c_str(), pm(c["rs_ohm"], "%.3g").c_str(),
+              pm(c["free_capacitance_f"], "%.5g").c_str());
+  for (const auto& m : j["modes"]) {
+    const double lo = std::max(m["window_hz"][0].is_null() ? 0.0 : m["window_hz"][0].get<double>(),
+                               j["band_hz"][0].get<double>());
+    const double hi = m["window_hz"][1].is_null() ? j["band_hz"][1].get<double>()
+                                                  : std::min(m["window_hz"][1].get<double>(), j["band_hz"][1].get<double>());
+    std::printf("\n  mode %d  (window %.6g-%.6g Hz, %d points, misfit %.3g %%)\n", m["mode"].get<int>(), lo, hi,
+                m["points"].get<int>(), m["misfit_rel_rms"].is_null() ? 0.0 : m["misfit_rel_rms"].get<double>() * 100);
+    std::printf("    fs %s Hz   fp %s Hz\n", pm(m["fs_hz"], "%.7g").c_str(), pm(m["fp_hz"], "%.7g").c_str());
+    std::printf("    fm %s Hz   fn %s Hz\n", pm(m["fm_hz"], "%.7g").c_str(), pm(m["fn_hz"], "%.7g").c_str());
+    std::printf("    fr %s Hz   fa %s Hz\n", pm(m["fr_hz"], "%.7g").c_str(), pm(m["fa_hz"], "%.7g").c_str());
+    std::printf("    k_eff %s (IEEE 176, fs/fp)   %s (EN 50324-2, fm/fn)\n", pm(m["k_eff_ieee176"], "%.4g").c_str(),
+                pm(m["k_eff_en50324"], "%.4g").c_str());
+    std::printf("    Qm %s (branch)   %s (bandwidth)\n", pm(m["qm_branch"], "%.4g").c_str(),
+                pm(m["qm_bandwidth"], "%.4g").c_str());
+    std::printf("    R1 %s ohm   L1 %s H   C1 %s F\n", pm(m["r1_ohm"], "%.5g").c_str(), pm(m["l1_h"], "%.5g").c_str(),
+                pm(m["c1_f"], "%.5g").c_str());
+  }
+  for (const auto& n : j["notes"]) std::printf("  note: %s\n", n.get<std::string>().c_str());
+}
+
+}  // namespace
+
+void register_figures_command(CLI::App& app, Context& ctx) {
+  auto a = std::make_shared<FiguresArgs>();
+  auto* cmd = app.add_subcommand(
+      "figures", "Per-mode figures with sigma from a capture (.h5) or an impedance file (Touchstone, 4294A, E4990A, Bode 100, CSV/TSV)");
+  cmd->add_option("FILE", a->req.file, "Capture (.h5) or impedance file")->required();
+  add_json_flag(cmd, ctx);
+  cmd->add_flag("--csv", a->csv, "One CSV row per mode (value and sigma columns)");
+  cmd->add_option("--plot", a->plot, "PNG of the data and the fitted network");
+  cmd->add_option("--modes", a->req.max_modes, "Modes (branches) at most")->capture_default_str();
+  cmd->add_option("--band", a->band, "Frequency band LO:HI in Hz (default: the data's; a capture: its estimate's)");
+  cmd->add_option("--method", a->req.method, "A capture's estimator: fft, xspec or prony")->capture_default_str();
+  cmd->callback([&ctx, a] {
+    ctx.exit_code = run_command(ctx, [&] {
+      if (!a->band.empty()) parse_band(a->band, a->req);
+      const auto r = jobs::run_figures(a->req);
+      if (!a->plot.empty()) jobs::write_figures_plot(r, a->plot);
+      if (a->csv) {
+        jobs::write_figures_csv(std::cout, r);
+        return;
+      }
+      const auto j = jobs::figures_json(a->req, r);
+      if (ctx.json)
+        print_json(j);
+      else
+        print_text(j);
+    });
+  });
+}
+
+}  // namespace piezo::cli
