@@ -4,6 +4,7 @@
 #include <filesystem>
 
 #include "acquisition/calibration_plan.hpp"
+#include "drivers/sim/disturbances.hpp"
 #include "model/effects.hpp"
 
 namespace piezo::jobs {
@@ -11,7 +12,6 @@ namespace piezo::jobs {
 PipelineRequest demo_pipeline_request(const DemoRequest& d) {
   namespace fs = std::filesystem;
   const DemoRequest* a = &d;
-  fs::create_directories(a->out_dir);
   PipelineRequest req;
   req.instrument = "sim";
   req.plan.setup.divider_r1_ohm = 3140.0;
@@ -27,6 +27,8 @@ PipelineRequest demo_pipeline_request(const DemoRequest& d) {
   req.sim.noise_rel = a->noise;
   req.sim.seed = a->seed;
   for (const auto& e : a->effects) model::apply_effect_assignment(req.sim.effects, e);
+  req.sim.disturbances =
+      drivers::sim::parse_disturbances(a->disturbances);  // also the held-out's bench
   req.diagnose = !a->no_diagnose;
   if (!a->no_calibrate && !a->calibrate.empty())
     req.calibration = acq::parse_calibration_list(a->calibrate, 1000.0);
@@ -41,6 +43,7 @@ PipelineRequest demo_pipeline_request(const DemoRequest& d) {
   req.material = "apc850";
   req.isotropic = true;
   req.compare_lm = true;  // the table shows oe, cmcm and lm
+  fs::create_directories(a->out_dir);  // last: bad input leaves nothing behind
   return req;
 }
 

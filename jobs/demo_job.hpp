@@ -20,6 +20,9 @@ struct DemoRequest {
   double noise = 0.005;
   std::uint64_t seed = 2016;
   std::vector<std::string> effects;  // NAME=VALUE, bench effects the simulated bench adds
+  // A real bench's slow disturbances, the option string of
+  // drivers::sim::parse_disturbances ("offset=V,hum=V,..."; "" = none).
+  std::string disturbances;
   bool no_diagnose = false;
   std::string calibrate = "open,short,load";
   bool no_calibrate = false;
@@ -27,7 +30,7 @@ struct DemoRequest {
 };
 
 // The pipeline's request of the demo (creates `out_dir`). Throws
-// std::invalid_argument for a bad effect or calibration list.
+// std::invalid_argument for a bad effect, disturbance string or calibration list.
 PipelineRequest demo_pipeline_request(const DemoRequest& req);
 
 PipelineResult run_demo(const DemoRequest& req, const std::function<void(const PipelineProgress&)>& progress,

@@ -2,6 +2,7 @@
 // export. Each hands its work to the Job or TaskQueue thread and returns at
 // once; outcomes come back into the AppState on the UI thread.
 #include "drivers/instrument_uri.hpp"
+#include "drivers/sim/disturbances.hpp"
 #include "jobs/bench_probe.hpp"
 #include "jobs/export/report_export.hpp"
 #include "jobs/nominal_material.hpp"
@@ -12,11 +13,13 @@
 namespace piezo::gui {
 
 namespace {
-// The simulated bench's spec with the panel's effects; throws std::invalid_argument
-// naming a bad item (jobs/sim_effects.hpp).
+// The simulated bench's spec with the panel's effects and disturbances; throws
+// std::invalid_argument naming a bad item (jobs/sim_effects.hpp).
 acq::SimSpec sim_spec(const AppState& s) {
   acq::SimSpec sim = s.request.sim;
   sim.effects = jobs::parse_sim_effects(s.instrument.sim_effects);  // "series_resistance=15, channel_skew=1e-7"
+  sim.disturbances =
+      drivers::sim::parse_disturbances(s.instrument.sim_disturbances);  // "offset=0.005,hum=0.005"
   return sim;
 }
 }  // namespace

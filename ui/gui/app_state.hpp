@@ -53,6 +53,9 @@ struct InstrumentForm {
   // Bench effects the simulated bench adds (NAME=VALUE, comma separated), so
   // that the gap diagnosis has something to find; see model/effects.hpp.
   char sim_effects[256] = "";
+  // A real bench's slow disturbances on the simulated bench, the option string
+  // of drivers::sim::parse_disturbances ("offset=0.005,hum=0.005,mains=50").
+  char sim_disturbances[256] = "";
   int driver_choice = 0;  // the driver combo's entry (ui/gui/driver_choices.hpp)
   // (The order is the frame statistics' numbering; tests/gui relies on it.)
   enum class State {

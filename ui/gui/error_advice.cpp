@@ -76,7 +76,9 @@ std::string advice_for(ErrorKind kind, const std::string& stage) {
         return "Use 'sim', tcp://HOST:PORT or usbtmc://VID:PID[/SERIAL] (a USB bench needs the "
                "DAQ's address too).";
       if (stage == "simulated effects")
-        return "Write effects as NAME=VALUE separated by commas, e.g. series_resistance=15.";
+        return "Write effects as NAME=VALUE separated by commas, e.g. series_resistance=15; "
+               "disturbances as "
+               "offset=V,hum=V,mains=50|60,pink=PCT,drift=PCT,step=PCT@SHOT,jitter=SAMPLES.";
       return "Correct the value named above in the plan and run again.";
     case ErrorKind::Other:
     case ErrorKind::Attention:

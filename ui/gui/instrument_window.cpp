@@ -99,6 +99,13 @@ void render_instrument_window(AppState& s) {
           "comma separated:\nseries_resistance, parallel_capacitance, daq_input_resistance, "
           "dielectric_loss,\nchannel_skew, channel_gain, r1_tolerance, mechanical_damping, "
           "mass_loading");
+    ImGui::InputTextWithHint("Disturbances", "e.g. offset=0.005,hum=0.005,mains=50",
+                             in.sim_disturbances, sizeof in.sim_disturbances);
+    if (ImGui::IsItemHovered())
+      ImGui::SetTooltip(
+          "A real bench's slow disturbances on the simulated bench, comma separated (any subset):\n"
+          "offset=V, hum=V, mains=50|60, pink=PCT, drift=PCT, step=PCT@SHOT, jitter=SAMPLES\n"
+          "(recorded in the capture's /truth; see acquisition/README.md)");
   }
   if (tracked_button(s, "Connect")) connect_instruments(s);
   ImGui::EndDisabled();

@@ -134,6 +134,7 @@ int main(int argc, char** argv) {
   CLI::App cli{"piezobench-gui — Measure and update", "piezobench-gui"};
   std::vector<std::string> clicks;
   std::string screenshot, stats_file, replay, replay_heldout, instrument = "sim", daq, sim_effects;
+  std::string sim_disturbances;
   std::vector<float> hover;
   bool wait_job = false;
   double timeout_s = 0;
@@ -143,6 +144,9 @@ int main(int argc, char** argv) {
   cli.add_option("--daq", daq, "DAQ address (default: tcp PORT+1; required for usbtmc)");
   cli.add_option("--sim-effects", sim_effects,
                  "Effects of the simulated bench, NAME=VALUE[,NAME=VALUE...]");
+  cli.add_option(
+      "--sim-disturbances", sim_disturbances,
+      "Slow disturbances of the simulated bench, offset=V,hum=V[,mains=50|60],pink=PCT,...");
   cli.add_option("--shots", shots, "Shots in the plan")->check(CLI::PositiveNumber);
   cli.add_option("--replay", replay, "Put this recorded capture in the plan panel for replay");
   cli.add_option("--replay-heldout", replay_heldout,
@@ -206,6 +210,8 @@ int main(int argc, char** argv) {
     std::snprintf(state.instrument.daq, sizeof state.instrument.daq, "%s", daq.c_str());
     std::snprintf(state.instrument.sim_effects, sizeof state.instrument.sim_effects, "%s",
                   sim_effects.c_str());
+    std::snprintf(state.instrument.sim_disturbances, sizeof state.instrument.sim_disturbances, "%s",
+                  sim_disturbances.c_str());
     std::snprintf(state.replay_path, sizeof state.replay_path, "%s", replay.c_str());
     std::snprintf(state.heldout_path, sizeof state.heldout_path, "%s", replay_heldout.c_str());
     std::snprintf(state.limits_path, sizeof state.limits_path, "%s", limits.c_str());
