@@ -9,6 +9,7 @@
 #include <stdexcept>
 
 #include "dsp/levenberg_marquardt.hpp"
+#include "dsp/mode_figures.hpp"
 
 namespace piezo::dsp {
 
@@ -472,6 +473,35 @@ CircuitFit fit_equivalent_circuit(const Eigen::VectorXd& f, const Eigen::VectorX
   };
 
   Trial best = run(c0, false);
+  // A second start: the per-mode BVD fits of dsp/mode_figures (each mode with
+  // the others as its background), when the phase is usable. The better start
+  // by the criterion goes on.
+  if (!out.magnitude_only) {
+    try {
+      const auto mf = mode_figures(f, z, z_sigma);
+      EquivalentCircuit c1 = c0;
+      c1.branches.clear();
+      double cb1 = 0;
+      for (const auto& m : mf.modes)
+        if (std::isfinite(m.r1_ohm.value) && std::isfinite(m.l1_h.value) && std::isfinite(m.c1_f.value) &&
+            m.r1_ohm.value > 0 && m.l1_h.value > 0 && m.c1_f.value > 0 &&
+            c1.branches.size() < static_cast<std::size_t>(opt.max_branches)) {
+          c1.branches.push_back({m.r1_ohm.value, m.l1_h.value, m.c1_f.value});
+          cb1 += m.c1_f.value;
+        }
+      if (!c1.branches.empty()) {
+        if (c1.c0_f > 2 * cb1) c1.c0_f = c0.c0_f + cb - cb1;
+        Trial alt = run(sorted(c1), false);
+        if (alt.bic < best.bic) {
+          out.notes.push_back("started from the per-mode BVD fits (information criterion " + fmt(best.bic, 6) +
+                              " from the conductance peaks, " + fmt(alt.bic, 6) + " from them)");
+          best = alt;
+        }
+      }
+    } catch (const std::invalid_argument&) {
+      // too few points or no mode found: the conductance peaks' start stands
+    }
+  }
   // Backward: drop branches that leave the band or whose removal lowers the criterion.
   for (bool changed = true; changed && best.lay.branches > 0;) {
     changed = false;
@@ -527,14 +557,13 @@ CircuitFit fit_equivalent_circuit(const Eigen::VectorXd& f, const Eigen::VectorX
     }
   }
   // Out-of-band branches that the forward steps may have placed: never a mode without data.
-  {
+  for (int pass = 0; pass < 4; ++pass) {  // a refit may push another branch out
     EquivalentCircuit cur = circuit_of(best.lay, best.t);
     const auto before = cur.branches.size();
     std::erase_if(cur.branches, [&](const CircuitBranch& b) { return !(b.fs_hz() > f[0] && b.fs_hz() < f[n - 1]); });
-    if (cur.branches.size() != before) {
-      out.notes.push_back(std::to_string(before - cur.branches.size()) + " branch(es) outside the data dropped");
-      best = run(cur, best.lay.rs);
-    }
+    if (cur.branches.size() == before) break;
+    out.notes.push_back(std::to_string(before - cur.branches.size()) + " branch(es) outside the data dropped");
+    best = run(cur, best.lay.rs);
   }
   // Ascending fs, and the parameter vector and Jacobian in that order.
   {
