@@ -25,6 +25,7 @@
 #include "tests/support/sim_capture.hpp"
 
 #include <hdf5.h>
+#include "tests/support/truth_attributes.hpp"
 
 using namespace piezo;
 using cd = std::complex<double>;
@@ -48,17 +49,7 @@ std::filesystem::path scratch(const std::string& name) {
   return test::scratch_dir("sim_disturbances") / (name + ".h5");
 }
 
-double truth_number(const std::filesystem::path& file, const char* name) {  // NaN if absent
-  hid_t f = H5Fopen(file.c_str(), H5F_ACC_RDONLY, H5P_DEFAULT);
-  double v = std::nan("");
-  if (f >= 0 && H5Aexists_by_name(f, "truth", name, H5P_DEFAULT) > 0) {
-    hid_t a = H5Aopen_by_name(f, "truth", name, H5P_DEFAULT, H5P_DEFAULT);
-    H5Aread(a, H5T_NATIVE_DOUBLE, &v);
-    H5Aclose(a);
-  }
-  if (f >= 0) H5Fclose(f);
-  return v;
-}
+using piezo::test::truth_number;  // tests/support/truth_attributes.hpp
 
 std::vector<double> truth_series(const std::filesystem::path& file, const char* name) {
   hid_t f = H5Fopen(file.c_str(), H5F_ACC_RDONLY, H5P_DEFAULT);

@@ -16,6 +16,7 @@
 
 #include "acquisition/capture_file.hpp"
 #include "tests/support/run_cli.hpp"
+#include "tests/support/truth_attributes.hpp"
 
 namespace fs = std::filesystem;
 using namespace piezo;
@@ -28,17 +29,7 @@ fs::path tmp_dir() {
 }
 
 // A /truth attribute: a number (NaN if absent) or a string ("" if absent).
-double truth_number(const fs::path& file, const char* name) {
-  hid_t f = H5Fopen(file.c_str(), H5F_ACC_RDONLY, H5P_DEFAULT);
-  double v = std::nan("");
-  if (f >= 0 && H5Aexists_by_name(f, "truth", name, H5P_DEFAULT) > 0) {
-    hid_t a = H5Aopen_by_name(f, "truth", name, H5P_DEFAULT, H5P_DEFAULT);
-    H5Aread(a, H5T_NATIVE_DOUBLE, &v);
-    H5Aclose(a);
-  }
-  if (f >= 0) H5Fclose(f);
-  return v;
-}
+using piezo::test::truth_number;  // tests/support/truth_attributes.hpp
 
 std::string truth_string(const fs::path& file, const char* name) {
   hid_t f = H5Fopen(file.c_str(), H5F_ACC_RDONLY, H5P_DEFAULT);
