@@ -353,18 +353,14 @@ CircuitModeFigures figures_of(const EquivalentCircuit& c, const std::vector<doub
 std::vector<double> figure_vector(const std::vector<CircuitModeFigures>& ms) {
   std::vector<double> v;
   for (const auto& m : ms)
-    for (const Figure* f : {&m.fs_hz, &m.fp_hz, &m.fm_hz, &m.fn_hz, &m.fr_hz, &m.fa_hz, &m.k_eff_ieee176,
-                            &m.k_eff_en50324, &m.qm_branch, &m.qm_bandwidth, &m.r1_ohm, &m.l1_h, &m.c1_f})
-      v.push_back(f->value);
+    for (const auto& [name, f] : named_figures(m)) v.push_back(f->value);
   return v;
 }
 
 std::vector<Figure*> figure_slots(std::vector<CircuitModeFigures>& ms) {
   std::vector<Figure*> v;
   for (auto& m : ms)
-    for (Figure* f : {&m.fs_hz, &m.fp_hz, &m.fm_hz, &m.fn_hz, &m.fr_hz, &m.fa_hz, &m.k_eff_ieee176,
-                      &m.k_eff_en50324, &m.qm_branch, &m.qm_bandwidth, &m.r1_ohm, &m.l1_h, &m.c1_f})
-      v.push_back(f);
+    for (const auto& [name, f] : named_figures(m)) v.push_back(f);
   return v;
 }
 
@@ -376,6 +372,28 @@ std::vector<CircuitModeFigures> all_figures(const EquivalentCircuit& c) {
 }
 
 }  // namespace
+
+std::vector<std::pair<const char*, Figure*>> named_figures(CircuitModeFigures& m) {
+  return {{"fs_hz", &m.fs_hz},
+          {"fp_hz", &m.fp_hz},
+          {"fm_hz", &m.fm_hz},
+          {"fn_hz", &m.fn_hz},
+          {"fr_hz", &m.fr_hz},
+          {"fa_hz", &m.fa_hz},
+          {"k_eff_ieee176", &m.k_eff_ieee176},
+          {"k_eff_en50324", &m.k_eff_en50324},
+          {"qm_branch", &m.qm_branch},
+          {"qm_bandwidth", &m.qm_bandwidth},
+          {"r1_ohm", &m.r1_ohm},
+          {"l1_h", &m.l1_h},
+          {"c1_f", &m.c1_f}};
+}
+
+std::vector<std::pair<const char*, const Figure*>> named_figures(const CircuitModeFigures& m) {
+  std::vector<std::pair<const char*, const Figure*>> out;
+  for (const auto& [name, f] : named_figures(const_cast<CircuitModeFigures&>(m))) out.emplace_back(name, f);
+  return out;
+}
 
 CircuitModeFigures circuit_mode_figures(const EquivalentCircuit& c, std::size_t k) {
   if (k >= c.branches.size()) throw std::invalid_argument("circuit_mode_figures: no such branch");

@@ -23,6 +23,7 @@
 #include <Eigen/Core>
 #include <complex>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "dsp/impedance_types.hpp"
@@ -111,6 +112,10 @@ struct CircuitFit {
 // non-positive or non-ascending frequency, or a non-finite Z.
 CircuitFit fit_equivalent_circuit(const Eigen::VectorXd& f_hz, const Eigen::VectorXcd& z,
                                   const Eigen::VectorXd& z_sigma, const CircuitFitOptions& opt = {});
+
+// The per-mode figures by name in one fixed order (JSON keys, CSV columns, the σ propagation).
+std::vector<std::pair<const char*, Figure*>> named_figures(CircuitModeFigures& m);
+std::vector<std::pair<const char*, const Figure*>> named_figures(const CircuitModeFigures& m);
 
 // Figures of branch k of a circuit (values only; fit_equivalent_circuit adds σ).
 CircuitModeFigures circuit_mode_figures(const EquivalentCircuit& c, std::size_t k);

@@ -33,23 +33,6 @@ nlohmann::json fig(const dsp::Figure& f) {
 
 nlohmann::json num(double v) { return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json(nullptr); }
 
-// The figures of a mode in a fixed order (the CSV's columns and the JSON's keys).
-std::vector<std::pair<const char*, const dsp::Figure*>> named(const dsp::CircuitModeFigures& m) {
-  return {{"fs_hz", &m.fs_hz},
-          {"fp_hz", &m.fp_hz},
-          {"fm_hz", &m.fm_hz},
-          {"fn_hz", &m.fn_hz},
-          {"fr_hz", &m.fr_hz},
-          {"fa_hz", &m.fa_hz},
-          {"k_eff_ieee176", &m.k_eff_ieee176},
-          {"k_eff_en50324", &m.k_eff_en50324},
-          {"qm_branch", &m.qm_branch},
-          {"qm_bandwidth", &m.qm_bandwidth},
-          {"r1_ohm", &m.r1_ohm},
-          {"l1_h", &m.l1_h},
-          {"c1_f", &m.c1_f}};
-}
-
 }  // namespace
 
 FiguresJobResult run_figures(const FiguresRequest& req) {
@@ -173,7 +156,7 @@ nlohmann::json figures_json(const FiguresRequest& req, const FiguresJobResult& r
     const auto& m = fit.modes[k];
     nlohmann::json jm;
     jm["mode"] = k + 1;
-    for (const auto& [name, f] : named(m)) jm[name] = fig(*f);
+    for (const auto& [name, f] : dsp::named_figures(m)) jm[name] = fig(*f);
     jm["window_hz"] = {num(m.window_lo_hz), num(m.window_hi_hz)};
     jm["points"] = m.points;
     jm["misfit_rel_rms"] = num(m.misfit_rel_rms);
@@ -187,12 +170,12 @@ nlohmann::json figures_json(const FiguresRequest& req, const FiguresJobResult& r
 void write_figures_csv(std::ostream& os, const FiguresJobResult& r) {
   os << "mode";
   if (!r.fit.modes.empty())
-    for (const auto& [name, f] : named(r.fit.modes[0])) os << ',' << name << ',' << name << "_sigma";
+    for (const auto& [name, f] : dsp::named_figures(r.fit.modes[0])) os << ',' << name << ',' << name << "_sigma";
   os << ",misfit_rel_rms\n";
   os.precision(10);
   for (std::size_t k = 0; k < r.fit.modes.size(); ++k) {
     os << k + 1;
-    for (const auto& [name, f] : named(r.fit.modes[k])) os << ',' << f->value << ',' << f->sigma;
+    for (const auto& [name, f] : dsp::named_figures(r.fit.modes[k])) os << ',' << f->value << ',' << f->sigma;
     os << ',' << r.fit.modes[k].misfit_rel_rms << '\n';
   }
 }
