@@ -63,6 +63,7 @@ struct OeData {
   double sample_rate_hz = 0;
   model::DividerCircuit circuit;  // R1 (and a measured fixture: Cp, lead R)
   double v2_delay_s = 0;          // channel 2 recorded late by this (a measured skew)
+  double mains_hz = 0;            // the bench's mains frequency (/setup mains_hz); 0: unknown (50 and 60 tried)
 };
 
 // How the tube's mechanical loss is modelled (issue 19, item 2):
@@ -144,6 +145,12 @@ struct OeOptions {
   // second thread; the answers are the same for any count. 1 where the caller
   // already keeps every core busy (a batch replay with --jobs > 1).
   int threads = 2;
+  // Slow disturbances (issue 33; update/output_error/baseline.hpp): a baseline
+  // (offset, slope, polynomial wander, mains hum) projected out and 1/f noise
+  // whitened, each when the data show it at the first optimum (then the
+  // starts are refitted under it). false: the white model with the offset
+  // alone, as before.
+  bool disturbances = true;
   double effect_significance = 25.0;  // Δχ² (one parameter) beyond this, scaled by χ²/ν when > 1
   double alias_threshold = 0.05;
 };
@@ -202,6 +209,41 @@ struct OeParameter {
   std::string note;    // why not identifiable, and what would pin it
 };
 
+// The slow disturbances the fit found and modelled (issue 33 item 1). The
+// residual sees the DIFFERENCE of the channels' baselines (T ≈ 1 at their
+// frequencies: channel 1's reaches the prediction of v2 unchanged), so the
+// slope and hum are of channel 1 minus channel 2; each channel's offset is
+// its pretrigger's mean, where the record has one.
+struct OeBaselineShot {
+  int shot = 0;                      // index among the shots averaged
+  double offset_v = 0, slope_v_per_s = 0, hum_v = 0;
+};
+struct OeBaseline {
+  bool modelled = false;             // the baseline's columns were projected out
+  double delta_chi2 = 0;             // χ² its columns took beyond the offset's (at the first optimum)
+  int dof = 0;                       // their number beyond the offset
+  double log10_p = 0;                // chance of that under white noise (Bonferroni over the mains tried)
+  int poly_degree = 0;
+  double mains_hz = 0;               // the hum's frequency in the columns (0: none)
+  bool mains_known = false;          // from the capture's /setup
+  bool mains_distinguishable = false;  // 50 and 60 Hz told apart by the data
+  int harmonics = 0;                 // hum harmonics in the columns (0: record below half a mains cycle)
+  // Channel 1 minus channel 2, the shots averaged (volts, V/s), with sigmas;
+  // NaN where not in the model.
+  double offset_v = 0, offset_sigma_v = 0;          // beyond the pretrigger's means
+  double slope_v_per_s = 0, slope_sigma_v_per_s = 0;
+  double hum_v = std::numeric_limits<double>::quiet_NaN(), hum_sigma_v = std::numeric_limits<double>::quiet_NaN();
+  bool channel_offsets = false;      // from a pretrigger
+  double channel_offset_v[2] = {0, 0}, channel_offset_sigma_v[2] = {0, 0};
+  // 1/f noise.
+  bool pink = false;
+  double pink_ratio = 0;             // its power over the white floor's at the record's first bin (1/T)
+  double pink_rms_v = 0;             // its rms in the filtered residual
+  double pink_delta_2lnl = 0;        // the Whittle likelihood's gain from it
+  std::vector<OeBaselineShot> shots;  // per shot (two or more)
+  bool any() const { return modelled || pink; }
+};
+
 struct OeResult {
   UpdateStatus status = UpdateStatus::bad_input;
   std::string message;
@@ -222,7 +264,8 @@ struct OeResult {
   double band_hz = 0;
   int shots_used = 0;
   std::string noise_source;                 // "shots" | "pretrigger" | "high-pass estimate"
-  std::string offset_model;                 // how the DAQ offsets enter (pretrigger / unknown)
+  std::string offset_model;                 // how the DAQ offsets enter (pretrigger / unknown / the baseline's projection)
+  OeBaseline baseline;                      // the slow disturbances found (issue 33)
   double noise_rms_v = 0;                   // σ_r of the filtered residual samples
   double residual_rms_v = 0;                // of the filtered residual at the optimum
   double chi2_per_dof = 0;                  // (residual/noise)² per degree of freedom
@@ -289,6 +332,7 @@ struct OePrediction {
   // (update/residual_regions.hpp).
   std::vector<ResidualRegion> regions;
   std::string noise_source, offset_model;
+  OeBaseline baseline;  // the held-out capture's own slow disturbances
 };
 
 // Throws std::invalid_argument for unusable data (as fit_output_error) and

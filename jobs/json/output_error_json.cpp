@@ -10,6 +10,50 @@ nlohmann::json tube_params_json(const update::TubeParams& p) {
   return {{"YE11", p.y_e11}, {"nu12", p.nu12}, {"d31", p.d31}, {"epsT33_rel", p.eps_t33 / model::kEps0}};
 }
 
+namespace {
+nlohmann::json number(double v) { return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json(nullptr); }
+}  // namespace
+
+nlohmann::json baseline_json(const update::OeBaseline& b) {
+  nlohmann::json shots = nlohmann::json::array();
+  for (const auto& s : b.shots)
+    shots.push_back({{"shot", s.shot},
+                     {"offset_v", number(s.offset_v)},
+                     {"slope_v_per_s", number(s.slope_v_per_s)},
+                     {"hum_v", number(s.hum_v)}});
+  nlohmann::json channels = nlohmann::json::array();
+  if (b.channel_offsets)
+    for (int c = 0; c < 2; ++c)
+      channels.push_back({{"channel", c + 1},
+                          {"offset_v", b.channel_offset_v[c]},
+                          {"offset_sigma_v", b.channel_offset_sigma_v[c]},
+                          {"source", "pretrigger mean"}});
+  return {{"modelled", b.modelled},
+          {"delta_chi2", b.delta_chi2},
+          {"dof", b.dof},
+          {"log10_p", b.log10_p},
+          {"poly_degree", b.poly_degree},
+          {"mains_hz", b.mains_hz},
+          {"mains_known", b.mains_known},
+          {"mains_distinguishable", b.mains_distinguishable},
+          {"harmonics", b.harmonics},
+          {"differential",
+           {{"what", "channel 1 minus channel 2, as the output error sees them"},
+            {"offset_v", number(b.offset_v)},
+            {"offset_sigma_v", number(b.offset_sigma_v)},
+            {"slope_v_per_s", number(b.slope_v_per_s)},
+            {"slope_sigma_v_per_s", number(b.slope_sigma_v_per_s)},
+            {"hum_v", number(b.hum_v)},
+            {"hum_sigma_v", number(b.hum_sigma_v)}}},
+          {"channels", channels},
+          {"pink",
+           {{"modelled", b.pink},
+            {"ratio_at_first_bin", b.pink_ratio},
+            {"rms_v", b.pink_rms_v},
+            {"delta_2lnl", b.pink_delta_2lnl}}},
+          {"shots", shots}};
+}
+
 nlohmann::json output_error_json(const update::OeResult& r, const std::string& excitation) {
   nlohmann::json params = nlohmann::json::array();
   std::vector<std::string> names;
@@ -63,6 +107,7 @@ nlohmann::json output_error_json(const update::OeResult& r, const std::string& e
             {"chi2_limit", r.chi2_limit},
             {"lack_of_fit", r.lack_of_fit},
             {"offset_model", r.offset_model},
+            {"baseline", baseline_json(r.baseline)},
             {"chain_tolerances",
              {{"r1_rel_sigma", r.r1_rel_sigma},
               {"cp_sigma_f", r.cp_sigma_f},

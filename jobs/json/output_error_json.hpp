@@ -19,5 +19,7 @@ namespace piezo::jobs {
 
 nlohmann::json tube_params_json(const update::TubeParams& p);
 nlohmann::json output_error_json(const update::OeResult& r, const std::string& excitation);
+// The slow disturbances found (issue 33): OeResult/OePrediction::baseline.
+nlohmann::json baseline_json(const update::OeBaseline& b);
 
 }  // namespace piezo::jobs

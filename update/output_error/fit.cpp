@@ -16,6 +16,7 @@
 #include <vector>
 
 #include "update/output_error.hpp"
+#include "update/output_error/baseline.hpp"
 #include "update/output_error/common.hpp"
 #include "update/output_error/effect_scan.hpp"
 #include "update/output_error/fitter.hpp"
@@ -148,6 +149,38 @@ void take_answer(const std::vector<LmOutcome>& runs, const Coordinates5& co, con
   out.effect_set = prob.effects();
 }
 
+// The slow disturbances at the first optimum (decide_disturbances); when
+// found, `whiten` switches to them and every run is refitted from its optimum
+// under the new metric (the first, finished, leads the later ones).
+void refit_under_disturbances(Fitter& fitter, OffsetWhitening& whiten, const Averaged& rec, const OeData& data,
+                              double sigma, double ch1, double ch2, std::vector<LmOutcome>& runs, OeResult& out,
+                              int& models_elsewhere) {
+  Problem& prob = fitter.prob;
+  const auto t = prob.transfer(runs.front().x);
+  if (!t) return;
+  const DisturbanceModel d =
+      decide_disturbances(prob, rec, *t, prob.residual_of(*t), sigma, ch1, ch2, data.sample_rate_hz, data.mains_hz);
+  whiten.disturbances = d;
+  if (!d.any()) return;
+  whiten.use(d, prob, rec, *t);
+  fitter.set_dof(std::max(1.0, double(prob.samples()) - kParams - whiten.dof));
+  std::vector<LmOutcome> again;
+  again.reserve(runs.size());
+  again.push_back(fitter.levenberg_marquardt(runs.front().x, nullptr));
+  fitter.finish(again.front());
+  std::vector<LmOutcome> later(runs.size() - 1);
+  std::vector<std::size_t> order(later.size());
+  for (std::size_t k = 0; k < order.size(); ++k) order[k] = k;
+  models_elsewhere += in_parallel(fitter, order, prob.state(), [&](Problem&, Fitter& f, std::size_t k) {
+    later[k] = f.levenberg_marquardt(runs[k + 1].x, &again.front());
+  });
+  for (auto& o : later) again.push_back(std::move(o));
+  for (const auto& o : again) out.iterations += o.iterations;
+  std::sort(again.begin(), again.end(), [](const LmOutcome& a, const LmOutcome& b) { return a.cost < b.cost; });
+  if (again.front().jtj.rows() != kParams) fitter.finish(again.front());
+  runs = std::move(again);
+}
+
 // Re-weighs the runs' costs and Jacobians from the noise σ they were fitted
 // with to s, the noise at the answer; σ becomes s (the Fitter reads it).
 void reweigh(std::vector<LmOutcome>& runs, double& sigma, double s) {
@@ -219,11 +252,8 @@ OeResult fit_output_error(model::ModalSolver& solver, const MaterialClass& cls,
   }
 
   // The DAQ offsets (OffsetWhitening).
-  const OffsetWhitening whiten(prob, rec, *t_nominal, sigma);
-  const int offset_dof = whiten.dof;
-  out.offset_model = whiten.model;
-  const double dof_fit = std::max(1.0, double(prob.samples()) - kParams - offset_dof);
-  Fitter fitter(prob, whiten, sigma, opt, dof_fit);
+  OffsetWhitening whiten(prob, rec, *t_nominal, sigma);
+  Fitter fitter(prob, whiten, sigma, opt, std::max(1.0, double(prob.samples()) - kParams - whiten.dof));
   int models_elsewhere = 0;  // FE models the forks built (in_parallel)
 
   // The coarse grid and LM from its best starts.
@@ -234,6 +264,11 @@ OeResult fit_output_error(model::ModalSolver& solver, const MaterialClass& cls,
     out.message = "no start of the output-error fit could be simulated";
     return out;
   }
+  // Slow disturbances (baseline.hpp), decided at the first optimum: when
+  // found, every start's optimum is refitted under them.
+  if (opt.disturbances) refit_under_disturbances(fitter, whiten, rec, data, sigma, ch1, ch2, runs, out, models_elsewhere);
+  const int offset_dof = whiten.dof;
+  out.offset_model = whiten.model;
   const LmOutcome& best = runs.front();
   take_answer(runs, co, prob, opt, out);
 
@@ -253,6 +288,9 @@ OeResult fit_output_error(model::ModalSolver& solver, const MaterialClass& cls,
   // The sigmas, the lack of fit, each parameter's honesty, the effects.
   const FitAnswer answer{runs, best, t_best, dof, std::max(1.0, out.chi2_per_dof), ch1, ch2};
   const Covariance cov = covariance(answer, prob, whiten, sigma, nominal, opt, out);
+  if (t_best)
+    out.baseline = report_disturbances(whiten.disturbances, whiten.pink.get(), whiten.columns, prob, rec, *t_best,
+                                       sigma, answer.s2);
   judge_lack_of_fit(answer, prob, opt, out);
   identify(answer, cov, nominal, opt, out);
   models_elsewhere += scan_effects(answer, fitter, co, nominal, opt, out);

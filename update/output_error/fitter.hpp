@@ -36,6 +36,8 @@ class Fitter {
   // The same optimiser on another Problem (a fork for another thread): the
   // same whitening, noise (by reference) and options.
   Fitter on(Problem& other) const { return Fitter(other, whiten, sigma, opt, dof_fit); }
+  // The fit's degrees of freedom (the whitening's nuisance columns changed).
+  void set_dof(double dof) { dof_fit = dof; }
 
   // r/σ after the offsets' whitening; empty when x cannot be simulated.
   std::optional<Eigen::VectorXd> weighted(const Eigen::VectorXd& x);

@@ -1,7 +1,9 @@
 // The record's noise and the DAQ offsets' whitening (noise.hpp).
 #include "update/output_error/noise.hpp"
 
+#include <Eigen/SVD>
 #include <cmath>
+#include <memory>
 
 #include "dsp/prony_ss.hpp"
 
@@ -88,6 +90,33 @@ OffsetWhitening::OffsetWhitening(Problem& prob, const Averaged& rec,
   } else {
     model = "unknown (no pretrigger): projected out";
   }
+}
+
+void OffsetWhitening::use(const DisturbanceModel& d, Problem& prob, const Averaged& rec,
+                          const std::vector<cd>& t) {
+  disturbances = d;
+  if (!d.any()) return;
+  pink = d.pink ? std::make_shared<const PinkFilter>(prob.samples(), d.pink_b) : nullptr;
+  columns = d.baseline ? baseline_columns(prob, rec, t, d.poly_degree, d.mains_hz, d.harmonics)
+                       : baseline_columns(prob, rec, t, 0, 0.0, 0);
+  Eigen::MatrixXd cw(columns.rows(), columns.cols());
+  for (Eigen::Index c = 0; c < columns.cols(); ++c) cw.col(c) = pink ? (*pink)(columns.col(c)) : columns.col(c);
+  const Eigen::JacobiSVD<Eigen::MatrixXd> svd(cw, Eigen::ComputeThinU);
+  int rank = 0;
+  while (rank < svd.singularValues().size() && svd.singularValues()[rank] > 1e-9 * svd.singularValues()[0]) ++rank;
+  q = svd.matrixU().leftCols(rank);
+  dof = rank;
+  std::string m;
+  if (d.baseline) {
+    m = "baseline projected out: offset and slope to degree " + std::to_string(d.poly_degree);
+    if (d.harmonics > 0)
+      m += ", mains hum " + std::to_string(static_cast<int>(d.mains_hz)) + " Hz with " +
+           std::to_string(d.harmonics) + " harmonic(s)";
+  } else {
+    m = "offset projected out";
+  }
+  if (pink) m += "; 1/f noise whitened";
+  model = m;
 }
 
 }  // namespace piezo::update::oe

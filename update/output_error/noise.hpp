@@ -8,6 +8,9 @@
 #include <string>
 #include <vector>
 
+#include <memory>
+
+#include "update/output_error/baseline.hpp"
 #include "update/output_error/common.hpp"
 #include "update/output_error/forward_model.hpp"
 #include "update/output_error/shot_average.hpp"
@@ -33,15 +36,31 @@ RecordNoise record_noise(Problem& prob, const Averaged& rec, const std::vector<c
 // residual is whitened with the covariance σ²I + τ²uuᵀ (its component along
 // u shrunk by 1/√(1 + τ²uᵀu/σ²)). Without a pretrigger the offsets are
 // unknown (τ = ∞): the component is projected out, one degree of freedom less.
+//
+// With a slow disturbance found (baseline.hpp: decide_disturbances, then
+// use()): the residual is first whitened for 1/f noise (PinkFilter), then the
+// baseline's filtered-and-whitened columns (the offset among them) are
+// projected out — dof their rank.
 struct OffsetWhitening {
   Eigen::VectorXd u;
   double uu = 0;
   double shrink = 1.0;  // 1 − 1/√(1 + τ²uᵀu/σ²): the share of the u component removed
   int dof = 1;
   std::string model;
+  std::shared_ptr<const PinkFilter> pink;  // 1/f whitening (none: white noise)
+  Eigen::MatrixXd q;                        // orthonormal nuisance columns, projected out (none: u as above)
+  Eigen::MatrixXd columns;                  // the baseline's raw filtered columns (volts per coefficient)
+  DisturbanceModel disturbances;
   OffsetWhitening(Problem& prob, const Averaged& rec, const std::vector<cd>& t_nominal,
                   double sigma);
+  // Switches to the disturbance model d (its columns at transfer t).
+  void use(const DisturbanceModel& d, Problem& prob, const Averaged& rec, const std::vector<cd>& t);
   Eigen::VectorXd operator()(Eigen::VectorXd r) const {
+    if (pink) r = (*pink)(r);
+    if (q.cols() > 0) {
+      r -= q * (q.transpose() * r);
+      return r;
+    }
     if (uu > 0 && shrink > 0) r -= (shrink * u.dot(r) / uu) * u;
     return r;
   }

@@ -10,6 +10,7 @@
 #include <string>
 
 #include "update/output_error.hpp"
+#include "update/output_error/baseline.hpp"
 #include "update/output_error/common.hpp"
 #include "update/output_error/forward_model.hpp"
 #include "update/output_error/noise.hpp"
@@ -52,7 +53,15 @@ OePrediction predict_output_error(model::ModalSolver& solver, const MaterialClas
   out.noise_source = noise.source;
   out.noise_dof = noise.dof;
   if (!(sigma > 0) || !std::isfinite(sigma)) fail("the held-out capture shows no measurable noise");
-  const OffsetWhitening whiten(prob, rec, *t, sigma);
+  OffsetWhitening whiten(prob, rec, *t, sigma);
+  if (opt.disturbances) {
+    // The held-out capture's own slow disturbances (baseline.hpp), at the
+    // prediction: its baseline and 1/f noise are its own, never the fit's.
+    const DisturbanceModel d = decide_disturbances(prob, rec, *t, prob.residual_of(*t), sigma, noise.ch1, noise.ch2,
+                                                   fs, data.mains_hz);
+    whiten.use(d, prob, rec, *t);
+    out.baseline = report_disturbances(d, whiten.pink.get(), whiten.columns, prob, rec, *t, sigma, 1.0);
+  }
   out.offset_model = whiten.model;
   const Eigen::VectorXd r = whiten(prob.residual_of(*t)) / sigma;
   out.samples = static_cast<int>(r.size());

@@ -61,6 +61,17 @@ Averaged average(const OeData& d) {
       a.v1[i] -= m1;
       a.v2[i] -= m2;
     }
+    double s1 = 0, s2 = 0;
+    for (std::size_t i = 0; i < a.pretrigger; ++i) {
+      s1 += a.v1[i] * a.v1[i];
+      s2 += a.v2[i] * a.v2[i];
+    }
+    const double p = double(a.pretrigger);
+    a.with_offsets = true;
+    a.offset_v[0] = m1;
+    a.offset_v[1] = m2;
+    a.offset_sigma_v[0] = std::sqrt(s1 / (p - 1.0) / p);
+    a.offset_sigma_v[1] = std::sqrt(s2 / (p - 1.0) / p);
   }
   return a;
 }

@@ -16,6 +16,10 @@ struct Averaged {
   std::size_t pretrigger = 0;
   std::vector<std::vector<double>> dev1, dev2;  // each shot minus the average (K ≥ 2)
   int shots = 0;
+  // The pretrigger's means removed from each channel (with_offsets: a
+  // pretrigger of 16 samples or more), and their standard errors.
+  bool with_offsets = false;
+  double offset_v[2] = {0, 0}, offset_sigma_v[2] = {0, 0};
 };
 
 // Throws std::invalid_argument (fail) for no shots, v1 and v2 of different
