@@ -96,6 +96,10 @@ struct GapDiagnosis {
   bool base_from_other_start = false;
   std::string verdict_effect;          // "none", an effect name (first added), or "unexplained"
   std::vector<std::string> verdict_alternatives;  // indistinguishable from the verdict's effect on this data
+  // The bench's slow disturbances found in the fit data (issue 33: baseline
+  // wander, mains hum, 1/f noise), modelled as nuisance — findings of their
+  // own, never an effect of the catalogue. One sentence each.
+  std::vector<std::string> disturbances;
   std::string verdict;                 // one sentence for the technician
   double seconds = 0;
 };

@@ -43,8 +43,40 @@ bool weak_candidate(const OeEffect& e) {
   return e.value >= info->lower && e.value <= info->upper;
 }
 
+// The slow disturbances as sentences (issue 33 item 3).
+std::vector<std::string> disturbance_findings(const OeBaseline& b) {
+  std::vector<std::string> out;
+  char buf[400];
+  if (b.modelled) {
+    std::string hum;
+    if (b.harmonics > 0 && std::isfinite(b.hum_v)) {
+      char h[160];
+      std::snprintf(h, sizeof h, "; mains hum %s%.0f Hz %.3g +/- %.2g mV", b.mains_distinguishable ? "" : "(50 or 60 Hz, not told apart) ",
+                    b.mains_hz, 1e3 * b.hum_v, 1e3 * b.hum_sigma_v);
+      hum = h;
+    } else {
+      hum = "; any mains hum is inside it (the record spans less than half a mains cycle: 50 and 60 Hz look alike)";
+    }
+    std::snprintf(buf, sizeof buf,
+                  "Baseline wander between the channels (offset, slope to degree %d%s): projected out of the residual "
+                  "(it took chi2 %.0f for %d parameters, chance 1e%.0f under white noise); slope %.3g +/- %.2g V/s.",
+                  b.poly_degree, b.harmonics > 0 ? ", hum" : "", b.delta_chi2, b.dof, b.log10_p, b.slope_v_per_s,
+                  b.slope_sigma_v_per_s);
+    out.push_back(std::string(buf) + hum);
+  }
+  if (b.pink) {
+    std::snprintf(buf, sizeof buf,
+                  "1/f noise of %.3g mV rms in the fit's band (%.0f times the white floor at the record's lowest bin): "
+                  "weighted as noise (Whittle likelihood gain %.0f).",
+                  1e3 * b.pink_rms_v, b.pink_ratio, b.pink_delta_2lnl);
+    out.push_back(buf);
+  }
+  return out;
+}
+
 GapDiagnosis build(const OeResult& r, const std::string& fit_description, const HeldoutPredictions* ho) {
   GapDiagnosis d;
+  d.disturbances = disturbance_findings(r.baseline);
   d.method = "output-error";
   d.n_fit = r.residual_samples;
   d.dof_fit = std::max(1, r.residual_samples - static_cast<int>(r.parameters.size()));
@@ -253,6 +285,10 @@ GapDiagnosis build(const OeResult& r, const std::string& fit_description, const 
     d.verdict += " Not separable from the constants by this capture (aliases): ";
     for (std::size_t i = 0; i < aliases.size(); ++i) d.verdict += (i ? ", " : "") + aliases[i];
     d.verdict += " - calibrate the fixture to measure them.";
+  }
+  if (!d.disturbances.empty()) {
+    d.verdict += " Bench disturbances (not effects of the catalogue, modelled as nuisance):";
+    for (const auto& s : d.disturbances) d.verdict += " " + s;
   }
   d.seconds = r.seconds;
   return d;

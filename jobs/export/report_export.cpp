@@ -119,6 +119,7 @@ nlohmann::json diagnosis_json(const update::GapDiagnosis& d) {
                   {"base_from_other_start", d.base_from_other_start},
                   {"text", d.verdict}};
   j["verdict_text"] = d.verdict;
+  j["disturbances"] = d.disturbances;
   j["verdict_effect"] = d.verdict_effect;
   j["measured"] = nlohmann::json::array();
   for (const auto& m : d.measured)
