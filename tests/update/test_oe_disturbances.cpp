@@ -1,0 +1,213 @@
+// Issue 33 item 1: a real bench's slow disturbances as nuisance of the
+// output-error fit (update/output_error/baseline.hpp), against independent
+// truth. The records come from our time-domain divider simulator
+// (model::simulate_divider, not the estimator's per-bin prediction) and the
+// disturbances from a generator of this file, not the simulated bench's
+// (drivers/sim/disturbances: Voss–McCartney pink noise, its own hum model):
+// DC offsets, mains hum with harmonics at a random phase, and 1/f noise shaped
+// in frequency. What is checked:
+//  * a capture without disturbances keeps the white model, number for number
+//    the same as with the nuisance model switched off;
+//  * with offsets, hum and 1/f noise the fit is at its noise (no lack of
+//    fit), the constants within 4 sigma of the truth, their sigmas within 2x
+//    of the same record's without the disturbances (the acceptance study's
+//    1.5x is a median statement; one record's 1/f draw can take more);
+//  * a record long enough to hold two mains cycles tells 50 from 60 Hz and
+//    measures the hum's amplitude within 4 sigma; the diagnosis names it as a
+//    disturbance, not as an effect of the catalogue.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <complex>
+#include <random>
+#include <vector>
+
+#include "dsp/fft.hpp"
+#include "model/material_presets.hpp"
+#include "model/material_spec.hpp"
+#include "model/modal.hpp"
+#include "model/transient.hpp"
+#include "model/tube_model.hpp"
+#include "update/gap_diagnosis.hpp"
+#include "update/gap_output_error.hpp"
+#include "update/output_error.hpp"
+
+namespace {
+using namespace piezo;
+
+struct Record {
+  std::vector<double> v1, v2;
+  double fs = 10e6;
+  std::size_t pre = 200;
+};
+
+double rms(const std::vector<double>& v) {
+  double a = 0;
+  for (double x : v) a += x * x;
+  return std::sqrt(a / double(v.size()));
+}
+
+// The seed's lab drive (1 V exp_decay at 3000 1/s) through R1 = 3140 Ω into
+// the FE tube, white noise of noise_rel of each channel's rms.
+Record simulate(model::ModalSolver& solver, const update::MaterialClass& cls, const update::TubeParams& truth,
+                double fs, std::size_t n, double noise_rel, std::uint64_t seed) {
+  Record r;
+  r.fs = fs;
+  r.v1.assign(n, 0.0);
+  for (std::size_t i = r.pre; i < n; ++i) r.v1[i] = std::exp(-3000.0 * double(i - r.pre) / fs);
+  model::ModalOptions mo;
+  mo.n_modes = 40;
+  const auto port = solver.port_model(cls.e_form(truth), mo);
+  model::DividerCircuit c;
+  c.r1_ohm = 3140.0;
+  r.v2 = model::simulate_divider(port, {0.0, 6e-8}, c, r.v1, fs);
+  std::mt19937_64 rng(seed);
+  std::normal_distribution<double> nd;
+  const double s1 = noise_rel * rms(r.v1), s2 = noise_rel * rms(r.v2);
+  for (auto& x : r.v1) x += s1 * nd(rng);
+  for (auto& x : r.v2) x += s2 * nd(rng);
+  return r;
+}
+
+// 1/f noise of rms `level`: white noise shaped by 1/√f in frequency (DC zero).
+std::vector<double> pink(std::size_t n, double level, std::mt19937_64& rng) {
+  std::normal_distribution<double> nd;
+  std::vector<double> w(n);
+  for (auto& x : w) x = nd(rng);
+  dsp::RealFft fft(n);
+  std::vector<std::complex<double>> s(fft.bins());
+  fft.forward(w.data(), n, s.data());
+  s[0] = 0;
+  for (std::size_t k = 1; k < s.size(); ++k) s[k] /= std::sqrt(double(k));
+  std::vector<double> out(n);
+  fft.inverse(s.data(), out.data(), n);
+  const double k = level / rms(out);
+  for (auto& x : out) x *= k;
+  return out;
+}
+
+// Offsets, hum (fundamental with 30 % and 15 % harmonics, random phase per
+// channel) and 1/f noise of pink_rel of each channel's rms.
+void disturb(Record& r, double offset_v, double hum_v[2], double mains_hz, double pink_rel, std::uint64_t seed) {
+  std::mt19937_64 rng(seed);
+  std::uniform_real_distribution<double> ph(0.0, 2 * M_PI);
+  std::vector<double>* ch[2] = {&r.v1, &r.v2};
+  for (int c = 0; c < 2; ++c) {
+    auto& v = *ch[c];
+    const double phi = ph(rng);
+    const auto p = pink(v.size(), pink_rel * rms(v), rng);
+    const double off = (c == 0 ? 1.0 : -0.6) * offset_v;
+    for (std::size_t i = 0; i < v.size(); ++i) {
+      const double th = 2 * M_PI * mains_hz * double(i) / r.fs + phi;
+      v[i] += off + hum_v[c] * (std::sin(th) + 0.3 * std::sin(2 * th) + 0.15 * std::sin(3 * th)) + p[i];
+    }
+  }
+}
+
+update::OeData data_of(const Record& r) {
+  update::OeData d;
+  d.sample_rate_hz = r.fs;
+  d.circuit.r1_ohm = 3140.0;
+  d.shots.push_back({r.v1, r.v2, r.pre});
+  return d;
+}
+
+double truth_of(const update::TubeParams& t, int i) {
+  switch (i) {
+    case 0: return t.y_e11;
+    case 1: return t.nu12;
+    case 2: return t.d31;
+    default: return t.eps_t33 / model::kEps0;
+  }
+}
+
+class OeDisturbances : public ::testing::Test {
+ protected:
+  model::TubeModel tube{model::TubeGeometry{}};
+  model::ModalSolver solver{tube};
+  update::MaterialClass cls = update::MaterialClass::isotropic();
+  update::TubeParams nominal = model::isotropic_params(model::resolve_material({"apc850", true, ""}).d);
+  update::TubeParams truth() const {
+    update::TubeParams t = nominal;
+    t.y_e11 *= 1.04;
+    t.nu12 *= 0.96;
+    t.d31 *= 1.03;
+    t.eps_t33 *= 0.98;
+    return t;
+  }
+};
+
+TEST_F(OeDisturbances, ACleanRecordKeepsTheWhiteModelNumberForNumber) {
+  const Record r = simulate(solver, cls, truth(), 10e6, 20000, 0.02, 11);
+  const auto with = update::fit_output_error(solver, cls, nominal, data_of(r));
+  update::OeOptions off;
+  off.disturbances = false;
+  const auto without = update::fit_output_error(solver, cls, nominal, data_of(r), off);
+  ASSERT_TRUE(with.ok() && without.ok());
+  EXPECT_FALSE(with.baseline.any()) << "baseline log10 p " << with.baseline.log10_p << ", 1/f gain "
+                                    << with.baseline.pink_delta_2lnl;
+  for (std::size_t i = 0; i < 5; ++i) {
+    EXPECT_EQ(with.parameters[i].value, without.parameters[i].value) << with.parameters[i].name;
+    EXPECT_EQ(with.parameters[i].sigma, without.parameters[i].sigma) << with.parameters[i].name;
+  }
+  EXPECT_EQ(with.chi2_per_dof, without.chi2_per_dof);
+}
+
+TEST_F(OeDisturbances, OffsetsHumAndOneOverFNoiseAreNuisanceNotLackOfFit) {
+  const Record clean = simulate(solver, cls, truth(), 10e6, 20000, 0.02, 12);
+  Record dist = clean;
+  double hum[2] = {0.008, 0.003};
+  disturb(dist, 0.005, hum, 60.0, 0.01, 99);
+  const auto c = update::fit_output_error(solver, cls, nominal, data_of(clean));
+  const auto d = update::fit_output_error(solver, cls, nominal, data_of(dist));
+  ASSERT_TRUE(c.ok() && d.ok()) << d.message;
+  update::OeOptions off;
+  off.disturbances = false;
+  const auto white = update::fit_output_error(solver, cls, nominal, data_of(dist), off);
+  // Without the nuisance model the disturbances read as a lack of fit.
+  EXPECT_TRUE(white.lack_of_fit) << white.chi2_per_dof;
+  EXPECT_TRUE(d.baseline.modelled);
+  EXPECT_TRUE(d.baseline.pink);
+  EXPECT_FALSE(d.lack_of_fit) << "chi2/dof " << d.chi2_per_dof << " limit " << d.chi2_limit << ", band 1e"
+                              << d.band_log10_p;
+  for (int i = 0; i < 4; ++i) {
+    const auto& p = d.parameters[static_cast<std::size_t>(i)];
+    const double t = truth_of(truth(), i);
+    EXPECT_EQ(p.status, "ok") << p.name << ": " << p.note;
+    EXPECT_LT(std::abs(p.value - t), 4.0 * p.sigma_statistical) << p.name << " " << p.value << " truth " << t;
+    EXPECT_LT(p.sigma, 2.0 * c.parameters[static_cast<std::size_t>(i)].sigma) << p.name;
+  }
+  // The pretrigger's means are each channel's offset (+5 mV and -3 mV; the
+  // hum and 1/f noise move a 20 µs mean by up to their amplitude).
+  ASSERT_TRUE(d.baseline.channel_offsets);
+  EXPECT_NEAR(d.baseline.channel_offset_v[0], 0.005, 0.009);
+  EXPECT_NEAR(d.baseline.channel_offset_v[1], -0.003, 0.004);
+  // The diagnosis reports the disturbances as findings of their own.
+  const auto g = update::gap_from_output_error(d, "test");
+  EXPECT_EQ(g.verdict_effect, "none") << g.verdict;
+  EXPECT_EQ(g.disturbances.size(), 2u) << g.verdict;
+}
+
+// 1 MS/s, 40 ms: two 50 Hz cycles in the record — the hum is a hum, not a
+// polynomial, its frequency and amplitude measurable.
+TEST_F(OeDisturbances, ALongRecordTellsTheMainsFrequencyAndMeasuresTheHum) {
+  Record r = simulate(solver, cls, truth(), 1e6, 40000, 0.02, 13);
+  double hum[2] = {0.006, 0.0};
+  disturb(r, 0.0, hum, 50.0, 0.0, 7);
+  update::OeOptions o;
+  o.band_hz = 120e3;
+  const auto d = update::fit_output_error(solver, cls, nominal, data_of(r), o);
+  ASSERT_TRUE(d.ok()) << d.message;
+  EXPECT_FALSE(d.lack_of_fit) << d.chi2_per_dof;
+  ASSERT_TRUE(d.baseline.modelled);
+  EXPECT_EQ(d.baseline.mains_hz, 50.0);
+  EXPECT_TRUE(d.baseline.mains_distinguishable);
+  EXPECT_EQ(d.baseline.harmonics, 3);
+  EXPECT_TRUE(std::isfinite(d.baseline.hum_v));
+  // channel 1's hum (6 mV) minus channel 2's (none)
+  EXPECT_LT(std::abs(d.baseline.hum_v - 0.006), 4.0 * d.baseline.hum_sigma_v + 1e-4)
+      << d.baseline.hum_v << " +- " << d.baseline.hum_sigma_v;
+  EXPECT_LT(d.baseline.hum_sigma_v, 0.002);
+}
+
+}  // namespace
