@@ -240,6 +240,7 @@ struct OeBaseline {
   double pink_ratio = 0;             // its power over the white floor's at the record's first bin (1/T)
   double pink_rms_v = 0;             // its rms in the filtered residual
   double pink_delta_2lnl = 0;        // the Whittle likelihood's gain from it
+  double transfer_error_chi2 = 0;    // χ² of the first optimum's residual along generic transfer errors (a bench effect's)
   std::vector<OeBaselineShot> shots;  // per shot (two or more)
   bool any() const { return modelled || pink; }
 };

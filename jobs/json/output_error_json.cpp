@@ -30,6 +30,7 @@ nlohmann::json baseline_json(const update::OeBaseline& b) {
                           {"source", "pretrigger mean"}});
   return {{"modelled", b.modelled},
           {"delta_chi2", b.delta_chi2},
+          {"transfer_error_chi2", b.transfer_error_chi2},
           {"dof", b.dof},
           {"log10_p", b.log10_p},
           {"poly_degree", b.poly_degree},

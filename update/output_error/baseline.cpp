@@ -18,6 +18,7 @@ namespace {
 
 constexpr double kLn1e3 = -6.907755278982137;  // ln 1e-3
 constexpr double kPinkLr = 10.83;               // χ²₁ at p = 1e-3
+constexpr double kBaselineShare = 0.02;         // baseline Δχ² over the transfer errors' χ², at least
 
 // One FFT per size and thread (FFTW's plans execute on their own buffers).
 dsp::RealFft& thread_fft(std::size_t n) {
@@ -108,6 +109,33 @@ Eigen::MatrixXd baseline_columns(Problem& prob, const Averaged& rec, const std::
   return cols;
 }
 
+Eigen::MatrixXd transfer_error_columns(Problem& prob, const std::vector<cd>& t) {
+  const std::vector<cd> zero(t.size(), cd(0.0, 0.0));
+  const Eigen::VectorXd base = prob.residual_of(zero);  // −L ∗ v2
+  // τ: a quarter of the band's period scale (the columns' sizes comparable).
+  double fmax = 0;
+  for (std::size_t k = 0; k < t.size(); ++k) fmax = double(k) * prob.transfer_bin_hz();
+  const double tau = fmax > 0 ? 1.0 / (kTwoPi * fmax / 2.5) : 0.0;
+  // T^p·(jωτ)^q for p = 1..3, q = 0..2: the transfer errors of the bench's
+  // effects to second order (T² is 1/(1 + R1·Y)² — a load on the tube; T³ its
+  // square; the jω powers a delay, a capacitance, a loss angle's slope).
+  // And T^p·ωτ (real): a loss angle's conductance ωC·tanδ, which no power
+  // of jω makes (dielectric loss; refsim case 13's tanδ 0.019 read as a
+  // baseline without it).
+  Eigen::MatrixXd out(base.size(), 12);
+  int c = 0;
+  for (int pw = 1; pw <= 3; ++pw)
+    for (int q = 0; q <= 3; ++q, ++c) {
+      std::vector<cd> g(t.size());
+      for (std::size_t k = 0; k < t.size(); ++k) {
+        const double wt = kTwoPi * double(k) * prob.transfer_bin_hz() * tau;
+        g[k] = std::pow(t[k], pw) * (q == 3 ? cd(wt, 0.0) : std::pow(cd(0.0, wt), q));
+      }
+      out.col(c) = prob.residual_of(g) - base;
+    }
+  return out;
+}
+
 DisturbanceModel decide_disturbances(Problem& prob, const Averaged& rec, const std::vector<cd>& t,
                                      const Eigen::VectorXd& r, double sigma, double ch1, double ch2,
                                      double sample_rate_hz, double mains_hz) {
@@ -117,9 +145,25 @@ DisturbanceModel decide_disturbances(Problem& prob, const Averaged& rec, const s
   const Eigen::VectorXd z = r / sigma;
   const double seconds = double(rec.v1.size()) / sample_rate_hz;
 
+  // What a bench effect leaves at the optimum is a transfer error δT·v1 —
+  // smooth and slow for the exp_decay drive's v1 (a gain error is g·v2), so
+  // a polynomial and a 1/f weighting would take it. A baseline does not
+  // follow v1: it is measured beyond the generic transfer errors
+  // L ∗ (δT_k·v1), δT_k ∈ {T, T(1 − T), jωτ·T, jωτ·T(1 − T)} (gain, loading
+  // and series impedance, skew, parallel capacitance and dielectric loss to
+  // first order; τ = 1/(2π·band); to second order in transfer_error_columns),
+  // which are projected out of both sides of
+  // the test, and the 1/f noise is estimated from the residual without them.
+  const Eigen::MatrixXd errs = transfer_error_columns(prob, t);
+  auto with_errors = [&](const Eigen::MatrixXd& c) {
+    Eigen::MatrixXd a(c.rows(), c.cols() + errs.cols());
+    a << c, errs;
+    return a;
+  };
   // The baseline: the columns' Δχ² beyond the offset's, per mains frequency tried.
-  const Eigen::MatrixXd q_off = orthonormal(baseline_columns(prob, rec, t, 0, 0, 0));
+  const Eigen::MatrixXd q_off = orthonormal(with_errors(baseline_columns(prob, rec, t, 0, 0, 0)));
   const double chi_off = (q_off.transpose() * z).squaredNorm();
+  d.transfer_error_chi2 = (orthonormal(errs).transpose() * z).squaredNorm();
   std::vector<double> tried = mains_hz > 0 ? std::vector<double>{mains_hz} : std::vector<double>{50.0, 60.0};
   d.mains_known = mains_hz > 0;
   double best_logp = 0, best_delta = 0;
@@ -127,7 +171,7 @@ DisturbanceModel decide_disturbances(Problem& prob, const Averaged& rec, const s
   Eigen::MatrixXd q_best = q_off;
   for (double f : tried) {
     const int h = hum_harmonics(f, seconds);
-    const Eigen::MatrixXd q = orthonormal(baseline_columns(prob, rec, t, d.poly_degree, f, h));
+    const Eigen::MatrixXd q = orthonormal(with_errors(baseline_columns(prob, rec, t, d.poly_degree, f, h)));
     const double delta = std::max(0.0, (q.transpose() * z).squaredNorm() - chi_off);
     const int dof = static_cast<int>(q.cols()) - static_cast<int>(q_off.cols());
     deltas.push_back(delta);
@@ -143,7 +187,13 @@ DisturbanceModel decide_disturbances(Problem& prob, const Averaged& rec, const s
   }
   d.baseline_delta_chi2 = best_delta;
   d.baseline_log10_p = best_logp / std::log(10.0);
-  d.baseline = best_logp < kLn1e3;
+  // … and only when it is not dwarfed by the residual along the transfer
+  // errors: a bench effect's misfit beyond second order also leaves a slow
+  // part (refsim cases 13 and 14, dielectric loss: baseline Δχ² 0.3-0.4 % of
+  // the transfer errors' χ²), a baseline's Δχ² was 8-99 % of it on our
+  // disturbed study's captures. The cut between the two, 2 %, is a measured
+  // heuristic (update/README.md), not a test of chance.
+  d.baseline = best_logp < kLn1e3 && best_delta > kBaselineShare * d.transfer_error_chi2;
   d.mains_distinguishable =
       d.mains_known || (deltas.size() == 2 && d.harmonics > 0 && std::abs(deltas[0] - deltas[1]) > kPinkLr);
 
@@ -161,7 +211,7 @@ DisturbanceModel decide_disturbances(Problem& prob, const Averaged& rec, const s
   if (!(total > 0)) return d;
   const double top = shape.maxCoeff();
   // The projection removes about one bin per two columns at the bottom.
-  const std::size_t j0 = 1 + (static_cast<std::size_t>(q.cols()) + 1) / 2;
+  const std::size_t j0 = 1 + (static_cast<std::size_t>(q.cols() - errs.cols()) + 1) / 2;
   std::vector<double> zeta, g;
   std::vector<int> octave;
   for (std::size_t j = j0; j < half && j < static_cast<std::size_t>(shape.size()); ++j) {
@@ -239,6 +289,7 @@ OeBaseline report_disturbances(const DisturbanceModel& d, const PinkFilter* pink
   out.pink_ratio = d.pink_b;
   out.pink_rms_v = d.pink_rms_v;
   out.pink_delta_2lnl = d.pink_delta_2lnl;
+  out.transfer_error_chi2 = d.transfer_error_chi2;
   out.channel_offsets = rec.with_offsets;
   for (int c = 0; c < 2; ++c) {
     out.channel_offset_v[c] = rec.offset_v[c];

@@ -69,6 +69,7 @@ struct DisturbanceModel {
   double pink_b = 0;               // 1/f-to-white power ratio at the record's first bin
   double pink_delta_2lnl = 0;      // Whittle likelihood's gain from the 1/f term
   double pink_rms_v = 0;           // the 1/f noise's rms in the filtered residual, volts
+  double transfer_error_chi2 = 0;  // χ² along the generic transfer errors (transfer_error_columns)
   bool any() const { return baseline || pink; }
 };
 
@@ -79,6 +80,11 @@ Eigen::MatrixXd baseline_columns(Problem& prob, const Averaged& rec, const std::
 // Hum harmonics a record of `seconds` can hold apart from the polynomial
 // (h·f·T ≥ ½), at most 3.
 int hum_harmonics(double mains_hz, double seconds);
+
+// L ∗ (δT_k·v1) for the generic transfer errors δT_k = T^p·(jωτ)^q, p ≤ 3,
+// q ≤ 2: what a bench effect leaves in the residual to second order
+// (decide_disturbances measures a baseline beyond them).
+Eigen::MatrixXd transfer_error_columns(Problem& prob, const std::vector<cd>& t);
 
 // Decides the disturbance model at transfer t, from the raw (unwhitened)
 // filtered residual r (volts), the white noise σ of the filtered residual

@@ -59,6 +59,7 @@ class Problem {
   std::size_t samples() const { return idx_.size(); }
   int evaluations() const { return evaluations_; }  // FE port models built
   double sample_rate_hz() const { return fs_; }
+  double transfer_bin_hz() const { return fs_ / double(nfft_); }  // spacing of T(f_k)'s bins
 
   // The FE port model of the material part of x (θ without β) with an end
   // mass, from a small cache: the Jacobian's β and effect columns, the
