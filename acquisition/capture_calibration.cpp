@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <stdexcept>
 
 #include "acquisition/divider_record.hpp"
@@ -216,6 +217,29 @@ std::optional<CaptureCalibration> calibrate_from_capture(const Capture& cap,
   }
   if (load) cs.load = measure(*load, opt.fmin_hz, fmax, Role::Load, sk);
   if (cs.open || cs.shrt || cs.load) out.fixture = dsp::fit_fixture(cs);
+  // A fixture no bench has: R1 off its value by more than a resistor's
+  // tolerance allows, a capacitance across the DUT below zero or above 10 nF,
+  // channel 2 microseconds late. The standards' records then do not show the
+  // standards (mains hum or a baseline wander on a short's millivolts, a
+  // standard not connected as labelled): refused, never used to correct.
+  {
+    const auto& f = out.fixture;
+    std::string bad;
+    char b[160];
+    if (f.r1_error && std::abs(*f.r1_error) > 0.10) {
+      std::snprintf(b, sizeof b, "R1 off by %+.1f %% (beyond any resistor's tolerance, 10 %%)", 100 * *f.r1_error);
+      bad += b;
+    }
+    if (f.fixture_capacitance_f && (*f.fixture_capacitance_f < -50e-12 || *f.fixture_capacitance_f > 10e-9)) {
+      std::snprintf(b, sizeof b, "%scapacitance across the transducer %.0f pF (outside -50 pF ... 10 nF)",
+                    bad.empty() ? "" : ", ", 1e12 * *f.fixture_capacitance_f);
+      bad += b;
+    }
+    if (!bad.empty())
+      throw std::invalid_argument("calibration: the standards give a fixture no bench has: " + bad +
+                                  " - their records do not show the standards (hum or a baseline wander on "
+                                  "the short's millivolts, or a standard not connected as labelled)");
+  }
   if (out.fixture.skew_s) {  // total delay of channel 2: removed from the records + what the fit
                              // still sees
     out.fixture.skew_s = *out.fixture.skew_s + out.skew_applied_s;

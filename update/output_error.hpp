@@ -245,6 +245,37 @@ struct OeBaseline {
   bool any() const { return modelled || pink; }
 };
 
+// The shots' consistency before pooling (issue 33 item 2): each shot's
+// constants, linearised about the pooled answer (one Gauss–Newton step of the
+// shot's own residual on the answer's Jacobian), weighted by the shot's own
+// white noise (its pretrigger, else its high-pass estimate — a noise that
+// differences between the shots do not inflate). Their homogeneity χ², and
+// per constant the better of a linear drift over the shots and a step between
+// two of them.
+struct OeShotChange {
+  std::string parameter;  // YE11, nu12, d31, epsT33_rel, beta | qm_inverse
+  std::string kind;       // "drift" | "step"
+  double size_pct = 0, sigma_pct = 0;  // drift: last shot minus first, along the fitted line; step: after minus before
+  int after_shot = -1;    // step: between this shot and the next (indices among OeData::shots)
+  double z = 0;           // size / sigma
+};
+struct OeShotConsistency {
+  bool tested = false;    // two or more shots averaged
+  int shots = 0;
+  double chi2 = 0;        // homogeneity of the per-shot constants against their sigmas
+  int dof = 0;
+  double log10_p = 0;
+  bool consistent = true;  // chance above 1e-3
+  std::vector<std::vector<double>> per_shot_pct;  // each shot's constants, % from the pooled answer
+  std::vector<double> per_shot_sigma_pct;         // one shot's sigma of each constant, %
+  std::vector<OeShotChange> changes;              // the significant drifts and steps, largest z first
+  std::string summary;                            // one sentence ("" when consistent)
+  // Trigger jitter: each averaged shot's delay against the first (samples),
+  // and whether they were aligned before averaging (any beyond 0.1 sample).
+  std::vector<double> jitter_samples;
+  bool aligned = false;
+};
+
 struct OeResult {
   UpdateStatus status = UpdateStatus::bad_input;
   std::string message;
@@ -267,6 +298,7 @@ struct OeResult {
   std::string noise_source;                 // "shots" | "pretrigger" | "high-pass estimate"
   std::string offset_model;                 // how the DAQ offsets enter (pretrigger / unknown / the baseline's projection)
   OeBaseline baseline;                      // the slow disturbances found (issue 33)
+  OeShotConsistency shot_consistency;       // the shots' agreement before pooling (issue 33)
   double noise_rms_v = 0;                   // σ_r of the filtered residual samples
   double residual_rms_v = 0;                // of the filtered residual at the optimum
   double chi2_per_dof = 0;                  // (residual/noise)² per degree of freedom

@@ -55,6 +55,30 @@ nlohmann::json baseline_json(const update::OeBaseline& b) {
           {"shots", shots}};
 }
 
+nlohmann::json shot_consistency_json(const update::OeShotConsistency& c) {
+  nlohmann::json changes = nlohmann::json::array();
+  for (const auto& ch : c.changes) {
+    changes.push_back({{"parameter", ch.parameter},
+                       {"kind", ch.kind},
+                       {"size_pct", ch.size_pct},
+                       {"sigma_pct", ch.sigma_pct},
+                       {"z", ch.z}});
+    if (ch.kind == "step") changes.back()["after_shot"] = ch.after_shot;
+  }
+  return {{"tested", c.tested},
+          {"shots", c.shots},
+          {"chi2", c.chi2},
+          {"dof", c.dof},
+          {"log10_p", c.log10_p},
+          {"consistent", c.consistent},
+          {"per_shot_pct", c.per_shot_pct},
+          {"per_shot_sigma_pct", c.per_shot_sigma_pct},
+          {"changes", changes},
+          {"summary", c.summary},
+          {"jitter_samples", c.jitter_samples},
+          {"aligned", c.aligned}};
+}
+
 nlohmann::json output_error_json(const update::OeResult& r, const std::string& excitation) {
   nlohmann::json params = nlohmann::json::array();
   std::vector<std::string> names;
@@ -109,6 +133,7 @@ nlohmann::json output_error_json(const update::OeResult& r, const std::string& e
             {"lack_of_fit", r.lack_of_fit},
             {"offset_model", r.offset_model},
             {"baseline", baseline_json(r.baseline)},
+            {"shot_consistency", shot_consistency_json(r.shot_consistency)},
             {"chain_tolerances",
              {{"r1_rel_sigma", r.r1_rel_sigma},
               {"cp_sigma_f", r.cp_sigma_f},

@@ -21,5 +21,7 @@ nlohmann::json tube_params_json(const update::TubeParams& p);
 nlohmann::json output_error_json(const update::OeResult& r, const std::string& excitation);
 // The slow disturbances found (issue 33): OeResult/OePrediction::baseline.
 nlohmann::json baseline_json(const update::OeBaseline& b);
+// The shots' agreement before pooling (issue 33): OeResult::shot_consistency.
+nlohmann::json shot_consistency_json(const update::OeShotConsistency& c);
 
 }  // namespace piezo::jobs

@@ -61,6 +61,23 @@ void run_update_capture(Context& ctx, const std::string& file, const std::string
                   methods["oe"]["corr_nu12_d31"].get<double>(), fit["chi2_per_dof"].get<double>(),
                   fit["noise_source"].get<std::string>().c_str(), fit["shots"].get<int>(),
                   fit["band_hz"].get<double>());
+      // Issue 33: the slow disturbances modelled, and the shots' agreement.
+      if (fit.contains("baseline")) {
+        const auto& b = fit["baseline"];
+        if (b.value("modelled", false))
+          std::printf("    baseline projected out (offset, slope to degree %d%s): chi2 %.0f for %d parameters\n",
+                      b.value("poly_degree", 0), b.value("harmonics", 0) > 0 ? ", mains hum" : "",
+                      b.value("delta_chi2", 0.0), b.value("dof", 0));
+        if (b.contains("pink") && b["pink"].value("modelled", false))
+          std::printf("    1/f noise weighted as noise: %.3g mV rms in the band\n",
+                      1e3 * b["pink"].value("rms_v", 0.0));
+      }
+      if (fit.contains("shot_consistency")) {
+        const auto& c = fit["shot_consistency"];
+        if (c.value("aligned", false)) std::printf("    shots aligned for trigger jitter before averaging\n");
+        if (c.value("tested", false) && !c.value("consistent", true))
+          std::printf("    warning: %s\n", c.value("summary", std::string()).c_str());
+      }
     }
   }
   if (!converged) ctx.exit_code = kInternal;

@@ -25,6 +25,7 @@
 #include "update/output_error/noise.hpp"
 #include "update/output_error/parallel.hpp"
 #include "update/output_error/shot_average.hpp"
+#include "update/output_error/shot_consistency.hpp"
 #include "update/output_error/sigma.hpp"
 
 namespace piezo::update {
@@ -294,6 +295,9 @@ OeResult fit_output_error(model::ModalSolver& solver, const MaterialClass& cls,
                                        sigma, answer.s2);
   judge_lack_of_fit(answer, prob, opt, out);
   identify(answer, cov, nominal, opt, out);
+  out.shot_consistency = shot_consistency(answer, prob, whiten, rec, sigma, nominal.nu12 / out.updated.nu12,
+                                          out.parameters);
+
   models_elsewhere += scan_effects(answer, fitter, co, nominal, opt, out);
 
   out.status = best.converged ? UpdateStatus::converged : UpdateStatus::max_iterations;
