@@ -317,8 +317,12 @@ GapDiagnosis gap_from_output_error(const OeResult& r, const std::string& fit_des
 
 GapDiagnosis gap_from_output_error(const OeResult& r, const std::string& fit_description,
                                    model::ModalSolver& solver, const MaterialClass& cls, const OeHeldout& heldout,
-                                   const OeOptions& options) {
+                                   const OeOptions& options_in) {
   const auto t0 = std::chrono::steady_clock::now();
+  // The held-out capture comes from the same bench: its 1/f noise is weighted
+  // as noise when the fit's capture showed it (OeOptions::heldout_pink).
+  OeOptions options = options_in;
+  options.heldout_pink = r.baseline.pink;
   HeldoutPredictions ho;
   ho.description = heldout.description;
   ho.min_shrink = heldout.min_shrink;

@@ -151,6 +151,10 @@ struct OeOptions {
   // starts are refitted under it). false: the white model with the offset
   // alone, as before.
   bool disturbances = true;
+  // A held-out prediction weighs its capture's 1/f noise only when this is
+  // set (the fit's capture, on the same bench, showed 1/f noise): a
+  // prediction's own misfit can look like 1/f noise (prediction.cpp).
+  bool heldout_pink = false;
   double effect_significance = 25.0;  // Δχ² (one parameter) beyond this, scaled by χ²/ν when > 1
   double alias_threshold = 0.05;
 };

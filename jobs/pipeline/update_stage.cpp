@@ -220,6 +220,20 @@ std::optional<update::OeResult> output_error_stage(const PipelineRequest& req, c
       out.warnings.push_back(std::string(w) +
                              ": its constants are marked not identifiable; the gap diagnosis looks for the cause");
     }
+    // Issue 33: the bench's slow disturbances modelled, and shots that disagree.
+    if (r.baseline.modelled || r.baseline.pink) {
+      char w[320];
+      std::snprintf(w, sizeof w, "bench disturbances modelled as nuisance (not effects):%s%s%s",
+                    r.baseline.modelled ? " baseline wander (offset, slope to degree 3" : "",
+                    r.baseline.modelled ? (r.baseline.harmonics > 0 ? ", mains hum) projected out" : ") projected out")
+                                        : "",
+                    r.baseline.pink ? (r.baseline.modelled ? "; 1/f noise weighted as noise" : " 1/f noise weighted as noise")
+                                    : "");
+      out.warnings.push_back(w);
+    }
+    if (r.shot_consistency.tested && !r.shot_consistency.consistent)
+      out.warnings.push_back("non-stationary between shots: " + r.shot_consistency.summary);
+    if (r.shot_consistency.aligned) out.warnings.push_back("shots aligned for trigger jitter before averaging");
     out.output_error = r;
     out.output_error_excitation = f.excitation;
     return r;

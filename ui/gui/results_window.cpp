@@ -78,6 +78,38 @@ void parameter_table(const jobs::PipelineResult& r) {
   }
   ImGui::EndTable();
 }
+// The bench's slow disturbances the output-error fit modelled, and the shots'
+// agreement (issue 33): numbers the fit already holds, drawn only.
+void disturbances_block(const update::OeResult& o) {
+  const auto& b = o.baseline;
+  const auto& c = o.shot_consistency;
+  if (!b.any() && !b.channel_offsets && !c.tested) return;
+  if (!ImGui::CollapsingHeader("Bench disturbances")) return;
+  if (b.channel_offsets)
+    ImGui::Text("offsets (pretrigger): ch1 %+.3g mV +/- %.2g, ch2 %+.3g mV +/- %.2g", 1e3 * b.channel_offset_v[0],
+                1e3 * b.channel_offset_sigma_v[0], 1e3 * b.channel_offset_v[1], 1e3 * b.channel_offset_sigma_v[1]);
+  if (b.modelled) {
+    ImGui::Text("baseline ch1-ch2 projected out: slope %.3g +/- %.2g V/s (chi2 %.0f for %d parameters)",
+                b.slope_v_per_s, b.slope_sigma_v_per_s, b.delta_chi2, b.dof);
+    if (b.harmonics > 0 && std::isfinite(b.hum_v))
+      ImGui::Text("mains hum %.0f Hz%s: %.3g mV +/- %.2g", b.mains_hz, b.mains_distinguishable ? "" : " (or 60/50)",
+                  1e3 * b.hum_v, 1e3 * b.hum_sigma_v);
+    else
+      ImGui::TextDisabled("mains hum: inside the polynomial (record below half a mains cycle)");
+  } else {
+    ImGui::TextDisabled("no baseline wander beyond the offsets");
+  }
+  if (b.pink)
+    ImGui::Text("1/f noise: %.3g mV rms in the band, weighted as noise", 1e3 * b.pink_rms_v);
+  if (c.tested) {
+    if (c.consistent)
+      ImGui::Text("%d shots consistent (chi2 %.0f for %d dof)", c.shots, c.chi2, c.dof);
+    else
+      ImGui::TextColored(ImVec4(1, 0.6f, 0.2f, 1), "%s", c.summary.c_str());
+    if (c.aligned) ImGui::TextDisabled("shots aligned for trigger jitter before averaging");
+  }
+}
+
 // Pass / fail against the loaded limits, with one line per reason.
 void limits_line(const jobs::report::CaptureVerdict& v, const std::string& file) {
   const bool pass = v.status == "pass";
@@ -114,6 +146,7 @@ void render_results_window(AppState& s) {
       ImGui::TextDisabled("No updated parameters (see the stages below).");
     else
       parameter_table(r);
+    if (r.output_error) disturbances_block(*r.output_error);
     if (!r.curves.empty()) {  // the exports need at least the impedance estimate
       ImGui::SetNextItemWidth(150);
       ImGui::InputText("##export", s.export_base, sizeof s.export_base);

@@ -61,10 +61,11 @@ OePrediction predict_output_error(model::ModalSolver& solver, const MaterialClas
     // chirp sweeping through a bench effect's band leaves a broad low-
     // frequency excess that reads as 1/f noise 1e4 times the white floor
     // (test_gap_output_error's 30 ohm lead), which the 1/f weighting would
-    // hide. 1/f noise in a held-out capture counts as misfit (conservative).
+    // hide. It is weighted only where the fit's own capture, on the same
+    // bench, showed 1/f noise (OeOptions::heldout_pink).
     DisturbanceModel d = decide_disturbances(prob, rec, *t, prob.residual_of(*t), sigma, noise.ch1, noise.ch2, fs,
                                              data.mains_hz);
-    d.pink = false;
+    d.pink = d.pink && opt.heldout_pink;
     whiten.use(d, prob, rec, *t);
     out.baseline = report_disturbances(d, whiten.pink.get(), whiten.columns, prob, rec, *t, sigma, 1.0);
   }
