@@ -10,7 +10,7 @@ the acceptance counts.
 
 usage: scripts/disturbance-study.py BUILD/ui/piezobench WORKDIR [N]
 """
-import json, os, random, subprocess, sys
+import json, math, os, random, subprocess, sys
 
 exe, work = sys.argv[1], sys.argv[2]
 n = int(sys.argv[3]) if len(sys.argv) > 3 else 20
@@ -85,3 +85,13 @@ print("sigmas within 1.5x of the clean capture's: %d/%d (max ratio %.2f, median 
     ratio_ok, len(rows), max(max(r["ratio"].values()) for r in rows),
     sorted(max(r["ratio"].values()) for r in rows)[len(rows) // 2]))
 print("verdicts: %s" % {v: sum(r["verdict"] == v for r in rows) for v in set(r["verdict"] for r in rows)})
+# Acceptance (issue 33): verdict none and sigmas within 1.5x in >= 18/20, no
+# catalogue effect named. The constants' 1/3/3/1 % bound is printed, not
+# asserted: the same captures without any disturbance miss it as often (one
+# shot at 1-3 % noise gives nu12 and d31 sigmas of 2-5 %).
+need = int(math.ceil(0.9 * len(rows)))
+nones = sum(r["verdict"] == "none" for r in rows)
+named = sum(r["verdict"] not in ("none", "unexplained", "non_stationary") for r in rows)
+if nones < need or ratio_ok < need or named:
+    sys.exit("FAILED: verdict none %d, sigmas within 1.5x %d (need %d), effects named %d" % (nones, ratio_ok, need, named))
+

@@ -77,3 +77,9 @@ print("%s found in epsT33 with its size within 3 sigma (and place): %d/%d; found
     kind, sum(r["ok"] for r in rows), len(rows), sum(r["found"] for r in rows), len(rows)))
 print("pooled constants within 1/3/3/1 %% of the mean state: %d/%d" % (sum(r["within"] for r in rows), len(rows)))
 print("catalogue effects named: %d/%d" % (sum(r["named"] for r in rows), len(rows)))
+need = int(math.ceil(0.9 * len(rows)))
+ok = sum(r["ok"] for r in rows)
+named = sum(r["named"] for r in rows)
+if ok < need or named:
+    sys.exit("FAILED: %s found with its size within 3 sigma in %d (need %d), effects named %d" % (kind, ok, need, named))
+
