@@ -251,9 +251,9 @@ struct OeBaseline {
 
 // The shots' consistency before pooling (issue 33 item 2): each shot's
 // constants, linearised about the pooled answer (one Gauss–Newton step of the
-// shot's own residual on the answer's Jacobian), weighted by the shot's own
-// white noise (its pretrigger, else its high-pass estimate — a noise that
-// differences between the shots do not inflate). Their homogeneity χ², and
+// shot's own residual on the answer's Jacobian), weighted by one shot's noise
+// measured as the shots' scatter orthogonal to the constants' directions (a
+// drift or step of the constants does not inflate it). Their homogeneity χ², and
 // per constant the better of a linear drift over the shots and a step between
 // two of them.
 struct OeShotChange {
@@ -269,7 +269,7 @@ struct OeShotConsistency {
   double chi2 = 0;        // homogeneity of the per-shot constants against their sigmas
   int dof = 0;
   double log10_p = 0;
-  bool consistent = true;  // chance above 1e-3
+  bool consistent = true;  // chance above 1e-6 (shot_consistency.cpp: why not 1e-3)
   std::vector<std::vector<double>> per_shot_pct;  // each shot's constants, % from the pooled answer
   std::vector<double> per_shot_sigma_pct;         // one shot's sigma of each constant, %
   std::vector<OeShotChange> changes;              // the significant drifts and steps, largest z first
