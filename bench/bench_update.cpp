@@ -4,9 +4,13 @@
 
 #include <cmath>
 #include <random>
+#include <vector>
 
+#include "model/material_presets.hpp"
+#include "model/material_spec.hpp"
 #include "model/transient.hpp"
 #include "update/least_squares.hpp"
+#include "update/output_error.hpp"
 #include "update/port_fit.hpp"
 #include "update/updater.hpp"
 
@@ -100,5 +104,62 @@ void BM_PortFit(benchmark::State& state) {
   }
 }
 BENCHMARK(BM_PortFit)->Unit(benchmark::kMillisecond);
+
+// Issue 33's speed target: a one-shot output-error fit with the slow
+// disturbances' model still under 0.5 s. One exp_decay shot (20 000 samples
+// at 10 MS/s, 2 % white noise) of a tube 4 % off the nominal; Arg(1) adds DC
+// offsets, 50 Hz hum with harmonics and 1/f noise at 1 % (the baseline is
+// projected out, the 1/f noise whitened and the starts run again), Arg(0) is
+// the same record without them (the white model, as before issue 33).
+void BM_OutputErrorOneShot(benchmark::State& state) {
+  pm::TubeModel tube(pm::TubeGeometry{});
+  pm::ModalSolver solver(tube);
+  const auto cls = pu::MaterialClass::isotropic();
+  const auto nominal = pm::isotropic_params(pm::resolve_material({"apc850", true, ""}).d);
+  auto truth = nominal;
+  truth.y_e11 *= 1.04;
+  truth.eps_t33 *= 0.98;
+  const double fs = 10e6;
+  const std::size_t n = 20000, pre = 200;
+  std::vector<double> v1(n, 0.0);
+  for (std::size_t i = pre; i < n; ++i) v1[i] = std::exp(-3000.0 * double(i - pre) / fs);
+  pm::ModalOptions mo;
+  mo.n_modes = 40;
+  pm::DividerCircuit c;
+  c.r1_ohm = 3140.0;
+  std::vector<double> v2 = pm::simulate_divider(solver.port_model(cls.e_form(truth), mo), {0.0, 6e-8}, c, v1, fs);
+  std::mt19937_64 rng(7);
+  std::normal_distribution<double> nd;
+  auto rms = [](const std::vector<double>& v) {
+    double a = 0;
+    for (double x : v) a += x * x;
+    return std::sqrt(a / double(v.size()));
+  };
+  for (auto* v : {&v1, &v2}) {
+    const double s = 0.02 * rms(*v), level = 0.01 * rms(*v);
+    double pink = 0;  // 1/f by a leaky integrator of white noise (enough for a timing)
+    for (std::size_t i = 0; i < n; ++i) {
+      (*v)[i] += s * nd(rng);
+      if (state.range(0)) {
+        pink = 0.999 * pink + 0.045 * level * nd(rng);
+        const double th = 2 * M_PI * 50.0 * double(i) / fs + 0.7;
+        (*v)[i] += 0.005 + 0.006 * (std::sin(th) + 0.3 * std::sin(2 * th)) + pink;
+      }
+    }
+  }
+  pu::OeData d;
+  d.sample_rate_hz = fs;
+  d.circuit.r1_ohm = 3140.0;
+  d.shots.push_back({v1, v2, pre});
+  bool modelled = false;
+  for (auto _ : state) {
+    const auto r = pu::fit_output_error(solver, cls, nominal, d);
+    if (!r.ok()) state.SkipWithError(r.message.c_str());
+    modelled = r.baseline.any();
+    benchmark::DoNotOptimize(r);
+  }
+  state.counters["disturbances_modelled"] = modelled ? 1 : 0;
+}
+BENCHMARK(BM_OutputErrorOneShot)->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond)->Iterations(5);
 
 }  // namespace

@@ -11,7 +11,6 @@
 
 #include "dsp/deskew.hpp"
 #include "dsp/fft.hpp"
-#include "dsp/prony_ss.hpp"
 #include "update/output_error/common.hpp"
 
 namespace piezo::update::oe {
@@ -128,22 +127,7 @@ Averaged average(const OeData& d) {
     }
   }
   a.shots = static_cast<int>(used.size());
-  for (const OeShot* s : used) {
-    a.index.push_back(static_cast<int>(s - d.shots.data()));
-    auto white = [&](std::span<const double> v) {
-      if (s->pretrigger >= 64 && s->pretrigger < v.size()) {
-        double m = 0, q = 0;
-        for (std::size_t i = 0; i < s->pretrigger; ++i) m += v[i];
-        m /= double(s->pretrigger);
-        for (std::size_t i = 0; i < s->pretrigger; ++i) q += (v[i] - m) * (v[i] - m);
-        return std::sqrt(q / double(s->pretrigger - 1));
-      }
-      const Eigen::Map<const Eigen::VectorXd> x(v.data(), static_cast<Eigen::Index>(v.size()));
-      return dsp::estimate_noise_std(x);
-    };
-    a.white1.push_back(white(s->v1));
-    a.white2.push_back(white(s->v2));
-  }
+  for (const OeShot* s : used) a.index.push_back(static_cast<int>(s - d.shots.data()));
   for (auto& v : a.v1) v /= a.shots;
   for (auto& v : a.v2) v /= a.shots;
   if (a.shots >= 2)

@@ -20,16 +20,12 @@ struct Averaged {
   std::size_t pretrigger = 0;
   std::vector<std::vector<double>> dev1, dev2;  // each shot minus the average (K ≥ 2)
   int shots = 0;
-  // Per used shot (K ≥ 2): its index among OeData::shots and each channel's
-  // white noise (the pretrigger's std with 64 samples or more, else the
-  // high-pass estimate) — a noise that differences between shots (a drift, a
-  // step) do not inflate, for the shots' consistency (shot_consistency.hpp).
+  // Per used shot: its index among OeData::shots.
   std::vector<int> index;
   // Trigger jitter: each used shot's delay against the first (samples; the
   // first's is 0), and whether the shots were aligned before averaging.
   std::vector<double> jitter_samples;
   bool aligned = false;
-  std::vector<double> white1, white2;
   // The pretrigger's means removed from each channel (with_offsets: a
   // pretrigger of 16 samples or more), and their standard errors.
   bool with_offsets = false;

@@ -55,7 +55,7 @@ OeShotConsistency shot_consistency(const FitAnswer& answer, Problem& prob, const
   out.aligned = rec.aligned;
   const int K = rec.shots;
   const Eigen::MatrixXd& j = answer.best.j;
-  if (K < 2 || rec.dev1.size() != static_cast<std::size_t>(K) || rec.white1.size() != rec.dev1.size() ||
+  if (K < 2 || rec.dev1.size() != static_cast<std::size_t>(K) ||
       !answer.t || j.cols() != kParams || j.rows() == 0 || !(sigma > 0) || parameters.size() < kParams)
     return out;
   const Eigen::VectorXd r0 = prob.residual_of(*answer.t);
