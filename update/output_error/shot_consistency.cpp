@@ -204,10 +204,10 @@ OeShotConsistency shot_consistency(const FitAnswer& answer, Problem& prob, const
     for (std::size_t i = 0; i < out.changes.size(); ++i) {
       const auto& ch = out.changes[i];
       if (ch.kind == "step")
-        std::snprintf(buf, sizeof buf, " %s step %+.2f %% +/- %.2f %% between shots %d and %d", ch.parameter.c_str(),
+        std::snprintf(buf, sizeof buf, " %s step %+.2f %% +/- %.2g %% between shots %d and %d", ch.parameter.c_str(),
                       ch.size_pct, ch.sigma_pct, ch.after_shot, ch.after_shot + 1);
       else
-        std::snprintf(buf, sizeof buf, " %s drift %+.2f %% +/- %.2f %% over the %d shots", ch.parameter.c_str(),
+        std::snprintf(buf, sizeof buf, " %s drift %+.2f %% +/- %.2g %% over the %d shots", ch.parameter.c_str(),
                       ch.size_pct, ch.sigma_pct, K);
       out.summary += std::string(i ? ";" : "") + buf;
     }
