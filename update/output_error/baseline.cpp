@@ -113,8 +113,7 @@ Eigen::MatrixXd transfer_error_columns(Problem& prob, const std::vector<cd>& t) 
   const std::vector<cd> zero(t.size(), cd(0.0, 0.0));
   const Eigen::VectorXd base = prob.residual_of(zero);  // −L ∗ v2
   // τ: a quarter of the band's period scale (the columns' sizes comparable).
-  double fmax = 0;
-  for (std::size_t k = 0; k < t.size(); ++k) fmax = double(k) * prob.transfer_bin_hz();
+  const double fmax = double(t.size() - 1) * prob.transfer_bin_hz();
   const double tau = fmax > 0 ? 1.0 / (kTwoPi * fmax / 2.5) : 0.0;
   // T^p·(jωτ)^q for p = 1..3, q = 0..2: the transfer errors of the bench's
   // effects to second order (T² is 1/(1 + R1·Y)² — a load on the tube; T³ its
@@ -310,7 +309,11 @@ OeBaseline report_disturbances(const DisturbanceModel& d, const PinkFilter* pink
   const double seconds = double(rec.v1.size()) / prob.sample_rate_hz();
   const Eigen::Index nc = columns.cols();
   // hum's fundamental: the first cos/sin pair after the polynomial
-  const Eigen::Index hum0 = d.baseline && d.harmonics > 0 && nc >= d.poly_degree + 3 ? d.poly_degree + 1 : -1;
+  // (only when the fundamental itself is in the columns: a record of 5–10 ms
+  // at 50 Hz holds the 2nd and 3rd harmonics' half cycle but not its own)
+  const bool fundamental = d.mains_hz * seconds >= 0.5;
+  const Eigen::Index hum0 =
+      d.baseline && d.harmonics > 0 && fundamental && nc >= d.poly_degree + 3 ? d.poly_degree + 1 : -1;
   auto hum_of = [&](const Eigen::VectorXd& c) { return hum0 >= 0 ? std::hypot(c[hum0], c[hum0 + 1]) : nan; };
   const Eigen::VectorXd c = cod.solve(whiten(r));
   out.offset_v = c[0];
