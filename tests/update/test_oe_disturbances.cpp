@@ -20,7 +20,7 @@
 //    it is with its size within 3 sigma, and the diagnosis names no effect
 //    ("non_stationary"); shots with trigger jitter (sampled from a 4x finer
 //    simulation at other phases: not the aligner's interpolation) are
-//    measured within 0.05 sample and aligned.
+//    measured within 0.1 sample (4 sigma) and aligned.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -305,7 +305,10 @@ TEST_F(OeDisturbances, TriggerJitterIsMeasuredAndTheShotsAligned) {
   const auto& sc = r.shot_consistency;
   ASSERT_EQ(sc.jitter_samples.size(), 4u);
   EXPECT_TRUE(sc.aligned);
-  for (int k = 1; k < 4; ++k) EXPECT_NEAR(std::abs(sc.jitter_samples[std::size_t(k)]), 0.75 * k, 0.05) << k;
+  // The onset's timing sigma: noise 0.006 V over a slope of about 0.08 V per
+  // sample on the ~20 samples of the rise, two noisy records: ≈ 0.025
+  // sample; 0.1 is four of it.
+  for (int k = 1; k < 4; ++k) EXPECT_NEAR(std::abs(sc.jitter_samples[std::size_t(k)]), 0.75 * k, 0.1) << k;
   EXPECT_TRUE(sc.consistent) << sc.summary;
   EXPECT_FALSE(r.lack_of_fit) << r.chi2_per_dof;
   for (int i = 0; i < 4; ++i) {

@@ -24,7 +24,8 @@ namespace {
 // differences' amplified noise, is) and above the noise. Only the 512 samples from 64 before the
 // onset: the rest of the record adds noise and no timing. A jump's sub-sample
 // position is not in its samples: a step drive's jitter comes out to the
-// sample; a drive that rises over a few samples gives it to a few hundredths.
+// sample; a drive that ramps from idle over a sample or more (the simulated
+// AWG's, a real AWG's reconstruction) gives it to a few hundredths.
 double shot_delay_samples(std::span<const double> v0, std::span<const double> vk, std::size_t onset) {
   const std::size_t n = v0.size();
   const std::size_t lo = onset > 64 ? onset - 64 : 0;
@@ -42,18 +43,32 @@ double shot_delay_samples(std::span<const double> v0, std::span<const double> vk
   std::vector<cd> x0(fft.bins()), xk(fft.bins());
   fft.forward(d0.data(), w, x0.data());
   fft.forward(dk.data(), w, xk.data());
-  // The bins where the onset stands above the noise: |X0·Xk| ten times the
-  // median of the upper half of the band (noise there for any drive that rises
-  // over more than a sample; a jump's flat spectrum passes everywhere).
-  std::vector<double> hi;
-  for (std::size_t j = nfft / 4; j < fft.bins(); ++j) hi.push_back(std::abs(x0[j] * xk[j]));
-  std::nth_element(hi.begin(), hi.begin() + static_cast<long>(hi.size() / 2), hi.end());
-  const double floor = hi.empty() ? 0.0 : hi[hi.size() / 2];
+  // The bins where the onset stands above the noise: |X0·Xk| beyond 10× its
+  // noise, w·σ0·σk with σ the differences' std before the onset (the
+  // pretrigger's 64 samples); without a pretrigger, 10× the median of the
+  // upper half of the band (noise there for a drive that rises over more
+  // than a sample).
+  double floor = 0;
+  if (onset >= 64) {
+    auto sd = [&](const std::vector<double>& d) {
+      double m = 0, q = 0;
+      for (std::size_t i = 1; i < 64; ++i) m += d[i];
+      m /= 63.0;
+      for (std::size_t i = 1; i < 64; ++i) q += (d[i] - m) * (d[i] - m);
+      return std::sqrt(q / 62.0);
+    };
+    floor = 10.0 * double(w) * sd(d0) * sd(dk);
+  } else {
+    std::vector<double> hi;
+    for (std::size_t j = nfft / 4; j < fft.bins(); ++j) hi.push_back(std::abs(x0[j] * xk[j]));
+    std::nth_element(hi.begin(), hi.begin() + static_cast<long>(hi.size() / 2), hi.end());
+    floor = hi.empty() ? 0.0 : 10.0 * hi[hi.size() / 2];
+  }
   double num = 0, den = 0;
   for (std::size_t j = 1; j <= nfft / 8; ++j) {
     const double om = kTwoPi * double(j) / double(nfft);
     const cd c = std::conj(x0[j]) * xk[j] * std::polar(1.0, om * m0);
-    if (!(std::abs(c) > 10.0 * floor)) continue;
+    if (!(std::abs(c) > floor)) continue;
     num += std::abs(c) * om * std::arg(c);
     den += std::abs(c) * om * om;
   }
