@@ -289,18 +289,8 @@ GapDiagnosis build(const OeResult& r, const std::string& fit_description, const 
   // Shots that disagree (a drift, a step): the pooled record mixes two or
   // more states of the tube, whose misfit an effect of the catalogue may
   // mimic (a step of epsT33 and d31 read as channel_skew): no effect is named.
-  const OeShotConsistency& sc = r.shot_consistency;
-  if (sc.tested && !sc.consistent) {
-    d.disturbances.insert(d.disturbances.begin(), "Non-stationary between shots: " + sc.summary);
-    d.verdict_effect = "non_stationary";
-    d.added.clear();
-    d.steps.clear();
-    d.verdict_alternatives.clear();
-    d.gap = true;
-    d.verdict = "The transducer changed between the shots (not an effect of the catalogue, none is named): " +
-                sc.summary + " Measure again once it is stable, or fit the shots in groups.";
-  }
-  if (d.disturbances.size() > (sc.tested && !sc.consistent ? 1u : 0u)) {
+  const bool non_stationary = mark_non_stationary(d, r.shot_consistency);
+  if (d.disturbances.size() > (non_stationary ? 1u : 0u)) {
     d.verdict += " Bench disturbances (not effects of the catalogue, modelled as nuisance):";
     for (const auto& s : d.disturbances)
       if (s.rfind("Non-stationary", 0) != 0) d.verdict += " " + s;  // that one is the verdict's own
@@ -313,6 +303,19 @@ GapDiagnosis build(const OeResult& r, const std::string& fit_description, const 
 
 GapDiagnosis gap_from_output_error(const OeResult& r, const std::string& fit_description) {
   return build(r, fit_description, nullptr);
+}
+
+bool mark_non_stationary(GapDiagnosis& d, const OeShotConsistency& sc) {
+  if (!sc.tested || sc.consistent) return false;
+  d.disturbances.insert(d.disturbances.begin(), "Non-stationary between shots: " + sc.summary);
+  d.verdict_effect = "non_stationary";
+  d.added.clear();
+  d.steps.clear();
+  d.verdict_alternatives.clear();
+  d.gap = true;
+  d.verdict = "The transducer changed between the shots (not an effect of the catalogue, none is named): " +
+              sc.summary + " Measure again once it is stable, or fit the shots in groups.";
+  return true;
 }
 
 GapDiagnosis gap_from_output_error(const OeResult& r, const std::string& fit_description,

@@ -43,6 +43,13 @@ namespace piezo::update {
 // `r` from fit_output_error with scan_effects set. `fit_description` names the data.
 GapDiagnosis gap_from_output_error(const OeResult& r, const std::string& fit_description);
 
+// Shots that disagree (issue 33; OeShotConsistency): the verdict becomes
+// "non_stationary" with the consistency's summary, no effect is named, and
+// the finding leads d.disturbances. Both diagnosis paths (the output-error
+// one and the impedance-domain one on the update's fit) call it. Returns
+// whether it applied.
+bool mark_non_stationary(GapDiagnosis& d, const OeShotConsistency& sc);
+
 // The same, checked on held-out data: `heldout` another capture (its own R1
 // and noise), predicted by the fit's model with the solver and class of the
 // fit. Throws std::invalid_argument for unusable held-out data.

@@ -238,18 +238,7 @@ void diagnose_stage(const PipelineRequest& req, const acq::Capture& cap, const C
   // Shots that disagree (issue 33): the update's output-error fit tested them
   // on all the capture's shots; an impedance-domain diagnosis on averaged
   // halves of them would mix the tube's states and name no cause for it.
-  if (out.output_error && out.output_error->shot_consistency.tested &&
-      !out.output_error->shot_consistency.consistent) {
-    const auto& sc = out.output_error->shot_consistency;
-    d.disturbances.insert(d.disturbances.begin(), "Non-stationary between shots: " + sc.summary);
-    d.verdict_effect = "non_stationary";
-    d.added.clear();
-    d.steps.clear();
-    d.verdict_alternatives.clear();
-    d.gap = true;
-    d.verdict = "The transducer changed between the shots (not an effect of the catalogue, none is named): " +
-                sc.summary + " Measure again once it is stable, or fit the shots in groups.";
-  }
+  if (out.output_error) update::mark_non_stationary(d, out.output_error->shot_consistency);
   char note[200];
   std::snprintf(note, sizeof note, "gap chi2/dof %.2f on %s%s; verdict: %s", d.gap_fit,
                 fit.description.c_str(), ho ? (", held-out " + std::to_string(d.gap_heldout.value_or(0)).substr(0, 5)).c_str() : "",
