@@ -262,48 +262,94 @@ namespace {
 // The parallel resonances fp_k of the lossless network, one above each fs_k:
 // its susceptance runs from −∞ just above fs_k to +∞ just below fs_{k+1} (or
 // as ωC0 → ∞ above the last): one zero between (Foster's reactance theorem).
-std::vector<double> parallel_resonances(const EquivalentCircuit& c) {
+// A weak branch between a strong one's fs and fp (C_j below a tenth of C_k,
+// fs_j below the strong branch's one-branch fp = fs_k·√(1 + C_k/C0)) would
+// take that zero, and the strong mode's fp would be reported at the weak
+// one's: such a "guest" lies where its host's background is inductive, has no
+// parallel resonance above its fs (fp NaN), and its host's fp is the zero of
+// the network with the guests standing as their static capacitance C_j.
+struct Resonances {
   std::vector<double> fp;
-  auto bsus = [&](double f) { return c.lossless_susceptance(f); };
-  for (std::size_t k = 0; k < c.branches.size(); ++k) {
+  std::vector<int> host;  // a guest's host branch; −1 for the others
+  // The next branch that is not a guest of this one (its fs bounds the
+  // mode's window and its |Z| maximum); −1 above the last.
+  std::vector<int> next;
+};
+
+Resonances parallel_resonances(const EquivalentCircuit& c) {
+  const std::size_t n = c.branches.size();
+  Resonances r;
+  r.fp.assign(n, kNaN);
+  r.host.assign(n, -1);
+  r.next.assign(n, -1);
+  for (std::size_t k = 0; k < n; ++k) {
+    const auto& b = c.branches[k];
+    if (r.host[k] >= 0 || !(c.c0_f > 0)) continue;
+    const double fp1 = b.fs_hz() * std::sqrt(1.0 + b.c_f / c.c0_f);
+    for (std::size_t j = k + 1; j < n && c.branches[j].fs_hz() < fp1; ++j)
+      if (c.branches[j].c_f < 0.1 * b.c_f) r.host[j] = static_cast<int>(k);
+  }
+  for (std::size_t k = 0; k < n; ++k) {
+    for (std::size_t j = k + 1; j < n; ++j)
+      if (r.host[j] != static_cast<int>(k) || r.host[k] >= 0) {
+        r.next[k] = static_cast<int>(j);
+        break;
+      }
+    if (r.host[k] >= 0) continue;
+    EquivalentCircuit e = c;  // the guests of k as their static capacitance
+    e.branches.clear();
+    for (std::size_t j = 0; j < n; ++j) {
+      if (r.host[j] == static_cast<int>(k))
+        e.c0_f += c.branches[j].c_f;
+      else
+        e.branches.push_back(c.branches[j]);
+    }
+    auto bsus = [&](double f) { return e.lossless_susceptance(f); };
     const double fs = c.branches[k].fs_hz();
     const double lo = fs * (1 + 1e-12);
-    double hi = k + 1 < c.branches.size() ? c.branches[k + 1].fs_hz() * (1 - 1e-12) : 2 * fs;
-    if (k + 1 == c.branches.size())
+    double hi = r.next[k] >= 0 ? c.branches[static_cast<std::size_t>(r.next[k])].fs_hz() * (1 - 1e-12) : 2 * fs;
+    if (r.next[k] < 0)
       while (bsus(hi) < 0 && hi < fs * 1e6) hi *= 2;
-    fp.push_back(hi > lo && bsus(lo) < 0 && bsus(hi) > 0 ? bisect(bsus, lo, hi) : kNaN);
+    r.fp[k] = hi > lo && bsus(lo) < 0 && bsus(hi) > 0 ? bisect(bsus, lo, hi) : kNaN;
   }
-  return fp;
+  return r;
 }
 
-// The window of branch k: half-way to the neighbours (fp of the one below, fs
-// of the one above); the outer modes open to the band's ends.
-std::pair<double, double> mode_window(const EquivalentCircuit& c, const std::vector<double>& fp, std::size_t k) {
+// The window of branch k: half-way to the neighbours (fp of the one below, or
+// its fs when it has none; fs of the next one that is not a guest of k); the
+// outer modes open to the band's ends.
+std::pair<double, double> mode_window(const EquivalentCircuit& c, const Resonances& r, std::size_t k) {
   const double fs = c.branches[k].fs_hz();
-  const double lo = k > 0 && std::isfinite(fp[k - 1]) ? 0.5 * (fp[k - 1] + fs) : 0.0;
-  const double hi = k + 1 < c.branches.size() && std::isfinite(fp[k])
-                        ? 0.5 * (fp[k] + c.branches[k + 1].fs_hz())
-                        : std::numeric_limits<double>::infinity();
+  double lo = 0.0;
+  if (k > 0) {
+    const double below = std::isfinite(r.fp[k - 1]) && r.fp[k - 1] < fs ? r.fp[k - 1] : c.branches[k - 1].fs_hz();
+    lo = 0.5 * (below + fs);
+  }
+  double hi = std::numeric_limits<double>::infinity();
+  if (r.next[k] >= 0) {
+    const double nfs = c.branches[static_cast<std::size_t>(r.next[k])].fs_hz();
+    hi = 0.5 * ((std::isfinite(r.fp[k]) && r.fp[k] < nfs ? r.fp[k] : fs) + nfs);
+  }
   return {lo, hi};
 }
 
-CircuitModeFigures figures_of(const EquivalentCircuit& c, const std::vector<double>& fps, std::size_t k) {
+CircuitModeFigures figures_of(const EquivalentCircuit& c, const Resonances& res, std::size_t k) {
   CircuitModeFigures m;
   const auto& b = c.branches[k];
-  const double fs = b.fs_hz(), q = b.qm(), fp = fps[k];
+  const double fs = b.fs_hz(), q = b.qm(), fp = res.fp[k];
   m.fs_hz.value = fs;
   m.fp_hz.value = fp;
   m.qm_branch.value = q;
   m.r1_ohm.value = b.r_ohm;
   m.l1_h.value = b.l_h;
   m.c1_f.value = b.c_f;
-  std::tie(m.window_lo_hz, m.window_hi_hz) = mode_window(c, fps, k);
+  std::tie(m.window_lo_hz, m.window_hi_hz) = mode_window(c, res, k);
   if (!std::isfinite(fp)) return m;
   m.k_eff_ieee176.value = std::sqrt(std::max(0.0, 1.0 - std::pow(fs / fp, 2)));
   // |Z| extrema of the lossy network: the minimum below fp, the maximum above it.
   const double span = (fp - fs) + 3.0 * fs / q;
   const double a = std::max(std::max(m.window_lo_hz, 1e-9 * fs), fs - span);
-  const double next_fs = k + 1 < c.branches.size() ? c.branches[k + 1].fs_hz() : kNaN;
+  const double next_fs = res.next[k] >= 0 ? c.branches[static_cast<std::size_t>(res.next[k])].fs_hz() : kNaN;
   const double z_hi = std::isfinite(next_fs) ? next_fs : fp + span;
   auto absz = [&](double f) { return std::abs(c.impedance(f)); };
   m.fm_hz.value = grid_min(absz, a, fp);

@@ -56,7 +56,11 @@ struct Figure {
 struct CircuitModeFigures {
   // Motional branch (IEEE 176 "series" and "parallel" resonance of the
   // lossless network): fs = 1/(2π√(L_kC_k)); fp = the zero of the lossless
-  // susceptance between fs_k and fs_{k+1}.
+  // susceptance between fs_k and fs_{k+1}. A weak branch lying between a
+  // strong one's fs and fp (C_k below a tenth of the strong one's) would take
+  // that zero: it is the strong mode's "guest", has no fp (NaN: its
+  // background is inductive there), and the strong mode's fp is found with
+  // its guests standing as their static capacitance.
   Figure fs_hz, fp_hz;
   // |Z| minimum and maximum of the fitted network (IEEE 176 fm, fn).
   Figure fm_hz, fn_hz;

@@ -3,14 +3,20 @@
 #include <algorithm>
 #include <cmath>
 #include <fstream>
+#include <limits>
 #include <numbers>
 #include <ostream>
 #include <stdexcept>
 
+#include "acquisition/capture.hpp"
 #include "dsp/impedance_files/read_any.hpp"
 #include "jobs/impedance_job.hpp"
 #include "jobs/job_error.hpp"
+#include "jobs/json/output_error_json.hpp"
+#include "jobs/nominal_material.hpp"
+#include "jobs/pipeline/capture_fit.hpp"
 #include "jobs/report/figure_png.hpp"
+#include "update/model_figures.hpp"
 
 namespace piezo::jobs {
 
@@ -33,6 +39,83 @@ nlohmann::json fig(const dsp::Figure& f) {
 
 nlohmann::json num(double v) { return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json(nullptr); }
 
+// Relative RMS of the network against the data, over the points in [lo, hi]:
+// of Z, of |Z| and of |Y|; and how many points.
+struct Misfit {
+  double z = dsp::kNaN, abs_z = dsp::kNaN, abs_y = dsp::kNaN;
+  int points = 0;
+};
+Misfit misfit(const dsp::EquivalentCircuit& c, const Eigen::VectorXd& f, const Eigen::VectorXcd& z, double lo,
+              double hi) {
+  double sz = 0, sa = 0, sy = 0;
+  Misfit m;
+  for (Eigen::Index i = 0; i < f.size(); ++i) {
+    if (f[i] < lo || f[i] > hi || !(std::abs(z[i]) > 0)) continue;
+    const auto zf = c.impedance(f[i]);
+    sz += std::norm(zf - z[i]) / std::norm(z[i]);
+    sa += std::pow(std::abs(zf) / std::abs(z[i]) - 1, 2);
+    sy += std::pow(std::abs(z[i]) / std::abs(zf) - 1, 2);
+    ++m.points;
+  }
+  if (m.points) {
+    m.z = std::sqrt(sz / m.points);
+    m.abs_z = std::sqrt(sa / m.points);
+    m.abs_y = std::sqrt(sy / m.points);
+  }
+  return m;
+}
+
+// --method oe: the output-error fit of the capture, then the updated model's
+// figures (update/model_figures.hpp) within the fit's band (or --band).
+void figures_from_output_error(const FiguresRequest& req, const acq::Capture& cap, FiguresJobResult& out,
+                               double& band_hi) {
+  const auto nm = nominal_material(req.material, cap.setup.material);
+  if (nm.warning) out.warnings.push_back(*nm.warning);
+  CaptureFitRequest fr;
+  fr.material = nm.name;
+  const CaptureModel model = capture_model(cap, fr.material, fr.isotropic);
+  CaptureFit fit;
+  try {
+    fit = fit_capture(cap, fr, model);
+  } catch (const std::invalid_argument& e) {
+    throw InputError(req.file + ": " + e.what() + " (--method fft fits the circuit to the FFT estimate instead)");
+  }
+  const auto& r = fit.result;
+  out.output_error = output_error_json(r, fit.excitation);
+  if (!r.ok())
+    throw InputError(req.file + ": the output-error fit did not converge (" + r.message +
+                     "); no model to take figures from (--method fft fits the circuit to the FFT estimate)");
+  band_hi = req.band_hi_hz > 0 ? req.band_hi_hz : r.band_hz;
+  const auto mf = update::model_figures(*model.solver, model.cls, r.updated, r.loss(), update::total_covariance_rel(r),
+                                        req.band_lo_hz, band_hi, fr.options.modal, r.effect_set);
+  out.model_figures = true;
+  out.format = "oe";
+  out.quantity = "updated FE model (output-error fit of " + std::to_string(r.shots_used) + " " + fit.excitation +
+                 " shot(s), chi2/dof " + std::to_string(r.chi2_per_dof) + ")";
+  auto& cf = out.fit;
+  cf.circuit = mf.circuit;
+  cf.modes = mf.modes;
+  cf.c0_f = mf.c0_f;
+  cf.tan_delta = mf.tan_delta;
+  cf.rs_ohm = {0.0, 0.0};
+  cf.free_capacitance_f = mf.free_capacitance_f;
+  cf.parameters = static_cast<int>(r.parameters.size());
+  cf.chi2_per_dof = r.chi2_per_dof;  // of the samples, the fit's own
+  cf.converged = r.ok();
+  cf.notes = mf.notes;
+  cf.notes.push_back("figures of the updated FE model's short- and open-circuit modes (" +
+                     std::to_string(mf.port_models) + " FE port models: the answer and 2 per principal axis of the "
+                     "constants' covariance, type-B tolerances included); the data shown are the capture's FFT ratio");
+  if (r.lack_of_fit)
+    out.warnings.push_back("the output-error model does not explain the capture (chi2/dof " +
+                           std::to_string(r.chi2_per_dof) + "): the figures are the model's, their sigmas widened by "
+                           "the Birge ratio; an effect the model lacks may bias them");
+  for (const auto& p : r.parameters)
+    if (p.status != "ok")
+      out.warnings.push_back(p.name + " is not identifiable from this capture (" + p.reason +
+                             "): the figures that depend on it carry its sigma");
+}
+
 }  // namespace
 
 FiguresJobResult run_figures(const FiguresRequest& req) {
@@ -44,10 +127,14 @@ FiguresJobResult run_figures(const FiguresRequest& req) {
   std::vector<std::complex<double>> z;
   std::vector<double> zs;
   double hi_default = 0;
-  if (is_hdf5(req.file)) {
+  const bool capture = is_hdf5(req.file);
+  if (!capture && !req.method.empty())
+    throw InputError("--method " + req.method + " is for a capture (.h5): " + req.file + " is an impedance file");
+  const bool oe = capture && (req.method.empty() || req.method == "oe");
+  if (capture) {
     ImpedanceRequest ir;
     ir.file = req.file;
-    ir.method = req.method;
+    ir.method = oe ? "fft" : req.method;
     ir.uncertainty = "auto";
     const auto r = run_impedance(ir);
     out.source = "capture";
@@ -68,7 +155,9 @@ FiguresJobResult run_figures(const FiguresRequest& req) {
     hi_default = r.band_hz;
     if (!r.z.features.antiresonances.empty())
       hi_default = std::min(hi_default, 1.5 * r.z.features.antiresonances.back().f_hz);
-    if (!(req.band_hi_hz > 0))
+    if (oe)
+      figures_from_output_error(req, r.capture, out, hi_default);
+    else if (!(req.band_hi_hz > 0))
       out.notes.push_back("band up to " + std::to_string(static_cast<long>(hi_default)) +
                           " Hz (1.5 x the estimate's highest anti-resonance; --band sets another)");
   } else {
@@ -106,6 +195,31 @@ FiguresJobResult run_figures(const FiguresRequest& req) {
     out.f_hz[k] = f[i];
     out.z_ohm[k] = z[i];
     if (!zs.empty()) out.z_sigma_ohm[k] = zs[i];
+  }
+  if (out.model_figures) {  // the network is the model's: its misfit against the capture's estimate
+    auto& cf = out.fit;
+    cf.points = static_cast<int>(n);
+    cf.weighted = out.z_sigma_ohm.size() == n;
+    const auto all = misfit(cf.circuit, out.f_hz, out.z_ohm, 0, std::numeric_limits<double>::infinity());
+    cf.misfit_rel_rms = all.z;
+    cf.misfit_abs_rel_rms = all.abs_z;
+    cf.misfit_admittance_abs_rel_rms = all.abs_y;
+    for (auto& m : cf.modes) {
+      const auto w = misfit(cf.circuit, out.f_hz, out.z_ohm, m.window_lo_hz, m.window_hi_hz);
+      m.misfit_rel_rms = w.z;
+      m.points = w.points;
+    }
+    if (static_cast<int>(cf.modes.size()) > req.max_modes) {
+      cf.notes.push_back("reported the " + std::to_string(req.max_modes) + " strongest of " +
+                         std::to_string(cf.modes.size()) + " modes (--modes)");
+      std::stable_sort(cf.modes.begin(), cf.modes.end(), [](const auto& a, const auto& b) {
+        return a.k_eff_ieee176.value > b.k_eff_ieee176.value;
+      });
+      cf.modes.resize(static_cast<std::size_t>(req.max_modes));
+      std::sort(cf.modes.begin(), cf.modes.end(),
+                [](const auto& a, const auto& b) { return a.fs_hz.value < b.fs_hz.value; });
+    }
+    return out;
   }
   dsp::CircuitFitOptions opt;
   opt.max_branches = req.max_modes;
@@ -164,6 +278,16 @@ nlohmann::json figures_json(const FiguresRequest& req, const FiguresJobResult& r
   }
   j["notes"] = r.notes;
   for (const auto& s : fit.notes) j["notes"].push_back(s);
+  if (r.model_figures) {
+    j["figures_from"] = "updated FE model (output-error fit of the capture's samples)";
+    j["definitions"]["fs_hz, fp_hz"] =
+        "the updated FE model's short-circuit mode and the zero of its lossless susceptance (its open-circuit mode)";
+    j["definitions"]["sigma"] =
+        "1 sigma from the constants' covariance (Birge-widened under a lack of fit, type-B tolerances included)";
+    j["definitions"]["misfit_rel_rms"] = "of the model against the capture's FFT-ratio estimate (its noise included)";
+    j["output_error"] = r.output_error;
+  }
+  if (!r.warnings.empty()) j["warnings"] = r.warnings;
   return j;
 }
 

@@ -55,6 +55,15 @@ void print_text(const nlohmann::json& j) {
               j["points"].get<int>(), j["modes"].size(), fit["parameters"].get<int>(),
               fit["chi2_per_dof"].is_null() ? "-" : std::to_string(fit["chi2_per_dof"].get<double>()).c_str(),
               fit["misfit_abs_rel_rms"].get<double>() * 100, j["magnitude_only"].get<bool>() ? " (|Z| only)" : "");
+  if (j.contains("output_error") && j["output_error"].contains("parameters")) {
+    std::printf("  model          ");
+    for (const auto& p : j["output_error"]["parameters"]) {
+      const double v = p["value"].get<double>(), s = p["sigma"].get<double>();
+      std::printf(" %s %.5g +/- %.2g %%%s", p["name"].get<std::string>().c_str(), v,
+                  v != 0 ? 100 * s / std::abs(v) : 0.0, p["status"] == "ok" ? "" : " (not identifiable)");
+    }
+    std::printf("\n");
+  }
   const auto& c = j["circuit"];
   std::printf("  C0              %s F, tan d %s, Rs %s ohm, C^T %s F\n", pm(c["c0_f"], "%.5g").c_str(),
               pm(c["tan_delta"], "%.3g").c_str(), pm(c["rs_ohm"], "%.3g").c_str(),
@@ -77,6 +86,8 @@ void print_text(const nlohmann::json& j) {
                 pm(m["c1_f"], "%.5g").c_str());
   }
   for (const auto& n : j["notes"]) std::printf("  note: %s\n", n.get<std::string>().c_str());
+  if (j.contains("warnings"))
+    for (const auto& w : j["warnings"]) std::printf("  WARNING: %s\n", w.get<std::string>().c_str());
 }
 
 }  // namespace
@@ -91,7 +102,11 @@ void register_figures_command(CLI::App& app, Context& ctx) {
   cmd->add_option("--plot", a->plot, "PNG of the data and the fitted network");
   cmd->add_option("--modes", a->req.max_modes, "Modes (branches) at most")->capture_default_str();
   cmd->add_option("--band", a->band, "Frequency band LO:HI in Hz (default: the data's; a capture: its estimate's)");
-  cmd->add_option("--method", a->req.method, "A capture's estimator: fft, xspec or prony")->capture_default_str();
+  cmd->add_option("--method", a->req.method,
+                  "A capture's estimator: oe (default: the output-error fit's updated FE model, its modes' "
+                  "figures), or fft, xspec, prony (the circuit fitted to that impedance estimate)")
+      ->check(CLI::IsMember({"oe", "fft", "xspec", "prony"}));
+  cmd->add_option("--material", a->req.material, "oe: the nominal material (default: the capture's own)");
   cmd->callback([&ctx, a] {
     ctx.exit_code = run_command(ctx, [&] {
       if (!a->band.empty()) parse_band(a->band, a->req);
