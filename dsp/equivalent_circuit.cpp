@@ -566,6 +566,20 @@ CircuitFit fit_equivalent_circuit(const Eigen::VectorXd& f, const Eigen::VectorX
       // too few points or no mode found: the conductance peaks' start stands
     }
   }
+  // ONE branch may stand above the data for the modes above the band (their
+  // susceptance rises towards the band's top, which a constant C0 cannot
+  // follow: the highest modes' fp would move by percents): the largest one
+  // above; never reported as a mode. Any other branch outside the data goes.
+  auto outside_at = [&](const EquivalentCircuit& c, std::size_t k) {
+    const double fs = c.branches[k].fs_hz();
+    if (!(fs > f[0])) return true;
+    if (fs < f[n - 1]) return false;
+    for (std::size_t j = 0; j < c.branches.size(); ++j)
+      if (j != k && !(c.branches[j].fs_hz() < f[n - 1]) &&
+          (c.branches[j].c_f > c.branches[k].c_f || (c.branches[j].c_f == c.branches[k].c_f && j < k)))
+        return true;
+    return false;
+  };
   // Backward: drop branches that leave the band or whose removal lowers the criterion.
   for (bool changed = true; changed && best.lay.branches > 0;) {
     changed = false;
@@ -574,7 +588,7 @@ CircuitFit fit_equivalent_circuit(const Eigen::VectorXd& f, const Eigen::VectorX
       EquivalentCircuit less = cur;
       less.branches.erase(less.branches.begin() + static_cast<std::ptrdiff_t>(k));
       const double fs = cur.branches[k].fs_hz();
-      const bool outside = !(fs > f[0] && fs < f[n - 1]);
+      const bool outside = outside_at(cur, k);
       Trial tr = run(less, best.lay.rs);
       if (outside || tr.bic < best.bic) {
         out.notes.push_back("dropped the branch at " + fmt(fs) + " Hz (" +
@@ -624,7 +638,10 @@ CircuitFit fit_equivalent_circuit(const Eigen::VectorXd& f, const Eigen::VectorX
   for (int pass = 0; pass < 4; ++pass) {  // a refit may push another branch out
     EquivalentCircuit cur = circuit_of(best.lay, best.t);
     const auto before = cur.branches.size();
-    std::erase_if(cur.branches, [&](const CircuitBranch& b) { return !(b.fs_hz() > f[0] && b.fs_hz() < f[n - 1]); });
+    const EquivalentCircuit was = cur;
+    cur.branches.clear();
+    for (std::size_t k = 0; k < was.branches.size(); ++k)
+      if (!outside_at(was, k)) cur.branches.push_back(was.branches[k]);
     if (cur.branches.size() == before) break;
     out.notes.push_back(std::to_string(before - cur.branches.size()) + " branch(es) outside the data dropped");
     best = run(cur, best.lay.rs);
@@ -705,6 +722,13 @@ CircuitFit fit_equivalent_circuit(const Eigen::VectorXd& f, const Eigen::VectorX
   for (std::size_t k = 0; k < out.modes.size(); ++k) {
     out.modes[k].points = mode_n[k];
     out.modes[k].misfit_rel_rms = mode_n[k] ? std::sqrt(mode_s[k] / mode_n[k]) : kNaN;
+  }
+  // The branch above the data stands for the modes above the band: in the
+  // network (C^T, the misfit), not a mode.
+  if (!out.circuit.branches.empty() && !(out.circuit.branches.back().fs_hz() < f[n - 1])) {
+    out.notes.push_back("one branch above the data (fs " + fmt(out.circuit.branches.back().fs_hz()) +
+                        " Hz) stands for the modes above the band; not reported as a mode");
+    out.modes.pop_back();
   }
   if (!out.converged) out.notes.push_back("the least-squares fit did not converge");
   return out;

@@ -95,13 +95,19 @@ TEST(EquivalentCircuit, ClosePairIsResolvedAndNoModeAppearsOutsideTheData) {
   truth.branches = {branch(48.2e3, 40, 0.3e-9), branch(51.0e3, 40, 0.25e-9), branch(180e3, 40, 0.3e-9)};
   const auto g = sample(truth, 20e3, 120e3, 50, 0.01, 7);  // the 180 kHz mode is above the data
   const auto fit = fit_equivalent_circuit(g.f, g.z, g.sigma);
-  ASSERT_EQ(fit.circuit.branches.size(), 2u);
+  // Two modes reported; the network may hold ONE branch above the data for
+  // the modes above the band (here the 180 kHz one), never reported.
+  ASSERT_EQ(fit.modes.size(), 2u);
   for (std::size_t k = 0; k < 2; ++k) {
     const double fs = truth.branches[k].fs_hz();
     EXPECT_LT(std::abs(fit.modes[k].fs_hz.value - fs), 4 * fit.modes[k].fs_hz.sigma) << k;
     EXPECT_NEAR(fit.modes[k].fs_hz.value / fs, 1.0, 2e-3) << k;
   }
-  for (const auto& b : fit.circuit.branches) EXPECT_LT(b.fs_hz(), 120e3);
+  int above = 0;
+  for (const auto& b : fit.circuit.branches) above += !(b.fs_hz() < 120e3);
+  EXPECT_LE(above, 1);
+  EXPECT_LE(fit.circuit.branches.size(), 3u);
+  for (const auto& m : fit.modes) EXPECT_LT(m.fs_hz.value, 120e3);
 }
 
 TEST(EquivalentCircuit, SigmasAreCalibratedOverNoiseSeeds) {
