@@ -316,7 +316,10 @@ void write_figures_plot(const FiguresJobResult& r, const std::filesystem::path& 
     dp.y.push_back(std::arg(r.z_ohm[i]) * 180.0 / std::numbers::pi);
   }
   // The fitted network on a dense log grid.
-  Series fm{"fitted network (" + std::to_string(r.fit.modes.size()) + " modes)", {}, {}, "#2ca02c", 2.0, false, false};
+  Series fm{(r.model_figures ? "updated FE model (" : "fitted network (") + std::to_string(r.fit.modes.size()) +
+                " modes)",
+            {}, {}, "#2ca02c", 2.0, false, false};
+  if (r.model_figures) dm.label = "the capture's FFT ratio";
   Series fpz{"", {}, {}, "#2ca02c", 2.0, false, false};
   const double a = r.f_hz[0], b = r.f_hz[r.f_hz.size() - 1];
   for (int i = 0; i <= 2000; ++i) {
@@ -335,7 +338,8 @@ void write_figures_plot(const FiguresJobResult& r, const std::filesystem::path& 
     if (std::isfinite(m.fp_hz.value)) mag.markers.push_back({m.fp_hz.value, "#9467bd"});
   }
   Figure figure;
-  figure.title = "figures: data and fitted equivalent circuit (fs red, fp violet)";
+  figure.title = r.model_figures ? "figures: the capture and its updated FE model (fs red, fp violet)"
+                                 : "figures: data and fitted equivalent circuit (fs red, fp violet)";
   figure.panels = {mag, ph};
   write_png(figure, png);
 }

@@ -276,6 +276,7 @@ void add_impedance_mode_figures(nlohmann::json& j, const ImpedanceJobResult& res
   }
   j["modes"] = jobs::modes_json(m.figures);
   j["mode_summary"] = jobs::mode_summary_json(m.figures, m.mean_diameter_m, m.mean_diameter_source);
+  j["mode_summary"]["source"] = m.source;
 }
 
 void write_impedance_csv(std::ostream& os, const ImpedanceJobResult& r) {

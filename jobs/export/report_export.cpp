@@ -79,7 +79,7 @@ nlohmann::json report_json(const PipelineResult& r) {
                     {"r1_error", o(f.r1_error)},
                     {"skew_s", o(f.skew_s)}};
   }
-  if (r.mode_figures) {  // the per-mode figures of the Prony-SS estimate
+  if (r.mode_figures) {  // the per-mode figures: the updated model's, else the Prony-SS estimate's
     const auto& m = *r.mode_figures;
     if (m.error.empty()) {
       j["modes"] = modes_json(m.figures);
@@ -89,6 +89,7 @@ nlohmann::json report_json(const PipelineResult& r) {
       j["mode_summary"] = {{"notes", {"no mode figures: " + m.error}}};
     }
     j["mode_summary"]["estimate"] = "Prony-SS (the pipeline's estimate, before any fixture correction)";
+    j["mode_summary"]["source"] = m.source;
   }
   if (r.output_error) j["output_error"] = output_error_json(*r.output_error, r.output_error_excitation);
   if (r.diagnosis) j["diagnosis"] = diagnosis_json(*r.diagnosis);

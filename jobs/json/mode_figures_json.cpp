@@ -83,7 +83,9 @@ nlohmann::json mode_summary_json(const dsp::ModeFiguresResult& r, double d_mean,
 }
 
 void print_mode_figures(std::FILE* out, const nlohmann::json& modes, const nlohmann::json& s) {
-  std::fprintf(out, "  mode figures (IEEE 176 / EN 50324-2; BVD fit per mode, ±1σ)\n");
+  std::fprintf(out, "  mode figures (IEEE 176 / EN 50324-2; %s, ±1σ)\n",
+               s.contains("source") && s["source"].is_string() ? s["source"].get<std::string>().c_str()
+                                                               : "BVD fit per mode");
   std::fprintf(out, "  %-3s %-20s %-20s %-12s %-14s %-14s %-16s %-18s %-18s %-18s\n", "#",
                "fs [Hz]", "fp [Hz]", "k_eff", "Qm (R1 C1)", "Qm (fs/df)", "R1 [ohm]", "L1 [mH]",
                "C1 [pF]", "C0 [pF]");

@@ -13,7 +13,8 @@
 //              rms_rel_residual, iterations}, notes[]}]
 //   mode_summary{free_capacitance_f, free_capacitance_sigma_f, tan_delta, tan_delta_sigma,
 //                reference_hz, hoop_mode, mean_diameter_m, mean_diameter_source,
-//                frequency_constant_hz_m, frequency_constant_sigma_hz_m, sweeps, notes[]}
+//                frequency_constant_hz_m, frequency_constant_sigma_hz_m, sweeps, notes[],
+//                source (what the figures are of: the updated FE model or a BVD fit per mode)}
 #include <cstdio>
 #include <nlohmann/json.hpp>
 #include <string>

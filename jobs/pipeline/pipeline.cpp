@@ -54,6 +54,16 @@ PipelineResult run_pipeline(const PipelineRequest& req, const std::function<void
   const auto oe = output_error_stage(req, cap, cm, out);
   const std::string oe_note = out.stages.back().note;
   if (cancel) return out;
+  // The per-mode figures on the estimator the capture supports best (issue
+  // 34): the output-error fit's updated model, when it converged.
+  if (oe && oe->ok()) {
+    auto mm = model_mode_figures(cap, cm, *oe, out.mode_figures ? &*out.mode_figures : nullptr);
+    if (mm.error.empty())
+      out.mode_figures = std::move(mm);
+    else
+      out.warnings.push_back("per-mode figures of the updated model failed (" + mm.error +
+                             "); the estimate's are reported");
+  }
 
   // The pipeline's update: the output-error fit where it converged (its
   // constants carry sigma and status), else the seed's chain.

@@ -112,8 +112,9 @@ struct PipelineResult {
   std::vector<Curve> curves;  // measured (Prony), FFT, cross-spectra, original model, updated model
   std::vector<double> resonances_hz, antiresonances_hz;
   std::vector<double> singular_values;  // normalised, for the order plot
-  // Per-mode figures (fs, fp, k_eff, Qm, BVD branch; C^T and tan δ at 1 kHz)
-  // of the Prony-SS estimate above, when it ran.
+  // Per-mode figures (fs, fp, k_eff, Qm, BVD branch; C^T and tan δ at 1 kHz):
+  // the output-error fit's updated model's modes when it converged (issue
+  // 34), else those of the Prony-SS estimate above (capture_mode_figures.hpp).
   std::optional<CaptureModeFigures> mode_figures;
   int order = 0;
   std::vector<ParamRow> params;

@@ -27,7 +27,9 @@ const jobs::Curve* estimate_curve(const jobs::PipelineResult& r) {
 
 std::string mode_figures_markdown(const jobs::PipelineResult& r) {
   std::ostringstream o;
-  o << "\n## Per-mode figures (Prony-SS estimate)\n\n";
+  o << "\n## Per-mode figures";
+  if (r.mode_figures && !r.mode_figures->source.empty()) o << " (" << r.mode_figures->source << ")";
+  o << "\n\n";
   if (!r.mode_figures) {
     o << "None: no impedance estimate.\n";
     return o.str();
@@ -63,7 +65,9 @@ std::optional<Figure> nyquist_figure(const jobs::PipelineResult& r, int max_mode
   const auto ny = jobs::mode_nyquist(c->f_hz, c->z_ohm, r.mode_figures->figures);
   if (ny.empty()) return std::nullopt;
   Figure fig;
-  fig.title = "Admittance plane per mode: the estimate, the fitted BVD network, the motional circle";
+  const bool model = r.mode_figures->source.rfind("updated FE model", 0) == 0;
+  fig.title = model ? "Admittance plane per mode: the estimate, the updated model's branch, the motional circle"
+                    : "Admittance plane per mode: the estimate, the fitted BVD network, the motional circle";
   fig.width = 700;
   fig.panel_height = 420;
   auto ms = [](const std::vector<double>& v) {
@@ -78,7 +82,7 @@ std::optional<Figure> nyquist_figure(const jobs::PipelineResult& r, int max_mode
     p.x_label = "G [mS]";
     p.y_label = "B [mS]";
     p.series.push_back({"motional circle", ms(n.circle_g_s), ms(n.circle_b_s), "#999999", 1.0, true, false});
-    p.series.push_back({"fitted BVD", ms(n.fit_g_s), ms(n.fit_b_s), "#2ca02c", 2.0, false, false});
+    p.series.push_back({model ? "updated model" : "fitted BVD", ms(n.fit_g_s), ms(n.fit_b_s), "#2ca02c", 2.0, false, false});
     p.series.push_back({"measured (Prony-SS)", ms(n.g_s), ms(n.b_s), "#ff7f0e", 1.0, false, true});
     fig.panels.push_back(std::move(p));
   }

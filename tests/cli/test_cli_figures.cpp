@@ -89,3 +89,36 @@ TEST(CliFigures, BadInputExitsTwoNamingTheFile) {
   EXPECT_EQ(run_cli("figures /nonexistent/x.s1p").exit_code, 2);
   EXPECT_EQ(run_cli("figures " + kFixtures + "eqcirc3/MD1.txt --band 5:1").exit_code, 2);
 }
+
+// A capture's figures by default: the output-error fit's updated FE model
+// (issue 34 item 3), its JSON beside the figures, every figure with a σ; a
+// PNG of the capture's FFT ratio and the model. --method is a capture's
+// option: given with an impedance file it is refused (exit 2).
+TEST(CliFigures, ACapturesFiguresAreTheUpdatedModelsModes) {
+  const std::string cap = std::string(PIEZO_SOURCE_DIR) + "/../shared/corpus/refsim-v1/12/fit.h5";
+  if (!std::filesystem::exists(cap)) GTEST_SKIP() << "no corpus at " << cap;
+  const std::string png = tmp("modes.png");
+  const auto j = figures(cap + " --plot " + png);
+  EXPECT_TRUE(std::filesystem::file_size(png) > 1000);
+  std::filesystem::remove(png);
+  EXPECT_EQ(j["source"], "capture");
+  EXPECT_EQ(j["format"], "oe");
+  ASSERT_TRUE(j.contains("figures_from"));
+  EXPECT_TRUE(j["output_error"]["converged"].get<bool>());
+  ASSERT_GE(j["modes"].size(), 3u);
+  int with_fp = 0;
+  for (const auto& m : j["modes"]) {
+    ASSERT_FALSE(m["fs_hz"]["sigma"].is_null());
+    EXPECT_GT(m["fs_hz"]["sigma"].get<double>(), 0.0);
+    EXPECT_LT(m["fs_hz"]["value"].get<double>(), j["band_hz"][1].get<double>());
+    if (!m["fp_hz"]["value"].is_null()) {
+      ++with_fp;
+      EXPECT_GT(m["fp_hz"]["value"].get<double>(), m["fs_hz"]["value"].get<double>());
+      EXPECT_FALSE(m["k_eff_ieee176"]["sigma"].is_null());
+    }
+  }
+  EXPECT_GE(with_fp, 3);
+  EXPECT_FALSE(j["circuit"]["free_capacitance_f"]["sigma"].is_null());
+  EXPECT_EQ(run_cli("figures " + kFixtures + "eqcirc3/MD1.txt --method oe").exit_code, 2);
+  EXPECT_EQ(run_cli("figures " + kFixtures + "eqcirc3/MD1.txt --method fft").exit_code, 2);
+}

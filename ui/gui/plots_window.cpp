@@ -115,6 +115,7 @@ void render_modes_row(AppState& s, float width, float height) {
     ImGui::TextWrapped("no per-mode figures: %s", s.result->mode_figures->error.c_str());
   } else {
     const auto& r = s.result->mode_figures->figures;
+    if (!s.result->mode_figures->source.empty()) ImGui::TextDisabled("%s", s.result->mode_figures->source.c_str());
     ImGui::Text("C^T %s nF, tan d %s at %.0f Hz; N %s Hz m (hoop mode); hover a value for its sigma",
                 pm(r.free_capacitance_f, 1e9, "%.4g").c_str(), pm(r.tan_delta, 1.0, "%.2g").c_str(),
                 r.reference_used_hz, pm(r.frequency_constant_hz_m, 1.0, "%.5g").c_str());
