@@ -9,6 +9,7 @@
 #include <iostream>
 
 #include "jobs/demo_job.hpp"
+#include "jobs/json/mode_figures_json.hpp"
 #include "jobs/export/report_export.hpp"
 #include "ui/cli/cli_common.hpp"
 #include "ui/cli/diagnosis_text.hpp"
@@ -82,6 +83,14 @@ void register_demo_command(CLI::App& app, Context& ctx) {
           std::printf("  corr(nu12, d31) of the output-error fit: %+.3f; fitted %s\n",
                       res.output_error->corr_nu12_d31,
                       update::damping_summary(*res.output_error).c_str());
+      }
+      // The per-mode figures (issue 34): the updated model's modes with sigma
+      // (or the estimate's BVD fits when the output-error fit did not converge).
+      if (j.contains("modes") && !j["modes"].empty()) {
+        std::cout << "\n";
+        std::fflush(stdout);
+        jobs::print_mode_figures(stdout, j["modes"], j["mode_summary"]);
+        std::fflush(stdout);
       }
       if (res.diagnosis) print_diagnosis(std::cout, *res.diagnosis);
       if (!res.damping_from_resonances.empty())
