@@ -142,8 +142,18 @@ ImpedanceAssessment assess_impedance(const Capture& cap, const AssessmentOptions
   // The records are not altered by the calibration (below), so the estimate
   // before compensation and deskew is the same estimate: computed once.
   std::vector<OwnedRecord> ready;
+  out.baseline_removed = opt.baseline && opt.baseline_remove;
   for (const Shot* s : shots) {
     ready.push_back(single(cap, *s));
+    if (opt.baseline) {  // a real bench's slow disturbances, off channel 1 − channel 2 (issue 33)
+      auto bl = dsp::estimate_divider_baseline(ready.back().view(), opt.baseline_options);
+      auto& rec = ready.back();
+      if (bl.found && opt.baseline_remove)
+        for (std::size_t i = 0; i < bl.samples.size(); ++i) rec.v1[rec.pretrigger_samples + i] -= bl.samples[i];
+      if (bl.found) bl.note += opt.baseline_remove ? " - removed from channel 1" : " - kept (--remove-baseline removes it)";
+      if (bl.found || !bl.tested) out.notes.push_back("shot " + s->name + ": " + bl.note);
+      out.baselines.push_back(std::move(bl));
+    }
     // Channel 2's delay is removed from Z below (T = T_m·e^{+jωτ}), not from
     // the records: resampling channel 2 interpolates its response across the
     // drive's kinks at its onset and at t = 0 (-0.3 ... -2.8 points of |Z|

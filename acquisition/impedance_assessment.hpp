@@ -16,6 +16,7 @@
 
 #include "acquisition/capture.hpp"
 #include "acquisition/capture_calibration.hpp"
+#include "dsp/divider_baseline.hpp"
 #include "dsp/cross_spectra.hpp"
 #include "dsp/fft_ratio.hpp"
 #include "dsp/kramers_kronig.hpp"
@@ -50,6 +51,15 @@ struct AssessmentOptions {
   dsp::PronyImpedanceOptions prony = bench_prony_options();
   dsp::FftRatioOptions fft;        // fmin/fmax filled from the band
   dsp::CrossSpectraOptions xspec;  // fmin/fmax filled from the band
+
+  // A real bench's slow disturbances (issue 33): each shot's channel-1-minus-
+  // channel-2 baseline (slow wander, mains hum) tested (dsp/divider_baseline.hpp)
+  // and reported; removed from channel 1 before the estimate only with
+  // `baseline_remove` (on our bench the removal's own noise in the lowest bins
+  // cost as much as the baseline did: dsp/README.md).
+  bool baseline = true;
+  bool baseline_remove = false;
+  dsp::DividerBaselineOptions baseline_options;
 
   bool compensate = true;                  // use the capture's calibration shots, when it has any
   std::optional<dsp::FixtureModel> model;  // empty: the most complete the standards allow
@@ -88,6 +98,8 @@ struct ImpedanceAssessment {
   std::optional<dsp::ValidityReport> validity;  // one entry per shot in `shots`
   std::optional<dsp::StabilizationChart> stabilization;
   std::vector<std::string> shots;  // dut shots used
+  std::vector<dsp::DividerBaseline> baselines;  // per shot in `shots` (AssessmentOptions::baseline)
+  bool baseline_removed = false;                // the found ones were removed (AssessmentOptions::baseline_remove)
   std::vector<std::string> notes;  // what was skipped and why
 };
 

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <stdexcept>
+#include <vector>
 
 namespace piezo::dsp {
 
@@ -52,6 +53,19 @@ SignalStats compute_stats(std::span<const double> x, const ClipDetection& clip) 
     }
   }
   return st;
+}
+
+double log_gamma_tail(int w, double x) {
+  // ln P(Gamma(w, 1) ≥ x) = ln(e^{-x} Σ_{k<w} x^k/k!)
+  double best = -INFINITY;
+  std::vector<double> t(static_cast<std::size_t>(std::max(w, 1)));
+  for (int k = 0; k < w; ++k) {
+    t[static_cast<std::size_t>(k)] = (k == 0 ? 0.0 : k * std::log(std::max(x, 1e-300))) - std::lgamma(k + 1.0);
+    best = std::max(best, t[static_cast<std::size_t>(k)]);
+  }
+  double sum = 0;
+  for (int k = 0; k < w; ++k) sum += std::exp(t[static_cast<std::size_t>(k)] - best);
+  return -x + best + std::log(sum);
 }
 
 }  // namespace piezo::dsp

@@ -1,6 +1,7 @@
 #pragma once
 // Per-channel summary statistics of a sampled signal and clipping detection,
-// used by `capture info`, the acquisition runner and the estimators.
+// used by `capture info`, the acquisition runner and the estimators; the
+// chance of a χ² (the significance tests of dsp/ and update/).
 #include <cstddef>
 #include <optional>
 #include <span>
@@ -31,5 +32,10 @@ struct ClipDetection {
 };
 
 SignalStats compute_stats(std::span<const double> x, const ClipDetection& clip = {});
+
+// ln P(X ≥ x) for X ~ Gamma(w, 1): the chance that w bins of z = |e|²/var
+// (each Exp(1) under noise) sum to x or more; with w = (ν + 1)/2 and x = χ²/2
+// the chance of a χ² on ν degrees of freedom (exact for even ν).
+double log_gamma_tail(int w, double x);
 
 }  // namespace piezo::dsp

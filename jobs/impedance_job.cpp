@@ -126,6 +126,8 @@ acq::AssessmentOptions trust_options(const ImpedanceRequest& a) {
     o.model = *m;
   }
   o.deskew = !a.no_deskew;
+  o.baseline = !a.no_baseline;
+  o.baseline_remove = a.remove_baseline;
   if (a.skew_ns) o.skew_s = *a.skew_ns * 1e-9;
   if (a.uncertainty == "auto") o.uncertainty = acq::UncertaintySource::Auto;
   else if (a.uncertainty == "shots") o.uncertainty = acq::UncertaintySource::Shots;

@@ -28,6 +28,8 @@ struct ImpedanceRequest {
   std::string compensation = "auto", uncertainty = "auto", stabilization = "2:30:2";
   std::optional<double> skew_ns;
   bool no_deskew = false, average = false, no_kk = false, no_validity = false, no_stabilization = false;
+  bool no_baseline = false;      // do not test for a bench's slow disturbances (issue 33)
+  bool remove_baseline = false;  // remove a significant one from channel 1 before the estimate
   std::size_t bootstrap_shots = 30;
 };
 

@@ -8,19 +8,6 @@
 
 namespace piezo::update {
 
-double log_gamma_tail(int w, double x) {
-  // ln P(Gamma(w, 1) ≥ x) = ln(e^{-x} Σ_{k<w} x^k/k!)
-  double best = -INFINITY;
-  std::vector<double> t(static_cast<std::size_t>(w));
-  for (int k = 0; k < w; ++k) {
-    t[static_cast<std::size_t>(k)] = (k == 0 ? 0.0 : k * std::log(std::max(x, 1e-300))) - std::lgamma(k + 1.0);
-    best = std::max(best, t[static_cast<std::size_t>(k)]);
-  }
-  double sum = 0;
-  for (double v : t) sum += std::exp(v - best);
-  return -x + best + std::log(sum);
-}
-
 namespace {
 
 using cd = std::complex<double>;

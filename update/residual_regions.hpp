@@ -30,6 +30,7 @@
 // over the noise; else "broadband". For the resonance, the effective coupling
 // of the branch k_eff² = C_b/(C_b + C) with C the transducer's capacitance
 // there (IEEE 176: k_eff² = (fp² − fs²)/fp² of the branch and its shunt).
+#include "dsp/signal_stats.hpp"
 #include <complex>
 #include <optional>
 #include <string>
@@ -74,9 +75,8 @@ struct ResidualRegion {
   std::string description;  // one phrase, the same in JSON, terminal, GUI and plots
 };
 
-// ln P(X ≥ x) for X ~ Gamma(w, 1): the chance that w bins of z = |e|²/var
-// (each Exp(1) under noise) sum to x or more.
-double log_gamma_tail(int w, double x);
+// ln P(X ≥ x) for X ~ Gamma(w, 1) (dsp/signal_stats.hpp).
+using dsp::log_gamma_tail;
 
 // Up to `max_regions` regions whose window has a Bonferroni chance below
 // `p_threshold`, most significant first. Empty for a residual at the noise.

@@ -139,6 +139,30 @@ json assessment_json(const acq::ImpedanceAssessment& a) {
                           {"poles", poles}};
   }
   j["notes"] = a.notes;
+  if (!a.baselines.empty()) {  // per shot: the slow disturbances tested and removed (issue 33)
+    auto num = [](double v) { return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json(nullptr); };
+    nlohmann::json b = nlohmann::json::array();
+    for (std::size_t k = 0; k < a.baselines.size(); ++k) {
+      const auto& x = a.baselines[k];
+      b.push_back({{"shot", k < a.shots.size() ? a.shots[k] : std::string()},
+                   {"tested", x.tested},
+                   {"found", x.found},
+                   {"removed", x.found && a.baseline_removed},
+                   {"delta_chi2", x.delta_chi2},
+                   {"dof", x.dof},
+                   {"log10_p", x.log10_p},
+                   {"chi2_per_dof", num(x.chi2_per_dof)},
+                   {"band_hz", x.band_hz},
+                   {"mains_hz", x.mains_hz},
+                   {"offset_v", x.offset_v},
+                   {"slope_v_per_s", x.slope_v_per_s},
+                   {"slope_sigma_v_per_s", num(x.slope_sigma_v_per_s)},
+                   {"hum_v", num(x.hum_v)},
+                   {"rms_v", x.rms_v},
+                   {"note", x.note}});
+    }
+    j["baseline"] = b;
+  }
   return j;
 }
 

@@ -127,6 +127,10 @@ void register_impedance_command(CLI::App& app, Context& ctx) {
                   "open-short | open-short-load")
       ->capture_default_str();
   cmd->add_flag("--no-deskew", a->req.no_deskew, "Do not estimate/remove the channel-2 skew");
+  cmd->add_flag("--no-baseline", a->req.no_baseline,
+                "Do not test the shots for a slow baseline (wander, mains hum) of channel 1 - channel 2");
+  cmd->add_flag("--remove-baseline", a->req.remove_baseline,
+                "Remove a significant slow baseline of channel 1 - channel 2 from channel 1 before the estimate");
   cmd->add_option("--skew-ns", a->req.skew_ns, "A stored channel-2 skew (ns, > 0: v2 late) for a capture without calibration shots");
   cmd->add_flag("--average", a->req.average, "prony/fft: average every dut shot of the drive (default: one shot)");
   cmd->add_option("--uncertainty", a->req.uncertainty, "Uncertainty band: auto | shots | noise | none")->capture_default_str();
