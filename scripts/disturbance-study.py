@@ -25,6 +25,35 @@ def run(args):
     return p
 
 
+def chance_within(fit, truth, draws=4000):
+    """The chance that the four constants fall within BOUND when each is off by
+    its own sigma, with the fit's correlations (nu12 and d31 near -1): what the
+    fit's information allows, by Monte Carlo (Cholesky by hand, no numpy)."""
+    names = [k for k in BOUND]
+    par = {p["name"]: p for p in fit["parameters"]}
+    cn = fit.get("correlation", {}).get("names", [])
+    cm = fit.get("correlation", {}).get("matrix", [])
+    sig = [par[n]["sigma"] / abs(truth[n]) * 100 for n in names]  # %
+    c = [[1.0 if i == j else 0.0 for j in range(4)] for i in range(4)]
+    for i, a in enumerate(names):
+        for j, b in enumerate(names):
+            if a in cn and b in cn:
+                c[i][j] = cm[cn.index(a)][cn.index(b)]
+    cov = [[c[i][j] * sig[i] * sig[j] + (1e-12 if i == j else 0) for j in range(4)] for i in range(4)]
+    L = [[0.0] * 4 for _ in range(4)]
+    for i in range(4):
+        for j in range(i + 1):
+            v = cov[i][j] - sum(L[i][k] * L[j][k] for k in range(j))
+            L[i][j] = math.sqrt(max(v, 1e-18)) if i == j else v / L[j][j]
+    g = random.Random(7)
+    hit = 0
+    for _ in range(draws):
+        z = [g.gauss(0, 1) for _ in range(4)]
+        x = [sum(L[i][k] * z[k] for k in range(i + 1)) for i in range(4)]
+        hit += all(abs(x[i]) <= BOUND[names[i]] for i in range(4))
+    return hit / draws
+
+
 rows = []
 k = -1
 while len(rows) < n:
@@ -66,6 +95,8 @@ while len(rows) < n:
         row["within_clean"] = row.get("within_clean", True) and abs((clean["value"] / truth[name] - 1) * 100) <= BOUND[name]
         row["within3s"] = row.get("within3s", True) and abs(par["value"] - truth[name]) <= 3 * par["sigma"]
         row.setdefault("status", []).append(par["status"])
+    row["p_within"] = chance_within(res["dist"], truth)
+    row["p_within_clean"] = chance_within(res["clean"], truth)
     row["chi2"] = res["dist"]["fit"]["chi2_per_dof"]
     row["chi2_clean"] = res["clean"]["fit"]["chi2_per_dof"]
     row["baseline"] = res["dist"]["fit"].get("baseline", {})
@@ -80,6 +111,8 @@ within = sum(r["within"] for r in rows)
 ratio_ok = sum(max(r["ratio"].values()) <= 1.5 for r in rows)
 print("constants within 1/3/3/1 %%: %d/%d (the same captures without the disturbances: %d/%d)" % (
     within, len(rows), sum(r["within_clean"] for r in rows), len(rows)))
+print("... expected from the fits' own sigmas and correlations: %.1f/%d (clean %.1f/%d)" % (
+    sum(r["p_within"] for r in rows), len(rows), sum(r["p_within_clean"] for r in rows), len(rows)))
 print("every constant within 3 of its sigmas: %d/%d" % (sum(r["within3s"] for r in rows), len(rows)))
 print("sigmas within 1.5x of the clean capture's: %d/%d (max ratio %.2f, median of the max %.2f)" % (
     ratio_ok, len(rows), max(max(r["ratio"].values()) for r in rows),
