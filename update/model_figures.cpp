@@ -7,6 +7,8 @@
 #include <optional>
 #include <stdexcept>
 
+#include "update/output_error/forward_model.hpp"
+
 namespace piezo::update {
 
 namespace {
@@ -51,22 +53,6 @@ PortCircuit circuit_of(const model::ModalPortModel& port, const OeLoss& loss, do
   return pc;
 }
 
-// θ in the output-error fit's relative coordinates about (p, loss).
-TubeParams params_at(const TubeParams& p, const Eigen::VectorXd& x) {
-  TubeParams q = p;
-  q.y_e11 = p.y_e11 * std::exp(x[0]);
-  q.nu12 = p.nu12 * (1.0 + x[1]);
-  q.d31 = p.d31 * std::exp(x[2]);
-  q.eps_t33 = p.eps_t33 * std::exp(x[3]);
-  return q;
-}
-OeLoss loss_at(const OeLoss& l, const Eigen::VectorXd& x) {
-  OeLoss q = l;
-  q.beta_s *= std::exp(x[4]);
-  q.eta *= std::exp(x[4]);
-  return q;
-}
-
 }  // namespace
 
 dsp::EquivalentCircuit port_circuit(const model::ModalPortModel& port, const OeLoss& loss, double active_coupling) {
@@ -79,11 +65,13 @@ ModelFigures model_figures(model::ModalSolver& solver, const MaterialClass& cls,
   model::ModalOptions mo = modal;
   mo.end_mass_fraction = effects.mass_loading;
   ModelFigures out;
+  // θ in the output-error fit's relative coordinates about the answer.
+  const oe::Coordinates5 co{params, loss.model == OeDamping::rayleigh ? loss.beta_s : loss.eta, loss.model};
   auto build = [&](const Eigen::VectorXd& x) {
-    const auto port = solver.port_model(cls.e_form(params_at(params, x)), mo);
+    const auto port = solver.port_model(cls.e_form(co.params(x)), mo);
     ++out.port_models;
     if (!port.converged) throw std::runtime_error("the FE modal solve did not converge for the updated constants");
-    return circuit_of(port, loss_at(loss, x), mo.active_coupling);
+    return circuit_of(port, {loss.model, co.beta(x), co.eta(x)}, mo.active_coupling);
   };
   const Eigen::VectorXd x0 = Eigen::VectorXd::Zero(5);
   const PortCircuit centre = build(x0);
