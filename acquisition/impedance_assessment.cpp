@@ -222,6 +222,23 @@ ImpedanceAssessment assess_impedance(const Capture& cap, const AssessmentOptions
   }
   if (src == UncertaintySource::Noise) {
     const bool have = out.result.z_sigma_ohm.size() == out.result.f_hz.size();
+    // The estimators' noise propagation assumes white noise; slow noise that
+    // the baseline test measured in the lowest bins (1/f wander: issue 33)
+    // widens σ there, the shots' mean excess, continued above as 1/f.
+    if (have && !out.baselines.empty()) {
+      double widest = 1;
+      for (Eigen::Index k = 0; k < out.result.f_hz.size(); ++k) {
+        double e = 0;
+        for (const auto& bl : out.baselines) e += bl.excess_noise(out.result.f_hz[k]);
+        e /= double(out.baselines.size());
+        out.result.z_sigma_ohm[k] *= std::sqrt(e);
+        widest = std::max(widest, e);
+      }
+      if (widest > 1)
+        out.notes.push_back("the lowest bins hold slow noise " + std::to_string(widest) +
+                            " times the white floor (1/f wander, measured by the baseline test): sigma widened there, "
+                            "continued above as 1/f");
+    }
     out.band = dsp::band_from_sigma(
         out.result.f_hz, out.result.z_ohm, have ? out.result.z_sigma_ohm : Eigen::VectorXd(),
         opt.coverage_factor,

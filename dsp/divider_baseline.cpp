@@ -100,6 +100,11 @@ Fit solve(const std::vector<Eigen::VectorXcd>& cols, const Eigen::VectorXcd& y, 
 
 }  // namespace
 
+double DividerBaseline::excess_noise(double f_hz) const {
+  if (!tested || nu < 1 || !(chi2_per_dof > 1.0 + 4.0 * std::sqrt(2.0 / nu)) || !(band_hz > 0)) return 1.0;
+  return f_hz <= band_hz ? chi2_per_dof : 1.0 + (chi2_per_dof - 1.0) * band_hz / f_hz;
+}
+
 DividerBaseline estimate_divider_baseline(const DividerRecord& rec, const DividerBaselineOptions& opt) {
   DividerBaseline out;
   const std::size_t n = rec.v1.size(), n0 = rec.pretrigger_samples;
@@ -271,6 +276,7 @@ DividerBaseline estimate_divider_baseline(const DividerRecord& rec, const Divide
       out.dof = dof;
       out.mains_hz = h > 0 ? mains : 0;
       out.chi2_per_dof = f.chi2 / std::max(1, nu);
+      out.nu = nu;
     }
   }
   if (!best.ok) {

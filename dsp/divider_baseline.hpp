@@ -51,6 +51,7 @@ struct DividerBaseline {
   int dof = 0;             // their number
   double log10_p = 0;      // chance of that under noise alone (Bonferroni)
   double chi2_per_dof = kNaN;  // of the fit with them (the model's adequacy in its band)
+  int nu = 0;                  // its degrees of freedom
   double band_hz = 0;      // the bins fitted: 0 … band_hz
   double mains_hz = 0;     // the hum's frequency in the columns (0: none)
   double offset_v = 0;     // mean of d(t) (beyond the pretrigger means)
@@ -59,6 +60,11 @@ struct DividerBaseline {
   double rms_v = 0;        // rms of d(t) over the record
   std::vector<double> samples;  // d(t) from t = 0 (pretrigger excluded), volts
   std::string note;
+  // The noise power at f over the white floor the estimators' σ assume: the
+  // fit's χ²/ν in its band when significantly above 1 (beyond 1 + 4·√(2/ν):
+  // slow noise the baseline's columns do not hold, 1/f wander), continued
+  // above the band as 1/f — 1 + (χ²/ν − 1)·band/f; 1 otherwise.
+  double excess_noise(double f_hz) const;
 };
 
 // The record from its pretrigger on (as dsp::prepare_divider reads it). Never

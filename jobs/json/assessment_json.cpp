@@ -152,6 +152,7 @@ json assessment_json(const acq::ImpedanceAssessment& a) {
                    {"dof", x.dof},
                    {"log10_p", x.log10_p},
                    {"chi2_per_dof", num(x.chi2_per_dof)},
+                   {"nu", x.nu},
                    {"band_hz", x.band_hz},
                    {"mains_hz", x.mains_hz},
                    {"offset_v", x.offset_v},

@@ -155,3 +155,48 @@ TEST(DividerBaseline, AResonanceInsideTheBandNarrowsIt) {
 }
 
 }  // namespace
+
+namespace {
+
+// 1/f noise of `rms` volts on a record (spectral shaping of white noise).
+std::vector<double> pink(std::size_t n, double rms, unsigned seed) {
+  std::mt19937_64 g(seed);
+  std::normal_distribution<double> nd;
+  std::vector<double> w(n);
+  for (auto& v : w) v = nd(g);
+  piezo::dsp::RealFft fft(n);
+  std::vector<std::complex<double>> X(fft.bins());
+  fft.forward(w.data(), n, X.data());
+  X[0] = 0;
+  for (std::size_t k = 1; k < X.size(); ++k) X[k] /= std::sqrt(double(k));
+  std::vector<double> y(n);
+  fft.inverse(X.data(), y.data(), n);
+  double s = 0;
+  for (double v : y) s += v * v;
+  const double scale = rms / std::sqrt(s / double(n));
+  for (auto& v : y) v *= scale;
+  return y;
+}
+
+}  // namespace
+
+TEST(DividerBaseline, SlowNoiseWidensTheLowBinsOnly) {
+  // 2 mV of 1/f noise on channel 1 beside 1 mV of white noise: the lowest bins
+  // hold far more than the white floor, which the estimators' σ assume; white
+  // noise alone leaves the factor at 1.
+  int widened = 0, white_widened = 0;
+  for (unsigned s = 1; s <= 10; ++s) {
+    auto r = synth([](double f) { return capacitor(f); }, 1e7, 20000, 0.001, s);
+    const auto w = dsp::estimate_divider_baseline(r.view());
+    white_widened += w.excess_noise(1000.0) > 1.0;
+    const auto p = pink(r.v1.size(), 0.002, 100 + s);
+    for (std::size_t i = 0; i < r.v1.size(); ++i) r.v1[i] += p[i];
+    const auto b = dsp::estimate_divider_baseline(r.view());
+    ASSERT_TRUE(b.tested) << b.note;
+    if (b.excess_noise(1000.0) > 2.0) ++widened;
+    EXPECT_DOUBLE_EQ(b.excess_noise(1000.0), b.excess_noise(2000.0));  // flat within the band
+    EXPECT_LT(b.excess_noise(1e6), 1.0 + (b.excess_noise(1000.0) - 1.0) * 0.05);  // 1/f above it
+  }
+  EXPECT_GE(widened, 9);
+  EXPECT_LE(white_widened, 1);
+}
