@@ -28,28 +28,37 @@ int hum_harmonics(double mains_hz, double seconds, int max) {
 // u = 2t/T − 1 (column j − 1), then cos/sin of h·mains for h = 1..harmonics.
 // No P0: a constant lives in the DFT's DC bin alone, which the fit leaves out
 // (there a dielectric loss's long memory and the record's cut meet the
-// offset); the offset is the pretrigger's.
-Eigen::MatrixXd slow_basis(std::size_t n, double fs, int deg, double mains_hz, int harmonics) {
-  const auto N = static_cast<Eigen::Index>(n);
-  Eigen::MatrixXd b(N, deg + 2 * harmonics);
-  const double T = double(n) / fs;
-  for (Eigen::Index i = 0; i < N; ++i) {
-    const double t = double(i) / fs, u = 2.0 * t / T - 1.0;
-    double p0 = 1.0, p1 = u;
-    if (deg >= 1) b(i, 0) = p1;
-    for (int j = 2; j <= deg; ++j) {  // (j)P_j = (2j − 1)u P_{j−1} − (j − 1)P_{j−2}
-      const double p2 = ((2.0 * j - 1.0) * u * p1 - (j - 1.0) * p0) / j;
-      b(i, j - 1) = p2;
-      p0 = p1;
-      p1 = p2;
+// offset); the offset is the pretrigger's. Evaluated a column at a time, so
+// that memory stays that of one record whatever its length.
+struct SlowBasis {
+  std::size_t n = 0;
+  double fs = 0;
+  int deg = 0, harmonics = 0;
+  double mains_hz = 0;
+  Eigen::Index cols() const { return deg + 2 * harmonics; }
+  double at(Eigen::Index j, std::size_t i) const {
+    const double t = double(i) / fs;
+    if (j < deg) {  // P_{j+1}: (m)P_m = (2m − 1)u P_{m−1} − (m − 1)P_{m−2}
+      const double u = 2.0 * t / (double(n) / fs) - 1.0;
+      double p0 = 1.0, p1 = u;
+      for (int m = 2; m <= j + 1; ++m) {
+        const double p2 = ((2.0 * m - 1.0) * u * p1 - (m - 1.0) * p0) / m;
+        p0 = p1;
+        p1 = p2;
+      }
+      return p1;
     }
-    for (int h = 1; h <= harmonics; ++h) {
-      b(i, deg + 2 * h - 2) = std::cos(kTwoPi * h * mains_hz * t);
-      b(i, deg + 2 * h - 1) = std::sin(kTwoPi * h * mains_hz * t);
-    }
+    const int h = static_cast<int>(j - deg) / 2 + 1;
+    const double ph = kTwoPi * h * mains_hz * t;
+    return (j - deg) % 2 == 0 ? std::cos(ph) : std::sin(ph);
   }
-  return b;
-}
+  // Its first `bins` DFT bins (scaled by Δt, as the channels').
+  Eigen::VectorXcd dft(Eigen::Index j, Eigen::Index bins) const {
+    Eigen::VectorXd col(static_cast<Eigen::Index>(n));
+    for (std::size_t i = 0; i < n; ++i) col[static_cast<Eigen::Index>(i)] = at(j, i);
+    return (rfft(col, n) / fs).head(bins);
+  }
+};
 
 struct Fit {
   double chi2 = 0;
@@ -144,7 +153,7 @@ DividerBaseline estimate_divider_baseline(const DividerRecord& rec, const Divide
   }
   const Eigen::VectorXcd X1 = rfft(x1, N) * dt, X2 = rfft(x2, N) * dt;
   std::vector<double> tried = opt.mains_hz > 0 ? std::vector<double>{opt.mains_hz} : std::vector<double>{50.0, 60.0};
-  // The band: `cycles` cycles of the record, halved while a (jω)⁵ term stands out.
+  // The band: `cycles` cycles of the record, halved while a resonance shows in it.
   double fc = opt.cycles / T;
   Eigen::Index K = 0;
   std::vector<Eigen::VectorXcd> model_cols;
@@ -173,8 +182,7 @@ DividerBaseline estimate_divider_baseline(const DividerRecord& rec, const Divide
     }
     return c;
   };
-  const Eigen::MatrixXd full_basis = slow_basis(N, fs, opt.poly_degree, tried.front(),
-                                                hum_harmonics(tried.front(), T, opt.harmonics));
+  const SlowBasis full_basis{N, fs, opt.poly_degree, hum_harmonics(tried.front(), T, opt.harmonics), tried.front()};
   for (;;) {
     K = static_cast<Eigen::Index>(std::floor(fc * T)) + 1;  // bins 0 .. fc
     const Eigen::Index p_max = kY + kBoundary + 1 + full_basis.cols();
@@ -212,10 +220,7 @@ DividerBaseline estimate_divider_baseline(const DividerRecord& rec, const Divide
     // unweighted first pass.
     w = Eigen::VectorXd::Ones(K);
     auto c5 = base_columns(K, true);
-    for (Eigen::Index j = 0; j < full_basis.cols(); ++j) {
-      const Eigen::VectorXd col = full_basis.col(j);
-      c5.push_back((rfft(col, N) * dt).head(K));
-    }
+    for (Eigen::Index j = 0; j < full_basis.cols(); ++j) c5.push_back(full_basis.dft(j, K));
     Fit f0 = solve(c5, y, w);
     if (!f0.ok) {
       out.note = "the baseline test's least squares is singular";
@@ -249,16 +254,13 @@ DividerBaseline estimate_divider_baseline(const DividerRecord& rec, const Divide
   }
   out.tested = true;
   Fit best;
-  Eigen::MatrixXd best_basis;
+  SlowBasis best_basis;
   double best_delta = -1, best_logp = 0;
   for (double mains : tried) {
     const int h = hum_harmonics(mains, T, opt.harmonics);
-    const Eigen::MatrixXd basis = slow_basis(N, fs, opt.poly_degree, mains, h);
+    const SlowBasis basis{N, fs, opt.poly_degree, h, mains};
     std::vector<Eigen::VectorXcd> cols = model_cols;
-    for (Eigen::Index j = 0; j < basis.cols(); ++j) {
-      const Eigen::VectorXd col = basis.col(j);
-      cols.push_back((rfft(col, N) * dt).head(K));
-    }
+    for (Eigen::Index j = 0; j < basis.cols(); ++j) cols.push_back(basis.dft(j, K));
     const Fit f = solve(cols, y, w);
     if (!f.ok) continue;
     const int dof = static_cast<int>(basis.cols());
@@ -288,7 +290,9 @@ DividerBaseline estimate_divider_baseline(const DividerRecord& rec, const Divide
   out.log10_p = best_logp / std::log(10.0);
   out.found = best_logp < std::log(opt.p_value);
   const Eigen::VectorXd c = best.coef.tail(best_basis.cols());
-  const Eigen::VectorXd d = best_basis * c;
+  Eigen::VectorXd d = Eigen::VectorXd::Zero(static_cast<Eigen::Index>(N));
+  for (std::size_t i = 0; i < N; ++i)
+    for (Eigen::Index j = 0; j < c.size(); ++j) d[static_cast<Eigen::Index>(i)] += c[j] * best_basis.at(j, i);
   out.samples.assign(d.data(), d.data() + d.size());
   out.rms_v = std::sqrt(d.squaredNorm() / double(d.size()));
   out.offset_v = d.mean();
