@@ -3,6 +3,8 @@
 
 Usage:  real-file-features.py FILE [--json] [--s2p-mode series|shunt|s11]
                                 [--columns f[kHz],G[S],B[S]]
+  --columns names the columns of a headerless table, e.g. f,|Z|,-theta[deg],skip
+  ('skip' ignores a column; a leading '-' flips its sign).
 
 Independent of the C++ readers: a small numpy-only reader for the layouts found
 in the real-file corpus (Touchstone s1p/s2p; Keysight E4990A / Agilent 4294A CSV
@@ -35,6 +37,7 @@ import sys
 
 import numpy as np
 
+G_ONLY = []   # set by z_from_cols when a table holds conductance alone
 UNIT = {'HZ': 1.0, 'KHZ': 1e3, 'MHZ': 1e6, 'GHZ': 1e9}
 
 
@@ -141,11 +144,18 @@ def colkind(h):
     """Map a header cell to (kind, scale). kinds: f, zmag, phase_deg, phase_rad,
     r, x, g, b, re_y, im_y, cs, d, ..."""
     s = h.strip().strip('"').strip()
+    if s.startswith('-') and len(s) > 1 and not s[1].isdigit():
+        # '--columns' spec: a leading '-' flips the sign (e.g. '-theta[deg]' for a
+        # file that stores the phase of the current, not of Z)
+        kind, scale = colkind(s[1:])
+        return kind, -scale
     low = s.lower().replace(' ', '')
     scale = 1.0
     m = re.search(r'[\[(]\s*([a-zA-Zµμ°Ωω]*)\s*[\])]', s)
     u = (m.group(1) if m else '').replace('μ', 'µ')
     pre = {'k': 1e3, 'M': 1e6, 'G': 1e9, 'm': 1e-3, 'u': 1e-6, 'µ': 1e-6, 'n': 1e-9, 'p': 1e-12}
+    if low.startswith('transmissionloss') or low.startswith('s21(db)'):
+        return 's21_db', 1.0
     if low.startswith('s11(db)') or low.startswith('s11db'):
         return 's11_db', 1.0
     if low.startswith('s11(deg)') or low.startswith('s11deg'):
@@ -183,12 +193,20 @@ def colkind(h):
 
 
 def z_from_cols(cols, data):
-    k = {c[0]: (i, c[1]) for i, c in enumerate(cols) if c[0]}
+    k = {}
+    for i, c in enumerate(cols):      # the first column of each kind wins
+        if c[0] and c[0] not in k:
+            k[c[0]] = (i, c[1])
     if 'f' not in k:
         return None, None, 'no frequency column'
     fi, fs = k['f']
     f = data[:, fi] * fs
     get = lambda n: data[:, k[n][0]] * k[n][1]
+    if 's21_db' in k and 'phase_deg' in k:
+        # vna/J transmission export: its own Rs/Xs columns are this same
+        # series-through Z, but printed in a fixed width that drops digits
+        s21 = 10 ** (get('s21_db') / 20) * np.exp(1j * np.deg2rad(get('phase_deg')))
+        return f, 2 * 50.0 * (1 - s21) / s21, 'S21 dB/deg -> series-through Z (Z0 50 ohm, transmission)'
     if 'r' in k and 'x' in k:
         return f, get('r') + 1j * get('x'), 'R,X'
     if 's11_db' in k and 's11_deg' in k:
@@ -206,6 +224,9 @@ def z_from_cols(cols, data):
         return f, 1 / (get('g') + 1j * get('b')), 'G,B'
     if 'zmag' in k:
         return f, get('zmag').astype(complex), '|Z| only (no phase)'
+    if 'g' in k:
+        G_ONLY.append(get('g'))
+        return f, None, 'conductance only: no complex Z and no |Z| (a reader must refuse)'
     return f, None, 'no impedance columns among %s' % [c for c in k]
 
 
@@ -420,7 +441,12 @@ def main():
         colspec = args[args.index('--columns') + 1]
     path = [a for a in args if not a.startswith('--') and a not in (mode, colspec)][0]
     f, z, lay = read_any(path, mode, colspec)
-    if f is None or z is None:
+    if f is not None and z is None and G_ONLY:
+        g = G_ONLY[-1]
+        out = {'file': path, 'layout': lay, 'error': 'no impedance: conductance only',
+               'f_min_hz': float('%.6g' % f.min()), 'f_max_hz': float('%.6g' % f.max()),
+               'points': int(len(f)), 'conductance_peaks_hz': peaks(np.sort(f), g[np.argsort(f)])}
+    elif f is None or z is None:
         out = {'file': path, 'layout': lay, 'error': 'could not read impedance'}
     else:
         out = {'file': path, 'layout': lay}
