@@ -154,6 +154,15 @@ def colkind(h):
     m = re.search(r'[\[(]\s*([a-zA-Zµμ°Ωω]*)\s*[\])]', s)
     u = (m.group(1) if m else '').replace('μ', 'µ')
     pre = {'k': 1e3, 'M': 1e6, 'G': 1e9, 'm': 1e-3, 'u': 1e-6, 'µ': 1e-6, 'n': 1e-9, 'p': 1e-12}
+    low = re.sub(r'^tr\d+:', '', low)          # OMICRON Bode Analyzer Suite trace prefix
+    if 'impedance(real)' in low:
+        return 'r', 1.0
+    if 'impedance(imag' in low:
+        return 'x', 1.0
+    if 'impedance(absolut' in low or 'impedance(magnitude)' in low:
+        return 'zmag', 1.0
+    if 'gain' in low:
+        return None, 1.0
     if low.startswith('transmissionloss') or low.startswith('s21(db)'):
         return 's21_db', 1.0
     if low.startswith('s11(db)') or low.startswith('s11db'):
