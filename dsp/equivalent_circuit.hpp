@@ -75,6 +75,16 @@ struct CircuitModeFigures {
   double window_lo_hz = kNaN, window_hi_hz = kNaN;  // the mode's share of the band
   double misfit_rel_rms = kNaN;  // √mean(|Z_fit − Z|²/|Z|²) in that window
   int points = 0;                // data points in the window
+  // Whether the figures can be trusted (dsp/circuit_adequacy.hpp): "ok", or
+  // "unreliable" with the reasons (misfit in the window, implausible values,
+  // the two k_eff forms disagreeing, a Q the grid or the window cannot
+  // resolve, a resonance outside the data). An unreliable figure never passes
+  // a limit.
+  std::string status = "ok";
+  std::vector<std::string> reasons;
+  // How σ was widened beyond the fit's covariance (residual correlation in the
+  // window, the offset from the data's own conductance / resistance maximum).
+  std::vector<std::string> sigma_notes;
 };
 
 struct CircuitFitOptions {
@@ -108,6 +118,24 @@ struct CircuitFit {
   double misfit_abs_rel_rms = kNaN;    // of |Z| over the band
   double misfit_admittance_abs_rel_rms = kNaN;  // of |Y| over the band
   std::vector<std::string> notes;      // order selection, dropped modes, assumptions
+  // Adequacy (dsp/circuit_adequacy.hpp): "ok", or "inadequate" when the
+  // network cannot describe the data (|Z| misfit above 10 %, not converged, C0
+  // absorbed into a branch); the reasons say which.
+  std::string status = "ok";
+  std::vector<std::string> status_reasons;
+  // The data's own noise from their point-to-point scatter (relative, per
+  // component of Z, or of ln|Z| when magnitude only), and the fit's residual
+  // RMS in units of it (1: the network explains the data to their noise).
+  double noise_scatter_rel = kNaN;
+  double residual_to_scatter = kNaN;
+  double residual_lag1 = kNaN;  // lag-1 autocorrelation of the residual over the band
+  // The data's conductance peaks with a clear prominence, and the mode each
+  // became (−1: none; the notes say why).
+  struct DataPeak {
+    double f_hz = kNaN, prominence_s = kNaN;
+    int mode = -1;
+  };
+  std::vector<DataPeak> data_peaks;
 };
 
 // f ascending, z the measured impedance, z_sigma per point sqrt(E|δZ|²) or

@@ -68,6 +68,10 @@ struct ModeFigures {
   BvdFit fit;                         // the fit's diagnostics (window points, residual, converged)
   double window_lo_hz = kNaN, window_hi_hz = kNaN;
   std::vector<std::string> notes;
+  // "ok", or "unreliable" with the reasons (dsp/circuit_adequacy.hpp's checks
+  // where the figures come from a network; the BVD fit's own otherwise).
+  std::string status = "ok";
+  std::vector<std::string> reasons;
 };
 
 struct ModeFiguresResult {

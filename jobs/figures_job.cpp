@@ -9,6 +9,7 @@
 #include <stdexcept>
 
 #include "acquisition/capture.hpp"
+#include "dsp/circuit_adequacy.hpp"
 #include "dsp/impedance_files/read_any.hpp"
 #include "jobs/impedance_job.hpp"
 #include "jobs/job_error.hpp"
@@ -209,6 +210,13 @@ FiguresJobResult run_figures(const FiguresRequest& req) {
       m.misfit_rel_rms = w.z;
       m.points = w.points;
     }
+    {  // the model's figures are not a fit to the estimate: plausibility only
+      dsp::AdequacyOptions ao;
+      ao.widen_sigma = false;
+      ao.data_checks = false;
+      ao.max_branches = req.max_modes;
+      dsp::assess_circuit_fit(out.f_hz, out.z_ohm, cf, ao);
+    }
     if (static_cast<int>(cf.modes.size()) > req.max_modes) {
       cf.notes.push_back("reported the " + std::to_string(req.max_modes) + " strongest of " +
                          std::to_string(cf.modes.size()) + " modes (--modes)");
@@ -264,7 +272,22 @@ nlohmann::json figures_json(const FiguresRequest& req, const FiguresJobResult& r
       {"k_eff_en50324", "sqrt(1 - (fm/fn)^2), EN 50324-2's form from the |Z| extrema"},
       {"qm_branch", "2 pi fs L1 / R1"},
       {"qm_bandwidth", "f_Gmax / (f2 - f1), conductance half-power points (EN 50324-2)"},
-      {"sigma", "1 sigma from the fit's covariance, inflated by chi2/dof when above 1 (lack of fit)"}};
+      {"sigma", "1 sigma from the fit's covariance (a file without per-point sigma: relative weights, the "
+                "residual sets the scale; with them: inflated by chi2/dof when above 1), widened by the residual's "
+                "correlation in the mode's window and by the offset from the data's own conductance, resistance and "
+                "|Z| extrema where significant (sigma_notes say by how much)"},
+      {"status", "ok, or unreliable with the reasons (misfit in the window, implausible values, the k_eff forms "
+                 "disagreeing, a Q the grid or window cannot resolve, a resonance outside the data); an unreliable "
+                 "figure never passes a limit"}};
+  j["status"] = fit.status;
+  j["status_reasons"] = fit.status_reasons;
+  j["fit"]["noise_scatter_rel"] = num(fit.noise_scatter_rel);
+  j["fit"]["residual_to_scatter"] = num(fit.residual_to_scatter);
+  j["fit"]["residual_lag1"] = num(fit.residual_lag1);
+  j["data_peaks"] = nlohmann::json::array();
+  for (const auto& p : fit.data_peaks)
+    j["data_peaks"].push_back({{"f_hz", p.f_hz}, {"prominence_s", p.prominence_s},
+                               {"mode", p.mode >= 0 ? nlohmann::json(p.mode + 1) : nlohmann::json(nullptr)}});
   j["modes"] = nlohmann::json::array();
   for (std::size_t k = 0; k < fit.modes.size(); ++k) {
     const auto& m = fit.modes[k];
@@ -274,6 +297,9 @@ nlohmann::json figures_json(const FiguresRequest& req, const FiguresJobResult& r
     jm["window_hz"] = {num(m.window_lo_hz), num(m.window_hi_hz)};
     jm["points"] = m.points;
     jm["misfit_rel_rms"] = num(m.misfit_rel_rms);
+    jm["status"] = m.status;
+    jm["reasons"] = m.reasons;
+    jm["sigma_notes"] = m.sigma_notes;
     j["modes"].push_back(jm);
   }
   j["notes"] = r.notes;

@@ -62,6 +62,8 @@ nlohmann::json modes_json(const dsp::ModeFiguresResult& r) {
                 {"rms_rel_residual", m.fit.rms_rel_residual},
                 {"iterations", m.fit.iterations}};
     j["notes"] = m.notes;
+    j["status"] = m.status;
+    j["reasons"] = m.reasons;
     a.push_back(j);
   }
   return a;
@@ -106,6 +108,8 @@ void print_mode_figures(std::FILE* out, const nlohmann::json& modes, const nlohm
         vs(m, "fm_hz", "fm_sigma_hz", 1, "%.2f").c_str(),
         vs(m, "fn_hz", "fn_sigma_hz", 1, "%.2f").c_str(),
         vs(m, "frequency_constant_hz_m", "frequency_constant_sigma_hz_m", 1, "%.1f").c_str());
+    if (m.contains("reasons"))
+      for (const auto& r : m["reasons"]) std::fprintf(out, "      UNRELIABLE: %s\n", r.get<std::string>().c_str());
     for (const auto& n : m["notes"])
       std::fprintf(out, "      note: %s\n", n.get<std::string>().c_str());
   }

@@ -4,6 +4,7 @@
 #include <numbers>
 #include <stdexcept>
 
+#include "dsp/circuit_adequacy.hpp"
 #include "update/model_figures.hpp"
 
 namespace piezo::jobs {
@@ -50,6 +51,19 @@ CaptureModeFigures model_mode_figures(const acq::Capture& cap, const CaptureMode
     out.error = std::string("the updated model's modes: ") + e.what();
     return out;
   }
+  {  // plausibility of the model's figures (no data to check them against here)
+    dsp::CircuitFit cf;
+    cf.circuit = mf.circuit;
+    cf.modes = mf.modes;
+    cf.converged = r.ok();
+    dsp::AdequacyOptions ao;
+    ao.widen_sigma = false;
+    ao.data_checks = false;
+    Eigen::VectorXd band(2);
+    band << 1.0, r.band_hz;
+    dsp::assess_circuit_fit(band, Eigen::VectorXcd(), cf, ao);
+    mf.modes = cf.modes;
+  }
   auto& fr = out.figures;
   for (const auto& c : mf.modes) {
     dsp::ModeFigures m;
@@ -71,6 +85,8 @@ CaptureModeFigures model_mode_figures(const acq::Capture& cap, const CaptureMode
     m.fit.converged = r.ok();
     m.fit.weighted = true;
     m.fit.chi2_per_dof = r.chi2_per_dof;  // the output-error fit's, of the samples
+    m.status = c.status;
+    m.reasons = c.reasons;
     if (!std::isfinite(c.fp_hz.value))
       m.notes.push_back("a weak mode inside a stronger one's fs-fp interval: no parallel resonance of its own");
     fr.modes.push_back(std::move(m));

@@ -98,9 +98,22 @@ std::vector<PathStep> parse_path(const std::string& path) {
   return out;
 }
 
+namespace {
+const nlohmann::json* resolve_in(const nlohmann::json& result, const std::vector<PathStep>& path,
+                                 const nlohmann::json** parent);
+}
+
 const nlohmann::json* resolve(const nlohmann::json& result, const std::vector<PathStep>& path) {
+  return resolve_in(result, path, nullptr);
+}
+
+namespace {
+// As resolve, and the object that holds the node (its mode, its parameter).
+const nlohmann::json* resolve_in(const nlohmann::json& result, const std::vector<PathStep>& path,
+                                 const nlohmann::json** parent) {
   const nlohmann::json* n = &result;
   for (const auto& s : path) {
+    if (parent && n->is_object()) *parent = n;
     if (!s.key.empty()) {
       if (n->is_object()) {
         const auto it = n->find(s.key);
@@ -141,8 +154,10 @@ const nlohmann::json* resolve(const nlohmann::json& result, const std::vector<Pa
     }
   }
   if (n->is_object() && n->contains("updated") && (*n)["updated"].is_number()) n = &(*n)["updated"];
+  if (parent && n->is_object()) *parent = n;
   return n;
 }
+}  // namespace
 
 Limits parse_limits(std::string_view text, const std::string& source) {
   toml::table t;
@@ -272,7 +287,22 @@ LimitCheck check_limit(const Limits& L, std::size_t k, const nlohmann::json& res
   const Limit& lim = L.limits.at(k);
   LimitCheck c;
   c.limit = k;
-  const nlohmann::json* v = resolve(result, lim.path);
+  const nlohmann::json* holder = nullptr;
+  const nlohmann::json* v = resolve_in(result, lim.path, &holder);
+  // A figure its own status calls unreliable (or a constant not identifiable)
+  // is not a measurement: it never passes a limit.
+  if (v && holder && holder != v && holder->contains("status") && (*holder)["status"].is_string()) {
+    const auto st = (*holder)["status"].get<std::string>();
+    if (st == "unreliable" || st == "not identifiable" || st == "not_identifiable" || st == "non_physical") {
+      c.state = "not measured";
+      c.value = nullptr;
+      c.reason = lim.quantity + " not measured: " + st;
+      if (holder->contains("reasons") && (*holder)["reasons"].is_array() && !(*holder)["reasons"].empty() &&
+          (*holder)["reasons"][0].is_string())
+        c.reason += " (" + (*holder)["reasons"][0].get<std::string>() + ")";
+      return c;
+    }
+  }
   const bool ok_type = v && (lim.numeric() ? v->is_number() : (v->is_string() || v->is_boolean()));
   if (!ok_type || (v->is_number() && !std::isfinite(v->get<double>()))) {
     c.state = "not measured";

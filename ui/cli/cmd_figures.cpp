@@ -55,6 +55,13 @@ void print_text(const nlohmann::json& j) {
               j["points"].get<int>(), j["modes"].size(), fit["parameters"].get<int>(),
               fit["chi2_per_dof"].is_null() ? "-" : std::to_string(fit["chi2_per_dof"].get<double>()).c_str(),
               fit["misfit_abs_rel_rms"].get<double>() * 100, j["magnitude_only"].get<bool>() ? " (|Z| only)" : "");
+  if (j.contains("status")) {
+    std::printf("  status          %s", j["status"].get<std::string>().c_str());
+    for (const auto& r : j["status_reasons"]) std::printf("; %s", r.get<std::string>().c_str());
+    if (!fit["residual_to_scatter"].is_null())
+      std::printf("  (residual %.3g x the data's point-to-point scatter)", fit["residual_to_scatter"].get<double>());
+    std::printf("\n");
+  }
   if (j.contains("output_error") && j["output_error"].contains("parameters")) {
     std::printf("  model          ");
     for (const auto& p : j["output_error"]["parameters"]) {
@@ -75,6 +82,13 @@ void print_text(const nlohmann::json& j) {
                                                   : std::min(m["window_hz"][1].get<double>(), j["band_hz"][1].get<double>());
     std::printf("\n  mode %d  (window %.6g-%.6g Hz, %d points, misfit %.3g %%)\n", m["mode"].get<int>(), lo, hi,
                 m["points"].get<int>(), m["misfit_rel_rms"].is_null() ? 0.0 : m["misfit_rel_rms"].get<double>() * 100);
+    if (m.contains("status")) {
+      if (m["status"] == "ok")
+        std::printf("    status ok\n");
+      else
+        for (const auto& r : m["reasons"]) std::printf("    UNRELIABLE: %s\n", r.get<std::string>().c_str());
+      for (const auto& r : m["sigma_notes"]) std::printf("    (%s)\n", r.get<std::string>().c_str());
+    }
     std::printf("    fs %s Hz   fp %s Hz\n", pm(m["fs_hz"], "%.7g").c_str(), pm(m["fp_hz"], "%.7g").c_str());
     std::printf("    fm %s Hz   fn %s Hz\n", pm(m["fm_hz"], "%.7g").c_str(), pm(m["fn_hz"], "%.7g").c_str());
     std::printf("    fr %s Hz   fa %s Hz\n", pm(m["fr_hz"], "%.7g").c_str(), pm(m["fa_hz"], "%.7g").c_str());

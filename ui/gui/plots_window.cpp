@@ -121,8 +121,8 @@ void render_modes_row(AppState& s, float width, float height) {
                 r.reference_used_hz, pm(r.frequency_constant_hz_m, 1.0, "%.5g").c_str());
     const ImGuiTableFlags flags = ImGuiTableFlags_Borders | ImGuiTableFlags_RowBg | ImGuiTableFlags_ScrollY |
                                   ImGuiTableFlags_SizingFixedFit;
-    if (ImGui::BeginTable("modes", 9, flags)) {
-      for (const char* h : {"mode", "fs kHz", "fp kHz", "k_eff", "Qm branch", "Qm 3 dB", "R1 ohm", "L1 mH", "C1 pF"})
+    if (ImGui::BeginTable("modes", 10, flags)) {
+      for (const char* h : {"mode", "status", "fs kHz", "fp kHz", "k_eff", "Qm branch", "Qm 3 dB", "R1 ohm", "L1 mH", "C1 pF"})
         ImGui::TableSetupColumn(h);
       ImGui::TableSetupScrollFreeze(0, 1);
       ImGui::TableHeadersRow();
@@ -139,6 +139,17 @@ void render_modes_row(AppState& s, float width, float height) {
             ny_index >= 0) {
           s.nyquist_mode = ny_index;
           s.nyquist_view.fitted = false;
+        }
+        ImGui::TableNextColumn();
+        if (m.status == "ok") {
+          ImGui::TextUnformatted("ok");
+        } else {
+          ImGui::TextColored(ImVec4(1.0f, 0.45f, 0.35f, 1.0f), "%s", m.status.c_str());
+          if (ImGui::IsItemHovered()) {
+            std::string why;
+            for (const auto& r : m.reasons) why += (why.empty() ? "" : "\n") + r;
+            ImGui::SetTooltip("%s", why.c_str());
+          }
         }
         cell(m.fs_hz, 1e-3, "%.4f");
         cell(m.fp_hz, 1e-3, "%.4f");
