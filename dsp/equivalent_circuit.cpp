@@ -179,6 +179,7 @@ struct Trial {
   Eigen::VectorXd t;
   Eigen::MatrixXd j;
   double chi2 = kNaN, bic = kNaN;
+  double neff = kNaN;  // rows × (1 − ρ)/(1 + ρ), ρ the residual's lag-1 autocorrelation
   bool converged = false;
 };
 
@@ -561,6 +562,34 @@ CircuitFit fit_equivalent_circuit(const Eigen::VectorXd& f, const Eigen::VectorX
   const Eigen::Index rows = d.rows();
   auto score = [&](Trial& tr) {
     tr.bic = std::isfinite(tr.chi2) ? bic_of(tr.chi2, rows, tr.lay.size(), out.weighted) : INFINITY;
+    // The residual's correlation along f: a network that is the wrong model
+    // leaves structure, and n correlated points weigh as n_eff independent ones.
+    const Eigen::VectorXd r = d.residual(tr.lay, tr.t, nullptr);
+    double num = 0, den = 0;
+    const Eigen::Index step = d.magnitude ? 1 : 2;
+    for (Eigen::Index i = 0; i + step < r.size(); ++i) {
+      den += r[i] * r[i];
+      num += r[i] * r[i + step];
+    }
+    const double rho = den > 0 ? std::clamp(num / den, 0.0, 0.999) : 0.0;
+    tr.neff = std::max(static_cast<double>(tr.lay.size() + 2), static_cast<double>(rows) * (1 - rho) / (1 + rho));
+  };
+  // Is trial a better than b? By the information criterion; with relative
+  // weights (no per-point σ: the residual sets the scale) on the effective
+  // number of points of the better-fitting one's residual, so that a branch
+  // that only follows structure the network cannot describe (a real part's
+  // wiggles, 236 × its scatter noise) is not bought with hundreds of
+  // correlated points (EQCIRC3's sampleadmittance took 10 branches for one mode).
+  auto better = [&](const Trial& a, const Trial& b) {
+    if (out.weighted || !std::isfinite(a.neff) || !std::isfinite(b.neff)) return a.bic < b.bic;
+    if (!std::isfinite(a.chi2)) return false;
+    if (!std::isfinite(b.chi2)) return true;
+    const double ne = a.chi2 < b.chi2 ? a.neff : b.neff;
+    const double n = static_cast<double>(rows);
+    auto crit = [&](const Trial& t) {
+      return ne * std::log(std::max(t.chi2, n * 1e-12) / n) + t.lay.size() * std::log(ne);
+    };
+    return crit(a) < crit(b);
   };
   auto run = [&](const EquivalentCircuit& c, bool rs) {
     Layout lay{rs, c.branches.size()};
@@ -609,9 +638,9 @@ CircuitFit fit_equivalent_circuit(const Eigen::VectorXd& f, const Eigen::VectorX
       EquivalentCircuit more = cur;
       more.branches.push_back(branch_at(f[i], dg[i], peak_q(f, dg, i)));
       Trial tr = run(sorted(more), false);
-      if (tr.bic < st.bic && !any_absorbs_c0(circuit_of(tr.lay, tr.t))) st = tr;
+      if (better(tr, st) && !any_absorbs_c0(circuit_of(tr.lay, tr.t))) st = tr;
     }
-    if (st.bic < best.bic) {
+    if (better(st, best)) {
       out.notes.push_back("fitted stagewise from the most prominent peak (information criterion " + fmt(best.bic, 6) +
                           " with every seed at once, " + fmt(st.bic, 6) + " stagewise)");
       best = st;
@@ -636,7 +665,7 @@ CircuitFit fit_equivalent_circuit(const Eigen::VectorXd& f, const Eigen::VectorX
       if (!c1.branches.empty()) {
         if (c1.c0_f > 2 * cb1) c1.c0_f = c0.c0_f + cb - cb1;
         Trial alt = run(sorted(c1), false);
-        if (alt.bic < best.bic) {
+        if (better(alt, best)) {
           out.notes.push_back("started from the per-mode BVD fits (information criterion " + fmt(best.bic, 6) +
                               " from the conductance peaks, " + fmt(alt.bic, 6) + " from them)");
           best = alt;
@@ -671,7 +700,7 @@ CircuitFit fit_equivalent_circuit(const Eigen::VectorXd& f, const Eigen::VectorX
       const bool outside = outside_at(cur, k), absorbing = absorbs_c0(cur, k);
       if (absorbing && !(less.c0_f > cur.branches[k].c_f)) less.c0_f += cur.branches[k].c_f;
       Trial tr = run(less, best.lay.rs);
-      if (outside || absorbing || tr.bic < best.bic) {
+      if (outside || absorbing || better(tr, best)) {
         out.notes.push_back("dropped the branch at " + fmt(fs) + " Hz (" +
                             (outside      ? std::string("outside the data")
                              : absorbing ? std::string("Q below 1 and larger than C0: it stood in for C0")
@@ -706,14 +735,14 @@ CircuitFit fit_equivalent_circuit(const Eigen::VectorXd& f, const Eigen::VectorX
     EquivalentCircuit more = cur;
     more.branches.push_back(branch_at(f[at], dg[at], peak_q(f, dg, at)));
     Trial tr = run(sorted(more), best.lay.rs);
-    if (!(tr.bic < best.bic) || any_absorbs_c0(circuit_of(tr.lay, tr.t))) break;
+    if (!better(tr, best) || any_absorbs_c0(circuit_of(tr.lay, tr.t))) break;
     out.notes.push_back("added a branch at " + fmt(f[at]) + " Hz (information criterion " + fmt(best.bic, 6) + " -> " +
                         fmt(tr.bic, 6) + ")");
     best = tr;
   }
   if (opt.try_series_resistance && !best.lay.rs) {
     Trial tr = run(circuit_of(best.lay, best.t), true);
-    if (tr.bic < best.bic) {
+    if (better(tr, best)) {
       out.notes.push_back("series resistance kept (information criterion " + fmt(best.bic, 6) + " -> " + fmt(tr.bic, 6) + ")");
       best = tr;
     }
