@@ -187,8 +187,10 @@ FixtureCalibration fit_fixture(const CalibrationStandards& s) {
   out.skew_sigma_s = sd[kTau];
   if (s.open) {
     out.fixture_capacitance_f = th[kBeta] / (th[kRho] * r1);
-    const double rel = std::hypot(sd[kBeta] / std::max(th[kBeta], 1e-300), sd[kRho] / th[kRho]);
-    out.fixture_capacitance_sigma_f = std::abs(*out.fixture_capacitance_f) * rel;
+    // σ of β/(ρ·R1) term by term: as a relative σ times the value it read
+    // 0 ± 5e275 F where β is near 0 (a fixture without parallel capacitance).
+    out.fixture_capacitance_sigma_f =
+        std::hypot(sd[kBeta] / (th[kRho] * r1), th[kBeta] * sd[kRho] / (th[kRho] * th[kRho] * r1));
     out.open_dc_transfer = 1.0 / th[kU];
     out.open_dc_transfer_sigma = sd[kU] / (th[kU] * th[kU]);
   }

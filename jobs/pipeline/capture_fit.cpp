@@ -1,5 +1,9 @@
 #include "jobs/pipeline/capture_fit.hpp"
 
+#include <algorithm>
+#include <cmath>
+#include <optional>
+
 #include <stdexcept>
 
 #include "model/material_presets.hpp"
@@ -62,12 +66,19 @@ CaptureFit fit_capture(const acq::Capture& cap, const CaptureFitRequest& req, co
   const update::OeData data = capture_oe_data(cap, req.fixture, &out.excitation);
   out.shots_available = static_cast<int>(data.shots.size());
   if (req.fixture) {
-    // Measured: their sigmas replace the stated tolerances.
+    // Measured: their sigmas replace the stated tolerances — but a calibration
+    // that cannot determine a quantity (a degenerate standard: the fixture
+    // capacitance 0 ± 5e275 F beside a measured channel skew) never makes it
+    // less known than the stated tolerance did: the smaller of the two.
     const auto& fx = *req.fixture;
     auto& o = opts;
-    if (fx.r1_error) o.r1_rel_sigma = fx.r1_error_sigma.value_or(o.r1_rel_sigma);
-    if (fx.fixture_capacitance_f) o.cp_sigma_f = fx.fixture_capacitance_sigma_f.value_or(o.cp_sigma_f);
-    if (fx.skew_s) o.skew_sigma_s = fx.skew_sigma_s.value_or(o.skew_sigma_s);
+    auto measured = [](const std::optional<double>& s, double stated) {
+      if (!s || !std::isfinite(*s) || !(*s >= 0)) return stated;
+      return stated > 0 ? std::min(*s, stated) : *s;
+    };
+    if (fx.r1_error) o.r1_rel_sigma = measured(fx.r1_error_sigma, o.r1_rel_sigma);
+    if (fx.fixture_capacitance_f) o.cp_sigma_f = measured(fx.fixture_capacitance_sigma_f, o.cp_sigma_f);
+    if (fx.skew_s) o.skew_sigma_s = measured(fx.skew_sigma_s, o.skew_sigma_s);
   }
   out.result = update::fit_output_error(*m.solver, m.cls, m.p0, data, opts);
   return out;
