@@ -11,6 +11,7 @@
 //           names that say nothing we know.
 #include <string>
 #include <string_view>
+#include <vector>
 
 #include "dsp/impedance_files/quantities.hpp"
 
@@ -28,5 +29,12 @@ struct ColumnMeaning {
 };
 
 ColumnMeaning classify_column(std::string_view header);
+
+// The names of a table's columns as the user gives them (`piezobench figures
+// --columns f[kHz],G[uS],B[uS]`): a comma list of header names as above, each
+// with its unit in brackets; "-" or "skip" leaves a column out. Throws
+// std::invalid_argument naming an item that is no column we know, or a list
+// without a frequency.
+std::vector<std::string> parse_column_spec(std::string_view spec);
 
 }  // namespace piezo::dsp::zfiles
