@@ -228,7 +228,17 @@ ColumnMeaning classify_column(std::string_view header) {
     }
     return false;
   };
+  // "Transmission Loss(dB)" (vna/J's transmission mode): S21 in dB.
+  bool transmission = false;
+  for (const auto& w : words) transmission = transmission || lower(w) == "transmission";
   for (auto w : words) {
+    if (transmission && in(lower(w), {"transmission", "loss"})) {
+      if (lower(w) == "transmission")
+        qs.push_back(Quantity::S21);
+      else
+        m.loss = true;
+      continue;
+    }
     if (w.find('|') != std::string::npos) {
       bars = true;
       w.erase(std::remove(w.begin(), w.end(), '|'), w.end());

@@ -6,6 +6,7 @@
 //   units:  Hz kHz MHz GHz (any case); Ω/ohm with m k M G prefixes (mΩ milli,
 //           MΩ mega); S with m u µ n p prefixes; deg ° rad; dB; H and F with
 //           prefixes; U or () for a pure number.
+//   S21:    "S21(DB)", "Transmission Loss(dB)" (vna/J, transmission mode)
 //   ignored: memory traces ("-mem", "Memory"), quantities that are not an
 //           impedance (gain, S21, return loss, voltage, current, ...), and
 //           names that say nothing we know.
@@ -26,6 +27,7 @@ struct ColumnMeaning {
   double scale = 1.0;       // file unit -> Hz, ohm, S, rad, H, F (dB values stay dB)
   bool unit_given = false;  // false: Hz, ohm/S, degrees assumed
   std::string why;          // why a column is ignored
+  bool loss = false;        // "Transmission Loss(dB)": a loss, maybe written positive
 };
 
 ColumnMeaning classify_column(std::string_view header);

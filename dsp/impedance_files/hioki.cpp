@@ -164,6 +164,7 @@ ImportedImpedance read_hioki_csv(const std::vector<TextLine>& lines, const std::
   opt.format_name = "HIOKI " + (m.empty() ? std::string() : m + " ") + "CSV";
   opt.allow_headerless = false;
   opt.columns_origin = "the header";
+  opt.header_line = lines[h].number;
   std::vector<std::string> not_read;
   bool theta = false;
   for (std::size_t k = 0; k < fields.size(); ++k) {

@@ -223,6 +223,7 @@ ImportedImpedance read_labone(const std::vector<TextLine>& lines, const std::str
   opt.columns = cols;
   opt.labels = fields;
   opt.columns_origin = "the header";
+  opt.header_line = lines[h].number;
   auto out = read_table(data, name, opt);
   out.notes.insert(out.notes.begin(), "header on line " + std::to_string(lines[h].number));
   out.notes.insert(out.notes.end(), notes.begin(), notes.end());

@@ -148,8 +148,17 @@ std::optional<PairChoice> choose_pair(const std::vector<ColumnMeaning>& cols,
         return i;
     return std::nullopt;
   };
-  for (const auto& o : kOrder) {
-    if (o.q == Q::S21 && !allow_s21) continue;
+  // A transmission export: S21 first (a program's Z columns beside it are
+  // derived from it, vna/J's printed in a width that drops digits).
+  bool s21_columns = false;
+  for (const auto& c : cols) s21_columns = s21_columns || c.quantity == Q::S21;
+  std::vector<Candidate> order;
+  if (s21_columns && allow_s21)
+    for (const auto& o : kOrder)
+      if (o.q == Q::S21) order.push_back(o);
+  for (const auto& o : kOrder)
+    if (o.q != Q::S21 || (allow_s21 && !s21_columns)) order.push_back(o);
+  for (const auto& o : order) {
     const auto a = find(o.q, o.a, cols.size());
     if (!a) continue;
     const auto b = find(o.q, o.b, *a);
@@ -280,6 +289,7 @@ ImportedImpedance read_table(const std::vector<TextLine>& lines, const std::stri
   int header_line = 0;
   const bool given = !opt.columns.empty();
   if (given) {
+    header_line = opt.header_line;
     // Names given: the header (if any) is text above the data like the rest.
     if (header) preamble.push_back(header);
     header = nullptr;
@@ -375,17 +385,22 @@ ImportedImpedance read_table(const std::vector<TextLine>& lines, const std::stri
   if (names.empty()) {
     const std::size_t n = row_fields(row0.text, *layout).size();
     if (!opt.allow_headerless) fail(fn, name, row0.number, "data without a header line");
-    if (n < 3)
+    if (n != 3) {
+      std::string spec = "f[Hz],R[ohm],X[ohm]";
+      for (std::size_t k = 3; k < n && k < 16; ++k) spec += ",-";
       fail(fn, name, row0.number,
-           "no header, and " + std::to_string(n) +
-               " columns: a table without a header must be f_hz, re_ohm, im_ohm" + kColumnsHint);
+           "no header, and " + std::to_string(n) + " columns: a table without a header is read " +
+               "only as the three columns f_hz, re_ohm, im_ohm; name the columns with --columns " +
+               "(piezobench figures), e.g. --columns " +
+               (n > 3 ? spec + " or f[Hz],|Z|[ohm],theta[deg]" + spec.substr(19)
+                      : std::string("f[Hz],|Z|[ohm] (a magnitude alone)")));
+    }
     ncols = n;
     fcol = 0;
     pair.spec = {Quantity::Z, Part::Re, Part::Im, 50.0};
     pair.col_a = 1;
     pair.col_b = 2;
-    b.out.notes.push_back("no header: columns read as f_hz, re_ohm, im_ohm" +
-                          std::string(n > 3 ? " (further columns ignored)" : ""));
+    b.out.notes.push_back("no header: columns read as f_hz, re_ohm, im_ohm");
     cols.assign(n, ColumnMeaning{});
     cols[0] = {Role::Frequency, Quantity::Unknown, Part::None, 1.0, true, ""};
     cols[1] = {Role::Value, Quantity::Z, Part::Re, 1.0, true, ""};
@@ -435,6 +450,14 @@ ImportedImpedance read_table(const std::vector<TextLine>& lines, const std::stri
                        : pair.spec.a == Part::Mag ? std::abs(va)
                                                   : std::pow(10.0, va / 20.0));
       }
+      // "Transmission Loss(dB)" written as a positive loss: -dB.
+      if (pair.spec.a == Part::MagDb && cols[pair.col_a].loss && !mags.empty() &&
+          std::all_of(mags.begin(), mags.end(), [](double m) { return m >= 1.0; }) &&
+          std::any_of(mags.begin(), mags.end(), [](double m) { return m > 1.0; })) {
+        cols[pair.col_a].scale = -cols[pair.col_a].scale;
+        for (auto& m : mags) m = 1.0 / m;
+        s21_note = "transmission loss written positive: read as |S21| = -loss (dB); ";
+      }
       double median = 0;
       if (!mags.empty()) {
         std::nth_element(mags.begin(), mags.begin() + static_cast<std::ptrdiff_t>(mags.size() / 2),
@@ -446,11 +469,11 @@ ImportedImpedance read_table(const std::vector<TextLine>& lines, const std::stri
       const auto s11 = choose_pair(cols, false);
       if (median < 1e-3 && s11 && s11->spec.quantity == Quantity::S) {
         pair = *s11;
-        s21_note = std::string("S21 is at noise level (median |S21| ") + db +
+        s21_note += std::string("S21 is at noise level (median |S21| ") + db +
                    " dB): nothing passes between the ports, so the device is taken to be on "
                    "port 1 and S11 is read as a reflection";
       } else {
-        s21_note =
+        s21_note +=
             "transmission S21 read as a device in series between the two ports (series-through "
             "fixture): Z = 2*z0*(1 - S21)/S21, z0 = 50 ohm assumed; S21 is preferred to any "
             "S11 column, and never read as a reflection";

@@ -10,6 +10,7 @@
 //               header (titles, settings) skipped with a note; a header in the
 //               last comment line before the data ("! Stimulus(Hz), ...") when
 //               there is no other; no header at all: f_hz, re_ohm, im_ohm
+//               (three columns only; any other count: name them, --columns)
 //   columns     the first usable pair, in this order: Z real/imaginary,
 //               |Z|/phase (linear or dB), Y real/imaginary, |Y|/phase, S21
 //               (transmission: series-through Z, preferred to S11), S11,
@@ -47,6 +48,7 @@ struct TableOptions {
   // own names); empty: the names themselves.
   std::vector<std::string> labels;
   std::string columns_origin = "--columns";  // "names N" in messages
+  int header_line = 0;  // the instrument's header line of the names above (0: none)
 };
 
 // Appended to a message about columns we could not read: how to name them.
