@@ -385,7 +385,7 @@ std::vector<std::string> parse_column_spec(std::string_view spec) {
     const auto m = classify_column(item);
     if (item.empty() || m.role == Role::Ignored)
       throw std::invalid_argument(
-          "--columns: '" + item + "' is not a column we know" +
+          "--columns: '" + printable(item) + "' is not a column we know" +
           (m.why.empty() ? std::string() : " (" + m.why + ")") +
           "; use f, R, X, G, B, |Z|, |Y|, theta, Rs, Rp, Cs, Cp, Ls, Lp, D, Q, re, im, S11, S21 "
           "with a unit in brackets (f[kHz], G[uS], theta[deg], |Z|[kohm]), or - to skip a column");
@@ -393,7 +393,7 @@ std::vector<std::string> parse_column_spec(std::string_view spec) {
     out.push_back(item);
   }
   if (!has_f)
-    throw std::invalid_argument("--columns: no frequency among '" + std::string(spec) +
+    throw std::invalid_argument("--columns: no frequency among '" + printable(spec) +
                                 "' (e.g. --columns f[Hz],R[ohm],X[ohm])");
   return out;
 }

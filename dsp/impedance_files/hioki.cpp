@@ -144,18 +144,15 @@ bool hioki_header(std::string_view line) {
 ImportedImpedance read_hioki_csv(const std::vector<TextLine>& lines, const std::string& name) {
   std::size_t h = lines.size();
   std::vector<std::string> fields;
-  char sep = ',';
   for (std::size_t i = 0; i < lines.size() && h == lines.size(); ++i)
     for (char s : {',', ';', '\t'})
       if (auto f = header_fields(lines[i].text, s)) {
         h = i;
         fields = *f;
-        sep = s;
         break;
       }
   if (h == lines.size())
     fail(kFn, name, 0, "no header line \"No.\",\"FREQUENCY(Hz)\",... (a HIOKI sweep saved as CSV)");
-  (void)sep;
 
   TableOptions opt;
   opt.fn = kFn;

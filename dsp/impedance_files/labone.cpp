@@ -117,13 +117,16 @@ bool labone_file(const std::vector<TextLine>& lines) {
 }
 
 ImportedImpedance read_labone(const std::vector<TextLine>& lines, const std::string& name) {
-  // The header: the first line (a '%' comment or not) with a frequency column.
+  // The header: the first line (a '%' comment or not) with a frequency (or grid) column.
   std::size_t h = lines.size();
   std::vector<std::string> fields;
   char sep = ';';
   for (std::size_t i = 0; i < lines.size() && i < kScan && h == lines.size(); ++i) {
     auto [f, s] = best_split(uncomment(lines[i].text));
-    if (has_field(f, "frequency") || (impedance_field(f) && has_field(f, "grid"))) {
+    // A column header, not prose that mentions a frequency: it names LabOne's columns too.
+    const bool labone_columns = impedance_field(f) || has_field(f, "chunk") ||
+                                has_field(f, "x") || has_field(f, "r");
+    if ((has_field(f, "frequency") || has_field(f, "grid")) && labone_columns) {
       h = i;
       fields = std::move(f);
       sep = s;

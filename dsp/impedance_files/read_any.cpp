@@ -80,9 +80,10 @@ ImportedImpedance read_impedance_any(std::istream& in, const std::string& name,
   return read_impedance_any(in, name, opt);
 }
 
-ImportedImpedance read_impedance_any(std::istream& in, const std::string& name,
-                                     const ImpedanceReadOptions& opt) {
-  const auto lines = zfiles::split_lines(zfiles::slurp(in, "read_impedance_any", name));
+namespace {
+
+ImportedImpedance read_lines(const std::vector<TextLine>& lines, const std::string& name,
+                             const ImpedanceReadOptions& opt) {
   if (!opt.columns.empty()) {
     zfiles::TableOptions t;
     t.columns = zfiles::parse_column_spec(opt.columns);
@@ -109,6 +110,18 @@ ImportedImpedance read_impedance_any(std::istream& in, const std::string& name,
       break;
   }
   return zfiles::read_table(lines, name, zfiles::TableOptions{});
+}
+
+}  // namespace
+
+ImportedImpedance read_impedance_any(std::istream& in, const std::string& name,
+                                     const ImpedanceReadOptions& opt) {
+  auto out = read_lines(zfiles::split_lines(zfiles::slurp(in, "read_impedance_any", name)), name, opt);
+  // Notes quote the file (and --columns): JSON needs UTF-8.
+  for (auto& n : out.notes) n = zfiles::printable(n);
+  out.format_name = zfiles::printable(out.format_name);
+  out.quantity = zfiles::printable(out.quantity);
+  return out;
 }
 
 ImportedImpedance read_impedance_file(const std::string& path, ImpedanceFileFormat hint) {
