@@ -382,13 +382,16 @@ std::vector<std::string> parse_column_spec(std::string_view spec) {
       out.push_back("-");
       continue;
     }
-    const auto m = classify_column(item);
+    // "-theta(deg)": the column negated (a current's phase for the impedance's).
+    const bool negated = item.size() > 1 && item.front() == '-';
+    const auto m = classify_column(negated ? std::string_view(item).substr(1) : item);
     if (item.empty() || m.role == Role::Ignored)
       throw std::invalid_argument(
           "--columns: '" + printable(item) + "' is not a column we know" +
           (m.why.empty() ? std::string() : " (" + m.why + ")") +
           "; use f, R, X, G, B, |Z|, |Y|, theta, Rs, Rp, Cs, Cp, Ls, Lp, D, Q, re, im, S11, S21 "
-          "with a unit in brackets (f[kHz], G[uS], theta[deg], |Z|[kohm]), or - to skip a column");
+          "with a unit in brackets (f[kHz], G[uS], theta[deg], |Z|[kohm]), a leading - to negate "
+          "one (-theta[deg]), or - alone to skip a column");
     has_f = has_f || m.role == Role::Frequency;
     out.push_back(item);
   }

@@ -34,7 +34,8 @@ ColumnMeaning classify_column(std::string_view header);
 
 // The names of a table's columns as the user gives them (`piezobench figures
 // --columns f[kHz],G[uS],B[uS]`): a comma list of header names as above, each
-// with its unit in brackets; "-" or "skip" leaves a column out. Throws
+// with its unit in brackets; "-" or "skip" leaves a column out, a leading "-"
+// negates one ("-theta(deg)": a current's phase read as the impedance's). Throws
 // std::invalid_argument naming an item that is no column we know, or a list
 // without a frequency.
 std::vector<std::string> parse_column_spec(std::string_view spec);

@@ -406,7 +406,17 @@ ImportedImpedance read_table(const std::vector<TextLine>& lines, const std::stri
     cols[1] = {Role::Value, Quantity::Z, Part::Re, 1.0, true, ""};
     cols[2] = {Role::Value, Quantity::Z, Part::Im, 1.0, true, ""};
   } else {
-    for (const auto& h : names) cols.push_back(classify_column(h));
+    std::vector<std::string> negated;
+    for (const auto& h : names) {
+      if (given && h.size() > 1 && h.front() == '-') {  // "-theta(deg)": the column negated
+        cols.push_back(classify_column(std::string_view(h).substr(1)));
+        cols.back().scale = -cols.back().scale;
+        negated.push_back(h.substr(1));
+        continue;
+      }
+      cols.push_back(classify_column(h));
+    }
+    if (!negated.empty()) b.out.notes.push_back("negated as asked: " + list(negated));
     for (std::size_t i = 0; i < names.size(); ++i) labels.push_back(label(i));
     const std::string hint = given ? std::string() : std::string(kColumnsHint);
     for (std::size_t i = 0; i < cols.size() && fcol == kNone; ++i)

@@ -498,6 +498,13 @@ TEST(Columns, NamedColumnsForAHeaderlessTable) {
   const auto mo = read(m, "m.txt", "f[Hz],skip,|Z|[ohm]");
   EXPECT_TRUE(mo.magnitude_only);
   EXPECT_NEAR(mo.z_ohm[3].real(), std::abs(t.z[3]), 1e-9 * std::abs(t.z[3]));
+  // A leading '-' negates a column: a current's phase read as the impedance's.
+  std::string ip;
+  for (std::size_t k = 0; k < t.f.size(); ++k)
+    ip += fmt("%.15g\t2.3\t%.15g\t%.15g\n", t.f[k], -std::arg(t.z[k]) * kDeg, std::abs(t.z[k]));
+  const auto neg = read(ip, "i.txt", "f,skip,-theta(deg),|Z|");
+  expect_curve(neg, t, 1e-13, "--columns with a negated phase");
+  EXPECT_TRUE(has_note(neg, "negated as asked: [theta(deg)]"));
   // A header is skipped when columns are given.
   const auto hd = read("a,b,c\n" + h, "hd.csv", "f,R[ohm],X[ohm]");
   expect_curve(hd, t, 1e-13, "--columns over a header");
