@@ -2,6 +2,7 @@
 
 #include <cctype>
 #include <cmath>
+#include <algorithm>
 #include <optional>
 
 #include "dsp/impedance_files/table.hpp"
@@ -99,6 +100,86 @@ std::optional<std::pair<std::string, std::string>> representation(
   return std::nullopt;
 }
 
+// LabOne's native sweeper CSV is transposed: a header "chunk;timestamp;size;fieldname"
+// and one row per chunk and field ("1;120126...;150;realz;v1;v2;..."). The last
+// chunk with a finite frequency becomes an ordinary table (one row per point, the
+// line of its frequency row as every point's line); nothing when the file is not so.
+std::optional<std::vector<TextLine>> untranspose(const std::vector<TextLine>& lines,
+                                                 std::vector<std::string>& notes) {
+  std::size_t h = lines.size();
+  for (std::size_t i = 0; i < lines.size() && i < kScan && h == lines.size(); ++i) {
+    const auto f = split_fields(trim(lines[i].text), ';');
+    if (f.size() >= 4 && iequals(f[0], "chunk") && iequals(f[3], "fieldname")) h = i;
+  }
+  if (h == lines.size()) return std::nullopt;
+  struct Field {
+    std::string name;
+    int line = 0;
+    std::vector<std::string> values;
+  };
+  struct Chunk {
+    std::string id;
+    std::vector<Field> fields;
+  };
+  std::vector<Chunk> chunks;
+  for (std::size_t i = h + 1; i < lines.size(); ++i) {
+    auto f = split_fields(trim(lines[i].text), ';');
+    if (f.size() < 5 || iequals(f[0], "chunk")) continue;  // blank, or the header again
+    while (f.size() > 4 && f.back().empty()) f.pop_back();
+    if (chunks.empty() || chunks.back().id != f[0]) chunks.push_back({f[0], {}});
+    chunks.back().fields.push_back({f[3], lines[i].number, {f.begin() + 4, f.end()}});
+  }
+  // The last complete sweep (every frequency and realz finite), else the last
+  // with any finite frequency.
+  const auto field = [](const Chunk& ch, std::string_view name) -> const Field* {
+    for (const auto& fl : ch.fields)
+      if (iequals(fl.name, name)) return &fl;
+    return nullptr;
+  };
+  const auto finite_count = [](const Field* fl) {
+    std::size_t n = 0;
+    for (std::size_t k = 0; fl && k < fl->values.size(); ++k) {
+      double v;
+      n += parse_number(fl->values[k], v) && std::isfinite(v);
+    }
+    return n;
+  };
+  std::size_t pick = chunks.size();
+  for (std::size_t c = chunks.size(); c-- > 0 && pick == chunks.size();) {
+    const auto* f = field(chunks[c], "frequency");
+    const auto* z = field(chunks[c], "realz") ? field(chunks[c], "realz") : field(chunks[c], "absz");
+    if (f && finite_count(f) == f->values.size() && (!z || finite_count(z) == z->values.size()))
+      pick = c;
+  }
+  for (std::size_t c = chunks.size(); c-- > 0 && pick == chunks.size();)
+    if (finite_count(field(chunks[c], "frequency")) > 0) pick = c;
+  for (std::size_t c = pick; c < chunks.size(); c = chunks.size()) {
+    const auto& ch = chunks[c];
+    const Field* freq = field(ch, "frequency");
+    std::vector<TextLine> out;
+    std::string header;
+    std::size_t n = 0;
+    for (const auto& fl : ch.fields) {
+      header += (header.empty() ? "" : ";") + fl.name;
+      n = std::max(n, fl.values.size());
+    }
+    out.push_back({lines[h].number, header});
+    for (std::size_t k = 0; k < n; ++k) {
+      std::string row;
+      for (std::size_t j = 0; j < ch.fields.size(); ++j) {
+        const auto& v = ch.fields[j].values;
+        row += (j ? ";" : "") + (k < v.size() && !v[k].empty() ? v[k] : std::string("nan"));
+      }
+      out.push_back({freq->line, row});
+    }
+    notes.push_back("LabOne's transposed layout (one row per field): chunk " + ch.id + " read, " +
+                    std::to_string(chunks.size()) + " chunk(s) (sweeps) in the file" +
+                    (c + 1 < chunks.size() ? " (the last complete sweep; later ones are not)" : ""));
+    return out;
+  }
+  return std::vector<TextLine>{lines[h]};  // no chunk with a frequency: "no data rows"
+}
+
 }  // namespace
 
 bool labone_file(const std::vector<TextLine>& lines) {
@@ -111,12 +192,17 @@ bool labone_file(const std::vector<TextLine>& lines) {
         return true;
     }
     const auto f = best_split(uncomment(t)).first;
-    if (impedance_field(f) || (has_field(f, "chunk") && has_field(f, "timestamp"))) return true;
+    if (impedance_field(f) || (has_field(f, "chunk") && has_field(f, "timestamp")) ||
+        (f.size() >= 4 && iequals(f[0], "chunk") && iequals(f[3], "fieldname")))
+      return true;
   }
   return false;
 }
 
-ImportedImpedance read_labone(const std::vector<TextLine>& lines, const std::string& name) {
+ImportedImpedance read_labone(const std::vector<TextLine>& all, const std::string& name) {
+  std::vector<std::string> notes;
+  const auto transposed = untranspose(all, notes);
+  const auto& lines = transposed ? *transposed : all;
   // The header: the first line (a '%' comment or not) with a frequency (or grid) column.
   std::size_t h = lines.size();
   std::vector<std::string> fields;
@@ -137,7 +223,6 @@ ImportedImpedance read_labone(const std::vector<TextLine>& lines, const std::str
          "no header line naming the columns (frequency;realz;imagz;... as LabOne writes it)" +
              std::string(kColumnsHint));
 
-  std::vector<std::string> notes;
   auto fcol = index_of(fields, "frequency");
   if (!fcol) {
     fcol = index_of(fields, "grid");

@@ -1,7 +1,12 @@
 #pragma once
 // Zurich Instruments LabOne exports of a sweep (MFIA, or an MFLI with the IA
 // option): the Sweeper's or the Impedance Analyzer module's "Save" as CSV or
-// text, one row per point:
+// text. LabOne's native CSV (seen in a real file: dev3221_imps_0_sample_00000.csv
+// of an MFLI/MFIA, 35 sweeps) is transposed: a header "chunk;timestamp;size;
+// fieldname" padded with ';', then one row per chunk and field
+// ("1;1201...;150;realz;v1;v2;..."), frequencies descending, unfinished cells
+// empty or nan; the last complete sweep is read (a note names the chunk). Also
+// read, one row per point:
 //   CSV   ';'-separated, a header such as
 //         chunk;timestamp;grid;frequency;realz;imagz;absz;phasez;param0;param1
 //         (any order, more columns allowed)
@@ -14,9 +19,9 @@
 // phase: volts) are not an impedance: such a file is refused with the next
 // step. Several sweeps (a chunk column with more than one value): the last is
 // read, with a note. Points not measured ("nan") are left out, with a note.
-// The layout follows issue 39's description and LabOne's field names
-// (realz, imagz, absz, phasez, param0, param1 of the impedance sample); the
-// representation line has not been seen in a real file.
+// The row-per-point layouts follow issue 39's description and LabOne's field
+// names (realz, imagz, absz, phasez, param0, param1 of the impedance sample);
+// they and the representation line have not been seen in a real file.
 #include <istream>
 #include <string>
 #include <vector>

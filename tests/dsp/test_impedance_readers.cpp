@@ -323,6 +323,34 @@ TEST(LabOne, SweeperCsvTextAndParameters) {
   EXPECT_TRUE(has_note(p, "phasez read in radians"));
   EXPECT_TRUE(has_note(p, "1 point(s) without a value (nan) left out"));
 
+  // LabOne's native (transposed) sweeper CSV: one row per chunk and field, the header
+  // padded with ';', frequencies descending, an unfinished last sweep (nan): the last
+  // complete sweep read.
+  {
+    std::string tr = "chunk;timestamp;size;fieldname" + std::string(t.f.size(), ';') + "\n";
+    const auto row = [&](int chunk, const char* field, const std::function<double(std::size_t)>& v,
+                         bool nan_tail) {
+      std::string r = fmt("%d;%d;%zu;%s", chunk, 1000 + chunk, t.f.size(), field);
+      for (std::size_t k = t.f.size(); k-- > 0;)  // descending
+        r += nan_tail && k < 3 ? std::string(";nan") : fmt(";%.15g", v(k));
+      return r + "\n";
+    };
+    for (int chunk = 0; chunk < 3; ++chunk) {
+      const double scale = chunk == 1 ? 1.0 : 3.0;  // chunk 1 is the last complete sweep
+      const bool unfinished = chunk == 2;
+      tr += row(chunk, "absz", [&](std::size_t k) { return scale * std::abs(t.z[k]); }, unfinished);
+      tr += row(chunk, "frequency", [&](std::size_t k) { return t.f[k]; }, unfinished);
+      tr += row(chunk, "imagz", [&](std::size_t k) { return scale * t.z[k].imag(); }, unfinished);
+      tr += row(chunk, "realz", [&](std::size_t k) { return scale * t.z[k].real(); }, unfinished);
+    }
+    EXPECT_EQ(dsp::detect_impedance_format(tr, "dev3221_imps_0_sample_00000.csv"),
+              ImpedanceFileFormat::LabOne);
+    const auto n = read(tr, "dev3221_imps_0_sample_00000.csv");
+    expect_curve(n, t, 1e-13, "LabOne transposed");
+    EXPECT_TRUE(has_note(n, "transposed layout (one row per field): chunk 1 read, 3 chunk(s)"));
+    EXPECT_TRUE(has_note(n, "descending sweep: reversed"));
+  }
+
   // param0/param1 with the representation stated: Cp and D.
   std::string rep = "% representation: Cp D\nfrequency;param0;param1\n";
   for (std::size_t k = 0; k < t.f.size(); ++k)

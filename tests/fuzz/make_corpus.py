@@ -312,6 +312,12 @@ labone = {
         f"{f:.9g};{(1 / bvd(f)).imag / (2 * math.pi * f):.9g};{(1 / bvd(f)).real / abs((1 / bvd(f)).imag):.9g}\n"
         for f in few),
     "demod.csv": "chunk;timestamp;grid;frequency;x;y;r;phase\n0;1;1000;1000;0.1;0.2;0.22;1.1\n",
+    "transposed.csv": "chunk;timestamp;size;fieldname" + ";" * 6 + "\n" + "".join(
+        f"{c};{1000 + c};6;{name};" + ";".join(
+            "nan" if c == 2 and k < 2 else f"{value(few[k]):.9g}" for k in reversed(range(6))) + "\n"
+        for c in range(3)
+        for name, value in (("absz", lambda f: abs(bvd(f))), ("frequency", lambda f: f),
+                            ("imagz", lambda f: bvd(f).imag), ("realz", lambda f: bvd(f).real))),
 }
 
 
