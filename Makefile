@@ -55,7 +55,7 @@ clean:
 # this: it runs the same harnesses briefly with gcc (CTest label fuzz).
 FUZZ_BUILD   ?= build-fuzz
 FUZZ_SECONDS ?= 600
-FUZZ_TARGETS ?= capture block_parser plan impedance_file touchstone hp4294a e4990a bode100 impedance_table
+FUZZ_TARGETS ?= capture block_parser plan impedance_file touchstone hp4294a e4990a bode100 impedance_table hioki labone impedance_columns
 .PHONY: fuzz
 fuzz:
 	@bash scripts/install-deps.sh fuzz

@@ -128,9 +128,12 @@ FiguresJobResult run_figures(const FiguresRequest& req) {
   std::vector<std::complex<double>> z;
   std::vector<double> zs;
   double hi_default = 0;
+  bool magnitude_only = false;  // the file gives |Z| without its phase
   const bool capture = is_hdf5(req.file);
   if (!capture && !req.method.empty())
     throw InputError("--method " + req.method + " is for a capture (.h5): " + req.file + " is an impedance file");
+  if (capture && !req.columns.empty())
+    throw InputError("--columns names a table's columns: " + req.file + " is a capture (.h5)");
   const bool oe = capture && (req.method.empty() || req.method == "oe");
   if (capture) {
     ImpedanceRequest ir;
@@ -164,7 +167,9 @@ FiguresJobResult run_figures(const FiguresRequest& req) {
   } else {
     dsp::ImportedImpedance im;
     try {
-      im = dsp::read_impedance_file(req.file);
+      dsp::ImpedanceReadOptions ro;
+      ro.columns = req.columns;
+      im = dsp::read_impedance_file(req.file, ro);
     } catch (const std::invalid_argument& e) {
       throw InputError(e.what());
     } catch (const std::runtime_error& e) {
@@ -176,6 +181,7 @@ FiguresJobResult run_figures(const FiguresRequest& req) {
     out.notes = im.notes;
     f = im.f_hz;
     z = im.z_ohm;
+    magnitude_only = im.magnitude_only;
     if (im.abs_sigma_ohm.size() == im.size() && im.phase_sigma_rad.size() == im.size())
       for (std::size_t i = 0; i < im.size(); ++i)
         zs.push_back(std::hypot(im.abs_sigma_ohm[i], std::abs(im.z_ohm[i]) * im.phase_sigma_rad[i]));
@@ -232,6 +238,7 @@ FiguresJobResult run_figures(const FiguresRequest& req) {
   dsp::CircuitFitOptions opt;
   opt.max_branches = req.max_modes;
   opt.auto_magnitude_only = out.source == "file";  // a capture's estimate has a defined phase
+  opt.magnitude_only = magnitude_only;
   try {
     out.fit = dsp::fit_equivalent_circuit(out.f_hz, out.z_ohm, out.z_sigma_ohm, opt);
   } catch (const std::invalid_argument& e) {

@@ -30,6 +30,7 @@ struct FiguresRequest {
   double band_hi_hz = 0;      // 0: the data's (a capture: the estimate's band)
   std::string method;         // a capture's estimator: oe, fft, xspec, prony ("": oe; a file: none)
   std::string material;       // oe: the nominal material (empty: the capture's own)
+  std::string columns;        // a table file's column names ("f[kHz],G[uS],B[uS]"; empty: its header)
 };
 
 struct FiguresJobResult {

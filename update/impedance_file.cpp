@@ -12,15 +12,17 @@ namespace piezo::update {
 
 namespace {
 
-std::ifstream open_in(const std::string& path, const char* fn) {
+std::ifstream open_in(const std::string& path, const char* /*fn*/) {
   std::ifstream in(path);
-  if (!in) throw std::runtime_error(std::string(fn) + ": cannot open '" + path + "'");
+  if (!in) throw std::runtime_error(path + ": cannot open the file");
   return in;
 }
 
-void check_curve(const ImpedanceCurve& c, const std::string& path, const char* fn) {
+// Messages name the file, not the function (they are the user's).
+void check_curve(const ImpedanceCurve& c, const std::string& path, const char* /*fn*/) {
+  const std::string fn = path;
   if (c.f_hz.size() < 5)
-    throw std::invalid_argument(std::string(fn) + ": fewer than 5 points in '" + path + "'");
+    throw std::invalid_argument(path + ": fewer than 5 points");
   for (std::size_t i = 0; i < c.f_hz.size(); ++i) {
     // Finite frequency (a Touchstone unit can overflow it) and finite |Z|
     // (features work in dB of |Z|; re and im near 1.8e308 overflow it).
@@ -38,6 +40,10 @@ void check_curve(const ImpedanceCurve& c, const std::string& path, const char* f
 // The dsp readers check what a file can hold (finite, ascending); check_curve
 // adds what the features need (5 points, finite |Z|).
 ImpedanceCurve from_dsp(dsp::ImportedImpedance&& d, const std::string& path, const char* fn) {
+  if (d.magnitude_only)
+    throw std::invalid_argument(path + ": the file gives |Z| without its phase (" + d.quantity +
+                                "): the features need complex Z; `piezobench figures` fits |Z| "
+                                "alone");
   ImpedanceCurve c;
   c.f_hz = std::move(d.f_hz);
   c.z_ohm = std::move(d.z_ohm);

@@ -5,6 +5,7 @@
 #include <cctype>
 #include <numbers>
 #include <optional>
+#include <stdexcept>
 #include <vector>
 
 #include "dsp/impedance_files/text.hpp"
@@ -120,6 +121,7 @@ std::optional<Quantity> quantity_word(std::string_view w) {
   if (in(w, {"z", "impedance", "imp", "zin", "z11", "zx"})) return Quantity::Z;
   if (in(w, {"y", "admittance", "adm", "y11"})) return Quantity::Y;
   if (in(w, {"s11", "s", "gamma", "reflection", "refl", "rho"})) return Quantity::S;
+  if (w == "s21") return Quantity::S21;
   return std::nullopt;
 }
 
@@ -136,7 +138,7 @@ std::optional<std::pair<Part, Quantity>> part_word(std::string_view w) {
   if (in(w, {"re", "real"})) return P{Part::Re, U};
   if (in(w, {"im", "imag", "imaginary"})) return P{Part::Im, U};
   if (in(w, {"r", "resistance", "rs", "esr"})) return P{Part::Re, Quantity::Z};
-  if (in(w, {"x", "reactance"})) return P{Part::Im, Quantity::Z};
+  if (in(w, {"x", "reactance", "xs"})) return P{Part::Im, Quantity::Z};
   if (in(w, {"g", "conductance", "gp"})) return P{Part::Re, Quantity::Y};
   if (in(w, {"b", "susceptance"})) return P{Part::Im, Quantity::Y};
   if (w == "ls") return P{Part::Ls, Quantity::Z};
@@ -150,7 +152,7 @@ std::optional<std::pair<Part, Quantity>> part_word(std::string_view w) {
 }
 
 bool not_impedance_word(std::string_view w) {
-  return in(w, {"gain",        "transmission", "s21",  "s12",   "s22", "voltage", "current",
+  return in(w, {"gain",        "transmission", "s12",   "s22", "voltage", "current",
                 "vac",         "iac",          "vdc",  "idc",   "dcv", "dci",     "power",
                 "temperature", "temp",         "time", "delay", "gd",  "vswr",    "swr",
                 "return",      "loss",         "a1",   "a2",    "b1",  "b2",      "t"});
@@ -166,6 +168,8 @@ ColumnMeaning classify_column(std::string_view header) {
     return m;
   };
   std::string s = ascii_symbols(trim(header));
+  // "Eq=(1-S11)/(1+S11)(DB)": a VNA's equation trace, not the parameter it names.
+  if (s.find('=') != std::string::npos) return ignored("an equation of other traces");
 
   // Units in brackets; groups that are not units stay as words ("S11(REAL)").
   std::optional<Unit> unit;
@@ -224,7 +228,17 @@ ColumnMeaning classify_column(std::string_view header) {
     }
     return false;
   };
+  // "Transmission Loss(dB)" (vna/J's transmission mode): S21 in dB.
+  bool transmission = false;
+  for (const auto& w : words) transmission = transmission || lower(w) == "transmission";
   for (auto w : words) {
+    if (transmission && in(lower(w), {"transmission", "loss"})) {
+      if (lower(w) == "transmission")
+        qs.push_back(Quantity::S21);
+      else
+        m.loss = true;
+      continue;
+    }
     if (w.find('|') != std::string::npos) {
       bars = true;
       w.erase(std::remove(w.begin(), w.end(), '|'), w.end());
@@ -316,8 +330,9 @@ ColumnMeaning classify_column(std::string_view header) {
     case Part::Re:
     case Part::Im:
       fits = !unit || uk == UnitKind::One ||
-             (uk == UnitKind::Ohm && q != Quantity::Y && q != Quantity::S) ||
-             (uk == UnitKind::Siemens && q != Quantity::Z && q != Quantity::S);
+             (uk == UnitKind::Ohm && q != Quantity::Y && q != Quantity::S && q != Quantity::S21) ||
+             (uk == UnitKind::Siemens && q != Quantity::Z && q != Quantity::S &&
+              q != Quantity::S21);
       break;
     case Part::Rp:
       fits = !unit || uk == UnitKind::Ohm;
@@ -353,6 +368,37 @@ ColumnMeaning classify_column(std::string_view header) {
   }
   m.role = Role::Value;
   return m;
+}
+
+std::vector<std::string> parse_column_spec(std::string_view spec) {
+  std::vector<std::string> out;
+  bool has_f = false;
+  std::size_t start = 0;
+  for (std::size_t i = 0; i <= spec.size(); ++i) {
+    if (i < spec.size() && spec[i] != ',') continue;
+    const std::string item(trim(spec.substr(start, i - start)));
+    start = i + 1;
+    if (item == "-" || lower(item) == "skip") {
+      out.push_back("-");
+      continue;
+    }
+    // "-theta(deg)": the column negated (a current's phase for the impedance's).
+    const bool negated = item.size() > 1 && item.front() == '-';
+    const auto m = classify_column(negated ? std::string_view(item).substr(1) : item);
+    if (item.empty() || m.role == Role::Ignored)
+      throw std::invalid_argument(
+          "--columns: '" + printable(item) + "' is not a column we know" +
+          (m.why.empty() ? std::string() : " (" + m.why + ")") +
+          "; use f, R, X, G, B, |Z|, |Y|, theta, Rs, Rp, Cs, Cp, Ls, Lp, D, Q, re, im, S11, S21 "
+          "with a unit in brackets (f[kHz], G[uS], theta[deg], |Z|[kohm]), a leading - to negate "
+          "one (-theta[deg]), or - alone to skip a column");
+    has_f = has_f || m.role == Role::Frequency;
+    out.push_back(item);
+  }
+  if (!has_f)
+    throw std::invalid_argument("--columns: no frequency among '" + printable(spec) +
+                                "' (e.g. --columns f[Hz],R[ohm],X[ohm])");
+  return out;
 }
 
 }  // namespace piezo::dsp::zfiles

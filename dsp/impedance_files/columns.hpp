@@ -6,11 +6,13 @@
 //   units:  Hz kHz MHz GHz (any case); Ω/ohm with m k M G prefixes (mΩ milli,
 //           MΩ mega); S with m u µ n p prefixes; deg ° rad; dB; H and F with
 //           prefixes; U or () for a pure number.
+//   S21:    "S21(DB)", "Transmission Loss(dB)" (vna/J, transmission mode)
 //   ignored: memory traces ("-mem", "Memory"), quantities that are not an
 //           impedance (gain, S21, return loss, voltage, current, ...), and
 //           names that say nothing we know.
 #include <string>
 #include <string_view>
+#include <vector>
 
 #include "dsp/impedance_files/quantities.hpp"
 
@@ -25,8 +27,17 @@ struct ColumnMeaning {
   double scale = 1.0;       // file unit -> Hz, ohm, S, rad, H, F (dB values stay dB)
   bool unit_given = false;  // false: Hz, ohm/S, degrees assumed
   std::string why;          // why a column is ignored
+  bool loss = false;        // "Transmission Loss(dB)": a loss, maybe written positive
 };
 
 ColumnMeaning classify_column(std::string_view header);
+
+// The names of a table's columns as the user gives them (`piezobench figures
+// --columns f[kHz],G[uS],B[uS]`): a comma list of header names as above, each
+// with its unit in brackets; "-" or "skip" leaves a column out, a leading "-"
+// negates one ("-theta(deg)": a current's phase read as the impedance's). Throws
+// std::invalid_argument naming an item that is no column we know, or a list
+// without a frequency.
+std::vector<std::string> parse_column_spec(std::string_view spec);
 
 }  // namespace piezo::dsp::zfiles

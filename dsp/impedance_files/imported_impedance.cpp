@@ -16,6 +16,10 @@ const char* to_string(ImpedanceFileFormat f) {
       return "bode100";
     case ImpedanceFileFormat::Table:
       return "table";
+    case ImpedanceFileFormat::Hioki:
+      return "hioki";
+    case ImpedanceFileFormat::LabOne:
+      return "labone";
   }
   return "?";
 }

@@ -19,14 +19,19 @@ enum class ImpedanceFileFormat {
   E4990a,      // Keysight E4990A CSV (BEGIN CHn_DATA ... END)
   Bode100,     // OMICRON Bode 100 (Bode Analyzer Suite) CSV
   Table,       // any delimited table with a header (f and a pair of Z or Y columns)
+  Hioki,       // HIOKI IM3570 / IM3536 / IM7580 CSV ("No.","FREQUENCY(Hz)",two parameters)
+  LabOne,      // Zurich Instruments LabOne sweeper / impedance-analyzer CSV or TXT export
 };
 
-// "touchstone", "hp4294a", "e4990a", "bode100", "table" ("auto" for Auto).
+// "touchstone", "hp4294a", "e4990a", "bode100", "table", "hioki", "labone" ("auto" for Auto).
 const char* to_string(ImpedanceFileFormat f);
 
 struct ImportedImpedance {
   std::vector<double> f_hz;                 // strictly ascending, finite, >= 0
   std::vector<std::complex<double>> z_ohm;  // finite, with a finite |Z|
+  // True when the file gives |Z| but not its phase (|Z| alone, |Z| with R, ...):
+  // z_ohm then holds |Z| + 0j, and only its magnitude means anything.
+  bool magnitude_only = false;
   // Per-point standard uncertainty (1 σ) of |Z| and of arg Z, when the file
   // carries them (the band of dsp/impedance_io's CSV); empty otherwise.
   std::vector<double> abs_sigma_ohm;

@@ -63,6 +63,8 @@ std::complex<double> to_impedance(const PairSpec& p, double f_hz, double a, doub
       return 1.0 / x;
     case Quantity::S:
       return p.z0_ohm * (1.0 + x) / (1.0 - x);
+    case Quantity::S21:
+      return 2.0 * p.z0_ohm * (1.0 - x) / x;
     default:
       return {nan, nan};
   }
@@ -102,12 +104,15 @@ const char* part_name(Part p) {
 
 std::string describe(const PairSpec& p) {
   const bool z = p.quantity == Quantity::Z, y = p.quantity == Quantity::Y;
-  if (p.quantity == Quantity::S) {
+  if (p.quantity == Quantity::S || p.quantity == Quantity::S21) {
     char ref[48];
     std::snprintf(ref, sizeof ref, "%.10g", p.z0_ohm);
     const char* form = p.a == Part::Mag     ? "magnitude and phase"
                        : p.a == Part::MagDb ? "dB and phase"
                                             : "real and imaginary parts";
+    if (p.quantity == Quantity::S21)
+      return std::string("transmission S21 (") + form + "), z0 = " + ref +
+             " ohm, device in series between the ports";
     return std::string("reflection coefficient S11 (") + form + "), z0 = " + ref + " ohm";
   }
   const std::string what = z ? "impedance" : y ? "admittance" : "?";

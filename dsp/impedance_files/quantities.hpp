@@ -6,19 +6,21 @@
 //   rectangular:  R and X, G and B, Re and Im of S11
 //   series:       Ls or Cs with Rs, D or Q       (Z = Rs + jX)
 //   parallel:     Lp or Cp with G, Rp, D or Q    (Y = G + jB)
-// S11 becomes Z = z0 (1 + S)/(1 − S); Y becomes Z = 1/Y.
+// S11 becomes Z = z0 (1 + S)/(1 − S); Y becomes Z = 1/Y; S21 (transmission)
+// becomes the impedance of a device in series between the two ports (the
+// series-through fixture crystals are measured in): Z = 2·z0·(1 − S21)/S21.
 #include <complex>
 #include <string>
 
 namespace piezo::dsp::zfiles {
 
-enum class Quantity { Unknown, Z, Y, S };
+enum class Quantity { Unknown, Z, Y, S, S21 };
 enum class Part { None, Mag, MagDb, Phase, Re, Im, Ls, Cs, Lp, Cp, Rp, D, Q };
 
 struct PairSpec {
   Quantity quantity = Quantity::Z;
   Part a = Part::Re, b = Part::Im;  // canonical order: magnitude / real part / L or C first
-  double z0_ohm = 50.0;             // reference of S11
+  double z0_ohm = 50.0;             // reference of S11 or S21
 };
 
 // True for the pairs listed above (in canonical order; Quantity must be known:

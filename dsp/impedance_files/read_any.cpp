@@ -4,8 +4,11 @@
 #include <stdexcept>
 
 #include "dsp/impedance_files/bode100.hpp"
+#include "dsp/impedance_files/columns.hpp"
 #include "dsp/impedance_files/e4990a.hpp"
+#include "dsp/impedance_files/hioki.hpp"
 #include "dsp/impedance_files/hp4294a.hpp"
+#include "dsp/impedance_files/labone.hpp"
 #include "dsp/impedance_files/table.hpp"
 #include "dsp/impedance_files/text.hpp"
 #include "dsp/impedance_files/touchstone.hpp"
@@ -20,7 +23,7 @@ bool touchstone_extension(const std::string& name) {
   const auto dot = name.rfind('.');
   if (dot == std::string::npos) return false;
   const std::string ext = zfiles::lower(std::string_view(name).substr(dot + 1));
-  return ext == "s1p" || ext == "ts" || ext == "snp";
+  return ext == "s1p" || ext == "s2p" || ext == "ts" || ext == "snp";
 }
 
 ImpedanceFileFormat detect(const std::vector<TextLine>& lines, const std::string& name) {
@@ -49,6 +52,9 @@ ImpedanceFileFormat detect(const std::vector<TextLine>& lines, const std::string
   if (!lines.empty() && zfiles::istarts_with(zfiles::trim(lines.front().text), "4294A"))
     return ImpedanceFileFormat::Hp4294a;
   if (first && zfiles::bode100_header(first->text)) return ImpedanceFileFormat::Bode100;
+  for (std::size_t i = 0; i < lines.size() && i < 400; ++i)
+    if (zfiles::hioki_header(lines[i].text)) return ImpedanceFileFormat::Hioki;
+  if (zfiles::labone_file(lines)) return ImpedanceFileFormat::LabOne;
   if (first && touchstone_extension(name)) {
     // Numbers only (a Touchstone file without its option line)?
     bool numbers = true;
@@ -69,8 +75,23 @@ ImpedanceFileFormat detect_impedance_format(std::string_view text, const std::st
 
 ImportedImpedance read_impedance_any(std::istream& in, const std::string& name,
                                      ImpedanceFileFormat hint) {
-  const auto lines = zfiles::split_lines(zfiles::slurp(in, "read_impedance_any", name));
-  const auto format = hint == ImpedanceFileFormat::Auto ? detect(lines, name) : hint;
+  ImpedanceReadOptions opt;
+  opt.hint = hint;
+  return read_impedance_any(in, name, opt);
+}
+
+namespace {
+
+ImportedImpedance read_lines(const std::vector<TextLine>& lines, const std::string& name,
+                             const ImpedanceReadOptions& opt) {
+  if (!opt.columns.empty()) {
+    zfiles::TableOptions t;
+    t.columns = zfiles::parse_column_spec(opt.columns);
+    auto out = zfiles::read_table(lines, name, t);
+    out.notes.insert(out.notes.begin(), "columns as given by --columns " + opt.columns);
+    return out;
+  }
+  const auto format = opt.hint == ImpedanceFileFormat::Auto ? detect(lines, name) : opt.hint;
   switch (format) {
     case ImpedanceFileFormat::Touchstone:
       return zfiles::read_touchstone(lines, name);
@@ -80,6 +101,10 @@ ImportedImpedance read_impedance_any(std::istream& in, const std::string& name,
       return zfiles::read_e4990a_csv(lines, name);
     case ImpedanceFileFormat::Bode100:
       return zfiles::read_bode100_csv(lines, name);
+    case ImpedanceFileFormat::Hioki:
+      return zfiles::read_hioki_csv(lines, name);
+    case ImpedanceFileFormat::LabOne:
+      return zfiles::read_labone(lines, name);
     case ImpedanceFileFormat::Table:
     case ImpedanceFileFormat::Auto:
       break;
@@ -87,10 +112,28 @@ ImportedImpedance read_impedance_any(std::istream& in, const std::string& name,
   return zfiles::read_table(lines, name, zfiles::TableOptions{});
 }
 
+}  // namespace
+
+ImportedImpedance read_impedance_any(std::istream& in, const std::string& name,
+                                     const ImpedanceReadOptions& opt) {
+  auto out = read_lines(zfiles::split_lines(zfiles::slurp(in, "read_impedance_any", name)), name, opt);
+  // Notes quote the file (and --columns): JSON needs UTF-8.
+  for (auto& n : out.notes) n = zfiles::printable(n);
+  out.format_name = zfiles::printable(out.format_name);
+  out.quantity = zfiles::printable(out.quantity);
+  return out;
+}
+
 ImportedImpedance read_impedance_file(const std::string& path, ImpedanceFileFormat hint) {
+  ImpedanceReadOptions opt;
+  opt.hint = hint;
+  return read_impedance_file(path, opt);
+}
+
+ImportedImpedance read_impedance_file(const std::string& path, const ImpedanceReadOptions& opt) {
   std::ifstream in(path, std::ios::binary);
-  if (!in) throw std::runtime_error("read_impedance_file: cannot open '" + path + "'");
-  return read_impedance_any(in, path, hint);
+  if (!in) throw std::runtime_error(path + ": cannot open the file");
+  return read_impedance_any(in, path, opt);
 }
 
 }  // namespace piezo::dsp

@@ -1,15 +1,22 @@
 #include "dsp/impedance_files/table.hpp"
 
+#include <algorithm>
 #include <array>
 #include <cmath>
+#include <cstdio>
 #include <optional>
 
 #include "dsp/impedance_files/columns.hpp"
+#include "dsp/impedance_files/lcr_parameters.hpp"
 #include "dsp/impedance_files/quantities.hpp"
 
 namespace piezo::dsp {
 
 namespace zfiles {
+
+const char* const kColumnsHint =
+    "; name the columns with --columns (piezobench figures), e.g. --columns f[Hz],R[ohm],X[ohm] "
+    "or --columns f[kHz],G[uS],B[uS]";
 
 namespace {
 
@@ -115,7 +122,8 @@ struct PairChoice {
   bool quantity_assumed = false;
 };
 
-std::optional<PairChoice> choose_pair(const std::vector<ColumnMeaning>& cols) {
+std::optional<PairChoice> choose_pair(const std::vector<ColumnMeaning>& cols,
+                                      bool allow_s21 = true) {
   using Q = Quantity;
   using P = Part;
   struct Candidate {
@@ -125,6 +133,7 @@ std::optional<PairChoice> choose_pair(const std::vector<ColumnMeaning>& cols) {
   static constexpr Candidate kOrder[] = {
       {Q::Z, P::Re, P::Im}, {Q::Z, P::Mag, P::Phase}, {Q::Z, P::MagDb, P::Phase},
       {Q::Y, P::Re, P::Im}, {Q::Y, P::Mag, P::Phase}, {Q::Y, P::MagDb, P::Phase},
+      {Q::S21, P::Re, P::Im}, {Q::S21, P::Mag, P::Phase}, {Q::S21, P::MagDb, P::Phase},
       {Q::S, P::Re, P::Im}, {Q::S, P::Mag, P::Phase}, {Q::S, P::MagDb, P::Phase},
       {Q::Z, P::Ls, P::Re}, {Q::Z, P::Cs, P::Re},     {Q::Z, P::Ls, P::D},
       {Q::Z, P::Cs, P::D},  {Q::Z, P::Ls, P::Q},      {Q::Z, P::Cs, P::Q},
@@ -139,7 +148,17 @@ std::optional<PairChoice> choose_pair(const std::vector<ColumnMeaning>& cols) {
         return i;
     return std::nullopt;
   };
-  for (const auto& o : kOrder) {
+  // A transmission export: S21 first (a program's Z columns beside it are
+  // derived from it, vna/J's printed in a width that drops digits).
+  bool s21_columns = false;
+  for (const auto& c : cols) s21_columns = s21_columns || c.quantity == Q::S21;
+  std::vector<Candidate> order;
+  if (s21_columns && allow_s21)
+    for (const auto& o : kOrder)
+      if (o.q == Q::S21) order.push_back(o);
+  for (const auto& o : kOrder)
+    if (o.q != Q::S21 || (allow_s21 && !s21_columns)) order.push_back(o);
+  for (const auto& o : order) {
     const auto a = find(o.q, o.a, cols.size());
     if (!a) continue;
     const auto b = find(o.q, o.b, *a);
@@ -152,6 +171,75 @@ std::optional<PairChoice> choose_pair(const std::vector<ColumnMeaning>& cols) {
                          (o.a == P::Mag || o.a == P::MagDb || o.a == P::Re);
     return c;
   }
+  return std::nullopt;
+}
+
+// The parameter a column holds, for lcr_parameters.hpp.
+std::optional<Lcr> lcr_of(const ColumnMeaning& c) {
+  if (c.role != Role::Value) return std::nullopt;
+  const auto q = c.quantity;
+  switch (c.part) {
+    case Part::Mag:
+      if (q == Quantity::Z) return Lcr::AbsZ;
+      if (q == Quantity::Y) return Lcr::AbsY;
+      return std::nullopt;
+    case Part::Phase:
+      if (q == Quantity::Y) return Lcr::PhaseY;
+      if (q == Quantity::Z || q == Quantity::Unknown) return Lcr::Phase;
+      return std::nullopt;
+    case Part::Re:
+      if (q == Quantity::Z) return Lcr::R;
+      if (q == Quantity::Y) return Lcr::G;
+      return std::nullopt;
+    case Part::Im:
+      if (q == Quantity::Z) return Lcr::X;
+      if (q == Quantity::Y) return Lcr::B;
+      return std::nullopt;
+    case Part::Rp:
+      return Lcr::Rp;
+    case Part::Cs:
+      return Lcr::Cs;
+    case Part::Cp:
+      return Lcr::Cp;
+    case Part::Ls:
+      return Lcr::Ls;
+    case Part::Lp:
+      return Lcr::Lp;
+    case Part::D:
+      return Lcr::D;
+    case Part::Q:
+      return Lcr::Q;
+    default:
+      return std::nullopt;
+  }
+}
+
+constexpr std::size_t kNoCol = static_cast<std::size_t>(-1);
+
+struct LcrChoice {
+  LcrPair pair;
+  std::size_t col_a = 0, col_b = kNoCol;
+};
+
+// Two columns that give complex Z, else two or one that give |Z|.
+std::optional<LcrChoice> choose_lcr(const std::vector<ColumnMeaning>& cols) {
+  std::optional<LcrChoice> magnitude;
+  for (std::size_t i = 0; i < cols.size(); ++i) {
+    const auto a = lcr_of(cols[i]);
+    if (!a) continue;
+    for (std::size_t j = i + 1; j < cols.size(); ++j) {
+      const auto b = lcr_of(cols[j]);
+      if (!b) continue;
+      if (auto p = lcr_pair(*a, *b)) {
+        if (!p->magnitude_only) return LcrChoice{*p, i, j};
+        if (!magnitude) magnitude = LcrChoice{*p, i, j};
+      }
+    }
+  }
+  if (magnitude) return magnitude;
+  for (std::size_t i = 0; i < cols.size(); ++i)
+    if (const auto a = lcr_of(cols[i]))
+      if (auto p = lcr_pair(*a, std::nullopt)) return LcrChoice{*p, i, kNoCol};
   return std::nullopt;
 }
 
@@ -199,6 +287,14 @@ ImportedImpedance read_table(const std::vector<TextLine>& lines, const std::stri
   meta.format_name = opt.format_name;
   std::string header_text;
   int header_line = 0;
+  const bool given = !opt.columns.empty();
+  if (given) {
+    header_line = opt.header_line;
+    // Names given: the header (if any) is text above the data like the rest.
+    if (header) preamble.push_back(header);
+    header = nullptr;
+    last_comment = nullptr;
+  }
   if (header) {
     header_text = header->text;
     header_line = header->number;
@@ -220,8 +316,8 @@ ImportedImpedance read_table(const std::vector<TextLine>& lines, const std::stri
     }
   }
   if (!preamble.empty())
-    meta.notes.push_back(std::to_string(preamble.size()) +
-                         " line(s) of text above the header skipped (first: '" +
+    meta.notes.push_back(std::to_string(preamble.size()) + " line(s) of text above the " +
+                         (given ? "data" : "header") + " skipped (first: '" +
                          std::string(trim(preamble.front()->text)) + "')");
 
   // Separator, from the header and the first row.
@@ -233,12 +329,18 @@ ImportedImpedance read_table(const std::vector<TextLine>& lines, const std::stri
       hsplit[k] = split_fields(header_text, seps[k]);
       drop_trailing_empty(hsplit[k]);
     }
+  } else if (given) {
+    hsplit.fill(opt.columns);
   }
   std::size_t ncols = 0;
-  auto layout = find_layout(header_text.empty() ? nullptr : hsplit.data(), row0.text, ncols);
+  auto layout =
+      find_layout(header_text.empty() && !given ? nullptr : hsplit.data(), row0.text, ncols);
   if (!layout) fail(fn, name, row0.number, "not a row of numbers");
   std::vector<std::string> names;
-  if (!header_text.empty()) {
+  if (given) {
+    names = opt.columns;
+    ncols = names.size();
+  } else if (!header_text.empty()) {
     const std::size_t k = layout->sep == '\t'  ? 0
                           : layout->sep == ';' ? 1
                           : layout->sep == ',' ? 2
@@ -270,48 +372,149 @@ ImportedImpedance read_table(const std::vector<TextLine>& lines, const std::stri
   // Columns.
   CurveBuilder b(fn, name);
   b.out = std::move(meta);
-  constexpr std::size_t kNone = static_cast<std::size_t>(-1);
+  constexpr std::size_t kNone = kNoCol;
   std::vector<ColumnMeaning> cols;
   std::size_t fcol = kNone, smag = kNone, sphase = kNone, kcol = kNone;
   PairChoice pair;
+  std::optional<LcrChoice> lcr;
+  // What a column is called in messages: the instrument's name, else the header's.
+  const auto label = [&](std::size_t i) {
+    return i < opt.labels.size() && !opt.labels[i].empty() ? opt.labels[i] : names[i];
+  };
+  std::vector<std::string> labels;
   if (names.empty()) {
     const std::size_t n = row_fields(row0.text, *layout).size();
     if (!opt.allow_headerless) fail(fn, name, row0.number, "data without a header line");
-    if (n < 3)
+    if (n != 3) {
+      std::string spec = "f[Hz],R[ohm],X[ohm]";
+      for (std::size_t k = 3; k < n && k < 16; ++k) spec += ",-";
       fail(fn, name, row0.number,
-           "no header, and " + std::to_string(n) +
-               " columns: a table without a header must be f_hz, re_ohm, im_ohm");
+           "no header, and " + std::to_string(n) + " columns: a table without a header is read " +
+               "only as the three columns f_hz, re_ohm, im_ohm; name the columns with --columns " +
+               "(piezobench figures), e.g. --columns " +
+               (n > 3 ? spec + " or f[Hz],|Z|[ohm],theta[deg]" + spec.substr(19)
+                      : std::string("f[Hz],|Z|[ohm] (a magnitude alone)")));
+    }
     ncols = n;
     fcol = 0;
     pair.spec = {Quantity::Z, Part::Re, Part::Im, 50.0};
     pair.col_a = 1;
     pair.col_b = 2;
-    b.out.notes.push_back("no header: columns read as f_hz, re_ohm, im_ohm" +
-                          std::string(n > 3 ? " (further columns ignored)" : ""));
+    b.out.notes.push_back("no header: columns read as f_hz, re_ohm, im_ohm");
     cols.assign(n, ColumnMeaning{});
     cols[0] = {Role::Frequency, Quantity::Unknown, Part::None, 1.0, true, ""};
     cols[1] = {Role::Value, Quantity::Z, Part::Re, 1.0, true, ""};
     cols[2] = {Role::Value, Quantity::Z, Part::Im, 1.0, true, ""};
   } else {
-    for (const auto& h : names) cols.push_back(classify_column(h));
+    std::vector<std::string> negated;
+    for (const auto& h : names) {
+      if (given && h.size() > 1 && h.front() == '-') {  // "-theta(deg)": the column negated
+        cols.push_back(classify_column(std::string_view(h).substr(1)));
+        cols.back().scale = -cols.back().scale;
+        negated.push_back(h.substr(1));
+        continue;
+      }
+      cols.push_back(classify_column(h));
+    }
+    if (!negated.empty()) b.out.notes.push_back("negated as asked: " + list(negated));
+    for (std::size_t i = 0; i < names.size(); ++i) labels.push_back(label(i));
+    const std::string hint = given ? std::string() : std::string(kColumnsHint);
     for (std::size_t i = 0; i < cols.size() && fcol == kNone; ++i)
       if (cols[i].role == Role::Frequency) fcol = i;
-    if (fcol == kNone) fail(fn, name, header_line, "no frequency column among " + list(names));
+    if (fcol == kNone)
+      fail(fn, name, header_line, "no frequency column among " + list(labels) + hint);
     auto c = choose_pair(cols);
-    if (!c)
+    if (!c) lcr = choose_lcr(cols);
+    if (!c && !lcr) {
+      std::vector<std::string> known;
+      for (std::size_t i = 0; i < cols.size(); ++i)
+        if (lcr_of(cols[i])) known.push_back(labels[i]);
+      if (!known.empty())
+        fail(fn, name, header_line,
+             "the columns give " + list(known) +
+                 ": neither complex Z nor |Z| (a second parameter is needed, such as X or B "
+                 "with R or G, the phase with |Z|, D with Cs or Cp; or |Z| alone for a "
+                 "magnitude-only fit)");
       fail(fn, name, header_line,
-           "no impedance columns among " + list(names) +
+           "no impedance columns among " + list(labels) +
                " (need real and imaginary parts, magnitude and phase, R and X, G and B, or an "
-               "equivalent circuit such as Cp and D, of Z, Y or S11)");
-    pair = *c;
-    if (pair.quantity_assumed)
-      b.out.notes.push_back(
-          "the columns do not say impedance, admittance or S11: read as impedance");
-    if (pair.spec.quantity == Quantity::S)
-      b.out.notes.push_back("S11 without its reference impedance in the file: z0 = 50 ohm assumed");
+               "equivalent circuit such as Cp and D, of Z, Y, S11 or S21)" + hint);
+    }
+    if (c) pair = *c;
+    std::string s21_note;
+    if (c && pair.spec.quantity == Quantity::S21) {
+      // A transmission export: S21 unless nothing passes (median |S21| below
+      // -60 dB: the device is on port 1), then S11 when the file has it.
+      std::vector<double> mags;
+      for (std::size_t i = first; i < lines.size(); ++i) {
+        if (trim(lines[i].text).empty() || is_comment(lines[i].text)) continue;
+        const auto f = row_fields(lines[i].text, *layout);
+        double va, vb;
+        if (f.size() <= std::max(pair.col_a, pair.col_b) ||
+            !parse_number(f[pair.col_a], va, layout->decimal_comma) ||
+            !parse_number(f[pair.col_b], vb, layout->decimal_comma))
+          continue;
+        va *= cols[pair.col_a].scale;
+        vb *= cols[pair.col_b].scale;
+        mags.push_back(pair.spec.a == Part::Re    ? std::hypot(va, vb)
+                       : pair.spec.a == Part::Mag ? std::abs(va)
+                                                  : std::pow(10.0, va / 20.0));
+      }
+      // "Transmission Loss(dB)" written as a positive loss: -dB.
+      if (pair.spec.a == Part::MagDb && cols[pair.col_a].loss && !mags.empty() &&
+          std::all_of(mags.begin(), mags.end(), [](double m) { return m >= 1.0; }) &&
+          std::any_of(mags.begin(), mags.end(), [](double m) { return m > 1.0; })) {
+        cols[pair.col_a].scale = -cols[pair.col_a].scale;
+        for (auto& m : mags) m = 1.0 / m;
+        s21_note = "transmission loss written positive: read as |S21| = -loss (dB); ";
+      }
+      double median = 0;
+      if (!mags.empty()) {
+        std::nth_element(mags.begin(), mags.begin() + static_cast<std::ptrdiff_t>(mags.size() / 2),
+                         mags.end());
+        median = mags[mags.size() / 2];
+      }
+      char db[32];
+      std::snprintf(db, sizeof db, "%.3g", 20 * std::log10(std::max(median, 1e-300)));
+      const auto s11 = choose_pair(cols, false);
+      if (median < 1e-3 && s11 && s11->spec.quantity == Quantity::S) {
+        pair = *s11;
+        s21_note += std::string("S21 is at noise level (median |S21| ") + db +
+                   " dB): nothing passes between the ports, so the device is taken to be on "
+                   "port 1 and S11 is read as a reflection";
+      } else {
+        s21_note +=
+            "transmission S21 read as a device in series between the two ports (series-through "
+            "fixture): Z = 2*z0*(1 - S21)/S21, z0 = 50 ohm assumed; S21 is preferred to any "
+            "S11 column, and never read as a reflection";
+        if (median < 1e-3)
+          s21_note += std::string(" (median |S21| ") + db + " dB: little passes)";
+      }
+    }
+    if (lcr) {
+      pair.col_a = lcr->col_a;
+      pair.col_b = lcr->col_b;
+      if (!lcr->pair.assumption.empty()) b.out.notes.push_back(lcr->pair.assumption);
+      for (const auto col : {lcr->col_a, lcr->col_b}) {
+        if (col == kNone) continue;
+        if (cols[col].part == Part::Phase && cols[col].quantity == Quantity::Unknown)
+          b.out.notes.push_back("the phase column does not say of what: read as the phase of Z");
+        if (cols[col].part == Part::Phase && !cols[col].unit_given)
+          b.out.notes.push_back("phase unit not given: degrees assumed");
+      }
+      b.out.magnitude_only = lcr->pair.magnitude_only;
+    } else {
+      if (pair.quantity_assumed)
+        b.out.notes.push_back(
+            "the columns do not say impedance, admittance or S11: read as impedance");
+      if (pair.spec.quantity == Quantity::S)
+        b.out.notes.push_back(
+            "S11 without its reference impedance in the file: z0 = 50 ohm assumed");
+      if (!s21_note.empty()) b.out.notes.push_back(s21_note);
+      if (pair.spec.b == Part::Phase && !cols[pair.col_b].unit_given)
+        b.out.notes.push_back("phase unit not given: degrees assumed");
+    }
     if (!cols[fcol].unit_given) b.out.notes.push_back("frequency unit not given: Hz assumed");
-    if (pair.spec.b == Part::Phase && !cols[pair.col_b].unit_given)
-      b.out.notes.push_back("phase unit not given: degrees assumed");
     for (std::size_t i = 0; i < cols.size(); ++i) {
       if (cols[i].role == Role::SigmaMag && smag == kNone) smag = i;
       if (cols[i].role == Role::SigmaPhase && sphase == kNone) sphase = i;
@@ -327,17 +530,17 @@ ImportedImpedance read_table(const std::vector<TextLine>& lines, const std::stri
     for (std::size_t i = 0; i < cols.size(); ++i) {
       const bool used =
           i == fcol || i == pair.col_a || i == pair.col_b || i == smag || i == sphase || i == kcol;
-      if (!used && !names[i].empty())
-        skipped.push_back(names[i] + (cols[i].why.empty() ? "" : " (" + cols[i].why + ")"));
+      if (!used && !names[i].empty() && names[i] != "-")
+        skipped.push_back(labels[i] + (cols[i].why.empty() ? "" : " (" + cols[i].why + ")"));
     }
     if (!skipped.empty()) b.out.notes.push_back("columns not read: " + list(skipped));
-    b.out.notes.push_back("columns read: " + names[fcol] + ", " + names[pair.col_a] + ", " +
-                          names[pair.col_b]);
+    b.out.notes.push_back("columns read: " + labels[fcol] + ", " + labels[pair.col_a] +
+                          (pair.col_b == kNone ? std::string() : ", " + labels[pair.col_b]));
     if (smag != kNone)
-      b.out.notes.push_back("uncertainty read (1 sigma): " + names[smag] + ", " + names[sphase] +
-                            (kcol != kNone ? ", coverage factor " + names[kcol] : std::string()));
+      b.out.notes.push_back("uncertainty read (1 sigma): " + labels[smag] + ", " + labels[sphase] +
+                            (kcol != kNone ? ", coverage factor " + labels[kcol] : std::string()));
   }
-  b.out.quantity = describe(pair.spec);
+  b.out.quantity = lcr ? describe(lcr->pair) : describe(pair.spec);
   if (layout->joined_halves)
     b.out.notes.push_back("decimal commas with comma separators: each value was split in two");
 
@@ -350,22 +553,31 @@ ImportedImpedance read_table(const std::vector<TextLine>& lines, const std::stri
     if (!parse_number(f[col], v, layout->decimal_comma))
       fail(fn, name, line,
            "'" + f[col] + "' is not a number (column " +
-               (names.empty() ? std::to_string(col + 1) : "'" + names[col] + "'") + ")");
+               (names.empty() ? std::to_string(col + 1) : "'" + labels[col] + "'") + ")");
     if (layout->decimal_comma && f[col].find(',') != std::string::npos) comma_used = true;
     return v;
   };
   for (std::size_t i = first; i < lines.size(); ++i) {
     const auto& L = lines[i];
     if (trim(L.text).empty() || is_comment(L.text)) continue;
-    const auto f = row_fields(L.text, *layout);
+    auto f = row_fields(L.text, *layout);
+    // Trailing columns left out (skipped ones, empty in the row: an instrument's "OFF").
+    bool short_ok = given && f.size() < ncols;
+    for (std::size_t k = f.size(); short_ok && k < ncols; ++k) short_ok = names[k] == "-";
+    if (short_ok) f.resize(ncols);
     if (f.size() != ncols && !(names.empty() && f.size() >= 3))
       fail(fn, name, L.number,
-           std::to_string(f.size()) + " columns, the " + (names.empty() ? "first row" : "header") +
-               " has " + std::to_string(ncols));
+           std::to_string(f.size()) + " columns, " +
+               (names.empty() ? "the first row has"
+                : given       ? opt.columns_origin + " names"
+                              : "the header has") +
+               " " + std::to_string(ncols));
     const double fhz = number(f, fcol, L.number) * cols[fcol].scale;
     const double a = number(f, pair.col_a, L.number) * cols[pair.col_a].scale;
-    const double bv = number(f, pair.col_b, L.number) * cols[pair.col_b].scale;
-    b.add(L.number, fhz, to_impedance(pair.spec, fhz, a, bv));
+    const double bv =
+        pair.col_b == kNone ? 0.0 : number(f, pair.col_b, L.number) * cols[pair.col_b].scale;
+    b.add(L.number, fhz,
+          lcr ? lcr_impedance(lcr->pair, fhz, a, bv) : to_impedance(pair.spec, fhz, a, bv));
     if (smag != kNone)
       b.add_sigma(number(f, smag, L.number) * cols[smag].scale,
                   number(f, sphase, L.number) * cols[sphase].scale);

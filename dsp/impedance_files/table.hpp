@@ -10,13 +10,17 @@
 //               header (titles, settings) skipped with a note; a header in the
 //               last comment line before the data ("! Stimulus(Hz), ...") when
 //               there is no other; no header at all: f_hz, re_ohm, im_ohm
+//               (three columns only; any other count: name them, --columns)
 //   columns     the first usable pair, in this order: Z real/imaginary,
-//               |Z|/phase (linear or dB), Y real/imaginary, |Y|/phase, S11,
-//               series Ls/Cs with Rs/D/Q, parallel Cp/Lp with G/Rp/D/Q; the
+//               |Z|/phase (linear or dB), Y real/imaginary, |Y|/phase, S21
+//               (transmission: series-through Z, preferred to S11), S11,
+//               series Ls/Cs with Rs/D/Q, parallel Cp/Lp with G/Rp/D/Q; then
+//               any two parameters lcr_parameters.hpp turns into Z (|Z| and
+//               X, θ and R, X and D, ...) or |Z| alone (magnitude only); the
 //               uncertainty band of dsp/impedance_io (abs_sigma_ohm,
 //               phase_sigma_deg, coverage_factor) when present
-// Errors name the file, the line and what was found:
-//   "x.csv: no frequency column among [Freq2, Foo, Bar]"
+// Errors name the file, the line, what was found and the next step:
+//   "x.csv: line 1: no frequency column among [Freq2, Foo, Bar]; name the columns ..."
 //   "x.csv: line 12: 2 columns, the header has 3"
 #include <istream>
 #include <string>
@@ -32,11 +36,23 @@ ImportedImpedance read_impedance_table(std::istream& in, const std::string& name
 namespace zfiles {
 
 struct TableOptions {
-  const char* fn = "read_impedance_table";  // names the reader in messages
+  const char* fn = "read_impedance_table";  // the reader (kept out of messages)
   ImpedanceFileFormat format = ImpedanceFileFormat::Table;
   std::string format_name = "table";
   bool allow_headerless = true;
+  // The columns' names given instead of the file's header (`--columns`, or a
+  // reader that translated an instrument's names): every text line above the
+  // data is skipped; a row may lack trailing columns named "-" (skipped).
+  std::vector<std::string> columns;
+  // What the names above are called in messages and notes (the instrument's
+  // own names); empty: the names themselves.
+  std::vector<std::string> labels;
+  std::string columns_origin = "--columns";  // "names N" in messages
+  int header_line = 0;  // the instrument's header line of the names above (0: none)
 };
+
+// Appended to a message about columns we could not read: how to name them.
+extern const char* const kColumnsHint;
 
 // The table reader on lines already split (the E4990A reader hands it one
 // BEGIN ... END block, the Bode 100 reader the whole file).

@@ -112,21 +112,50 @@ std::vector<std::string> split_fields(std::string_view line, char sep) {
   return fields;
 }
 
+std::string printable(std::string_view s) {
+  std::string out;
+  out.reserve(s.size());
+  for (std::size_t i = 0; i < s.size();) {
+    const auto c = static_cast<unsigned char>(s[i]);
+    std::size_t n = c < 0x80 ? 1 : (c >> 5) == 0x6 ? 2 : (c >> 4) == 0xE ? 3 : (c >> 3) == 0x1E ? 4 : 0;
+    bool ok = n > 0 && i + n <= s.size() && !(n == 2 && c < 0xC2) && !(n == 4 && c > 0xF4);
+    for (std::size_t k = 1; ok && k < n; ++k)
+      ok = (static_cast<unsigned char>(s[i + k]) & 0xC0) == 0x80;
+    if (ok && n == 3) {  // no overlong forms or surrogates
+      const auto d = static_cast<unsigned char>(s[i + 1]);
+      ok = !(c == 0xE0 && d < 0xA0) && !(c == 0xED && d >= 0xA0);
+    }
+    if (ok && n == 4) {
+      const auto d = static_cast<unsigned char>(s[i + 1]);
+      ok = !(c == 0xF0 && d < 0x90) && !(c == 0xF4 && d >= 0x90);
+    }
+    if (!ok) {
+      out += '?';
+      ++i;
+      continue;
+    }
+    out.append(s.substr(i, n));
+    i += n;
+  }
+  return out;
+}
+
 std::string list(const std::vector<std::string>& items) {
   std::string s = "[";
   for (std::size_t i = 0; i < items.size(); ++i) s += (i ? ", " : "") + items[i];
   return s + "]";
 }
 
-void fail(const char* fn, const std::string& name, int line, const std::string& what) {
-  std::string msg = std::string(fn) + ": " + name + ": ";
+void fail(const char* /*fn*/, const std::string& name, int line, const std::string& what) {
+  // The reader's function name stays out: the user sees the file, the line and what is wrong.
+  std::string msg = name + ": ";
   if (line > 0) msg += "line " + std::to_string(line) + ": ";
-  throw std::invalid_argument(msg + what);
+  throw std::invalid_argument(printable(msg + what));
 }
 
 ImportedImpedance CurveBuilder::finish() {
   auto& c = out;
-  const std::size_t n = c.f_hz.size();
+  std::size_t n = c.f_hz.size();
   if (n == 0) fail(fn_, name_, 0, "no data rows");
   if (!c.abs_sigma_ohm.empty() && c.abs_sigma_ohm.size() != n)
     fail(fn_, name_, 0, "uncertainty columns and data rows differ in number");
@@ -144,10 +173,40 @@ ImportedImpedance CurveBuilder::finish() {
          !(c.phase_sigma_rad[i] >= 0) || !std::isfinite(c.phase_sigma_rad[i])))
       fail(fn_, name_, line_[i], "uncertainty is not finite and >= 0");
   }
-  bool ascending = true, descending = n > 1;
+  bool ascending = true, descending = n > 1, ties = false;
   for (std::size_t i = 1; i < n; ++i) {
     ascending = ascending && c.f_hz[i] > c.f_hz[i - 1];
     descending = descending && c.f_hz[i] < c.f_hz[i - 1];
+    ties = ties || c.f_hz[i] == c.f_hz[i - 1];
+  }
+  // A sweep that repeats a frequency (a low-frequency log sweep printed with a
+  // coarse frequency resolution, LabOne's MFIA export) and is otherwise
+  // ascending: each run of equal frequencies becomes one point, Z averaged.
+  bool nondecreasing = ties && c.abs_sigma_ohm.empty();
+  for (std::size_t i = 1; i < n && nondecreasing; ++i)
+    nondecreasing = c.f_hz[i] >= c.f_hz[i - 1];
+  if (nondecreasing) {
+    std::size_t w = 0, merged = 0;
+    for (std::size_t i = 0; i < n;) {
+      std::size_t j = i;
+      std::complex<double> sum = 0;
+      while (j < n && c.f_hz[j] == c.f_hz[i]) sum += c.z_ohm[j++];
+      merged += j - i - 1;
+      c.f_hz[w] = c.f_hz[i];
+      c.z_ohm[w] = sum / static_cast<double>(j - i);
+      line_[w] = line_[i];
+      ++w;
+      i = j;
+    }
+    c.f_hz.resize(w);
+    c.z_ohm.resize(w);
+    line_.resize(w);
+    n = w;
+    c.notes.push_back(std::to_string(merged) +
+                      " point(s) repeat the frequency of the point before: each run of equal "
+                      "frequencies averaged into one point (" +
+                      std::to_string(w) + " points left)");
+    ascending = true;
   }
   if (!ascending && descending) {
     std::reverse(c.f_hz.begin(), c.f_hz.end());
@@ -171,6 +230,9 @@ ImportedImpedance CurveBuilder::finish() {
                       std::to_string(n) +
                       " points: not a passive impedance as written (a phase offset or inverted "
                       "leads?); read as it is");
+  for (auto& note : c.notes) note = printable(note);
+  c.format_name = printable(c.format_name);
+  c.quantity = printable(c.quantity);
   return std::move(c);
 }
 

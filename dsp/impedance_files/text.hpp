@@ -2,7 +2,8 @@
 // Shared by the readers of dsp/impedance_files/ (not part of their API): lines
 // and fields of a text file, locale-independent numbers, the error message
 // format, and the builder that validates a curve once it has been read.
-//   error: "<function>: <file>: line <n>: <what>" (std::invalid_argument)
+//   error: "<file>: line <n>: <what>" (std::invalid_argument; no function names:
+//   the message is the user's)
 #include <complex>
 #include <istream>
 #include <string>
@@ -39,6 +40,10 @@ bool parse_number(std::string_view s, double& out, bool decimal_comma = false);
 // quotes group a field and are removed; fields are trimmed.
 std::vector<std::string> split_fields(std::string_view line, char sep);
 
+// s with every byte that is not part of valid UTF-8 replaced by '?' (a file's
+// Shift-JIS or Latin-1 text quoted in a message or note: JSON needs UTF-8).
+std::string printable(std::string_view s);
+
 // "[a, b, c]" for messages.
 std::string list(const std::vector<std::string>& items);
 
@@ -60,6 +65,7 @@ class CurveBuilder {
     out.phase_sigma_rad.push_back(phase_sigma_rad);
   }
   std::size_t size() const { return out.f_hz.size(); }
+  int line_of(std::size_t i) const { return line_[i]; }
   ImportedImpedance finish();
 
   ImportedImpedance out;  // format, quantity and notes are filled by the reader

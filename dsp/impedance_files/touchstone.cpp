@@ -1,5 +1,6 @@
 #include "dsp/impedance_files/touchstone.hpp"
 
+#include <algorithm>
 #include <array>
 #include <cctype>
 #include <cmath>
@@ -24,6 +25,23 @@ std::vector<std::string> words(std::string_view s) {
   std::string t;
   while (ss >> t) w.push_back(t);
   return w;
+}
+
+// 2 for a ".s2p" file name, 1 for ".s1p", 0 otherwise.
+int ports_of_name(const std::string& name) {
+  const auto dot = name.rfind('.');
+  if (dot == std::string::npos) return 0;
+  const std::string ext = lower(std::string_view(name).substr(dot + 1));
+  return ext == "s2p" ? 2 : ext == "s1p" ? 1 : 0;
+}
+
+// The median of |x| over the points.
+double median_abs(std::vector<std::complex<double>> x) {
+  std::vector<double> m;
+  for (const auto& v : x) m.push_back(std::abs(v));
+  if (m.empty()) return 0;
+  std::nth_element(m.begin(), m.begin() + static_cast<std::ptrdiff_t>(m.size() / 2), m.end());
+  return m[m.size() / 2];
 }
 
 std::string fmt(double v) {
@@ -67,7 +85,10 @@ ImportedImpedance read_touchstone(const std::vector<TextLine>& lines, const std:
   CurveBuilder b(fn, name);
   std::vector<double> pending;  // values of the point being read (v2.0: may span lines)
   int pending_line = 0;
-  std::vector<std::pair<int, std::array<double, 3>>> points;
+  std::vector<std::pair<int, std::array<double, 9>>> points;
+  const int named_ports = ports_of_name(name);
+  int ports = named_ports == 2 ? 2 : 1;
+  bool order_21_first = true;  // 1.x two-port lines: S11 S21 S12 S22
 
   for (const auto& L : lines) {
     std::string_view t = L.text;
@@ -82,8 +103,8 @@ ImportedImpedance read_touchstone(const std::vector<TextLine>& lines, const std:
     if (reference_pending && t.front() != '[') {
       double v;
       const auto w = words(t);
-      if (w.size() != 1 || !parse_number(w[0], v) || !(v > 0) || !std::isfinite(v))
-        fail(fn, name, L.number, "[Reference] needs one positive resistance for a one-port file");
+      if (w.empty() || w.size() > 2 || !parse_number(w[0], v) || !(v > 0) || !std::isfinite(v))
+        fail(fn, name, L.number, "[Reference] needs one positive resistance per port");
       reference = v;
       reference_pending = false;
       continue;
@@ -110,9 +131,11 @@ ImportedImpedance read_touchstone(const std::vector<TextLine>& lines, const std:
       } else if (key == "number of ports") {
         long long n;
         one_int(n);
-        if (n != 1)
+        if (n != 1 && n != 2)
           fail(fn, name, L.number,
-               "[Number of Ports] " + std::to_string(n) + ": only one-port files are read (.s1p)");
+               "[Number of Ports] " + std::to_string(n) +
+                   ": only one-port (.s1p) and two-port (.s2p) files are read");
+        ports = static_cast<int>(n);
       } else if (key == "number of frequencies") {
         one_int(expected);
         if (expected < 1) fail(fn, name, L.number, "[Number of Frequencies] must be positive");
@@ -121,9 +144,8 @@ ImportedImpedance read_touchstone(const std::vector<TextLine>& lines, const std:
           reference_pending = true;
         } else {
           double v;
-          if (args.size() != 1 || !parse_number(args[0], v) || !(v > 0) || !std::isfinite(v))
-            fail(fn, name, L.number,
-                 "[Reference] needs one positive resistance for a one-port file");
+          if (args.size() > 2 || !parse_number(args[0], v) || !(v > 0) || !std::isfinite(v))
+            fail(fn, name, L.number, "[Reference] needs one positive resistance per port");
           reference = v;
         }
       } else if (key == "network data") {
@@ -136,8 +158,11 @@ ImportedImpedance read_touchstone(const std::vector<TextLine>& lines, const std:
         fail(fn, name, L.number, "mixed-mode data is not read (one single-ended port only)");
       } else if (key == "number of noise frequencies" || key == "noise data") {
         fail(fn, name, L.number, "noise data belongs to two-port files");
-      } else if (key == "two-port data order" || key == "matrix format") {
-        // meaningless for one port
+      } else if (key == "two-port data order") {
+        order_21_first = args.empty() || args[0] != "12_21";
+      } else if (key == "matrix format") {
+        if (!args.empty() && lower(args[0]) != "full")
+          fail(fn, name, L.number, "[Matrix Format] " + args[0] + ": only Full is read");
       } else {
         b.out.notes.push_back("keyword [" + std::string(t.substr(1, close - 1)) + "] on line " +
                               std::to_string(L.number) + " ignored");
@@ -182,19 +207,27 @@ ImportedImpedance read_touchstone(const std::vector<TextLine>& lines, const std:
     }
     // Network data.
     if (version2 && !network_data) fail(fn, name, L.number, "data before [Network Data]");
+    const bool first_data = !data_started;
     data_started = true;
     const auto w = words(t);
-    if (!version2 && w.size() != 3)
+    // A 1.x file of 9 values a line, not named .s1p: two ports.
+    if (!version2 && first_data && w.size() == 9 && named_ports != 1)
+      ports = 2;
+    const std::size_t per = ports == 2 ? 9 : 3;
+    if (!version2 && w.size() != per)
       fail(fn, name, L.number,
-           std::to_string(w.size()) + " values: a one-port line is 'f a b'" +
-               (w.size() > 3 ? " (a file of more ports?)" : ""));
+           std::to_string(w.size()) + " values: a " + (ports == 2 ? "two" : "one") +
+               "-port line is " + (ports == 2 ? "'f S11 S21 S12 S22' (8 values after f)" : "'f a b'") +
+               (w.size() > per ? " (a file of more ports?)" : ""));
     for (const auto& s : w) {
       double v;
       if (!parse_number(s, v)) fail(fn, name, L.number, "'" + s + "' is not a number");
       if (pending.empty()) pending_line = L.number;
       pending.push_back(v);
-      if (pending.size() == 3) {
-        points.push_back({pending_line, {pending[0], pending[1], pending[2]}});
+      if (pending.size() == per) {
+        std::array<double, 9> p{};
+        std::copy(pending.begin(), pending.end(), p.begin());
+        points.push_back({pending_line, p});
         pending.clear();
       }
     }
@@ -202,7 +235,8 @@ ImportedImpedance read_touchstone(const std::vector<TextLine>& lines, const std:
   if (reference_pending) fail(fn, name, 0, "[Reference] without a value");
   if (!pending.empty())
     fail(fn, name, pending_line,
-         std::to_string(pending.size()) + " value(s) left over: a one-port point is 'f a b'");
+         std::to_string(pending.size()) + " value(s) left over: a " +
+             (ports == 2 ? "two-port point is 'f' and 8 values" : "one-port point is 'f a b'"));
   if (version2 && !network_data) fail(fn, name, 0, "no [Network Data]");
   if (version2 && !ended) b.out.notes.push_back("no [End] keyword");
   if (expected >= 0 && static_cast<long long>(points.size()) != expected)
@@ -220,10 +254,42 @@ ImportedImpedance read_touchstone(const std::vector<TextLine>& lines, const std:
                     : form == "ma" ? Part::Mag
                                    : Part::MagDb,
                     form == "ri" ? Part::Im : Part::Phase, 50.0};
+  const auto value = [&](const std::array<double, 9>& p, std::size_t k) {
+    const double second = form == "ri" ? p[k + 1] : p[k + 1] * std::numbers::pi / 180.0;
+    return to_impedance(xs, p[0] * unit, p[k], second);  // the value as written
+  };
+  bool through = false;
+  if (ports == 2) {
+    if (param != 's')
+      fail(fn, name, 0,
+           std::string("two-port ") + static_cast<char>(std::toupper(param)) +
+               "-parameters are not read (S-parameters of a two-port are: S21 as a device in "
+               "series between the ports)");
+    const std::size_t k21 = order_21_first ? 3 : 5;
+    std::vector<std::complex<double>> s21;
+    for (const auto& pt : points) s21.push_back(value(pt.second, k21));
+    const double m = median_abs(s21);
+    through = m >= 1e-3;
+    if (through)
+      b.out.notes.push_back(
+          "two-port file: read as a device in series between the ports (series-through "
+          "fixture), Z = 2*z0*(1 - S21)/S21 from S21; S11, S12, S22 not used; never read as "
+          "a reflection");
+    else
+      b.out.notes.push_back("two-port file whose S21 is at noise level (median |S21| " +
+                            fmt(20 * std::log10(std::max(m, 1e-300))) +
+                            " dB): nothing passes between the ports, so the device is taken to "
+                            "be on port 1 and S11 is read as a reflection");
+    for (std::size_t i = 0; i < points.size(); ++i) {
+      const double f = points[i].second[0] * unit;
+      const auto x = through ? s21[i] : value(points[i].second, 1);
+      b.add(points[i].first, f, through ? 2.0 * z0 * (1.0 - x) / x : z0 * (1.0 + x) / (1.0 - x));
+    }
+  }
   for (const auto& [line, p] : points) {
+    if (ports == 2) break;
     const double f = p[0] * unit;
-    const double second = form == "ri" ? p[2] : p[2] * std::numbers::pi / 180.0;
-    const std::complex<double> x = to_impedance(xs, f, p[1], second);  // the value as written
+    const std::complex<double> x = value(p, 1);
     std::complex<double> z;
     if (param == 's')
       z = z0 * (1.0 + x) / (1.0 - x);
@@ -237,7 +303,10 @@ ImportedImpedance read_touchstone(const std::vector<TextLine>& lines, const std:
   b.out.format_name = version2 ? "Touchstone 2.0" : "Touchstone 1.x";
   std::string up = form;
   for (auto& c : up) c = static_cast<char>(std::toupper(static_cast<unsigned char>(c)));
-  if (param == 's')
+  if (ports == 2)
+    b.out.quantity = (through ? "S21 (" + up + "), series-through" : "S11 (" + up + ")") +
+                     ", z0 = " + fmt(z0) + " ohm";
+  else if (param == 's')
     b.out.quantity = "S11 (" + up + "), z0 = " + fmt(z0) + " ohm";
   else
     b.out.quantity = std::string(param == 'z' ? "Z (" : "Y (") + up + ")" +

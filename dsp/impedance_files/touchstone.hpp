@@ -1,6 +1,6 @@
 #pragma once
-// Touchstone one-port files (.s1p, .ts), versions 1.x and 2.0 (IBIS Touchstone
-// specification 2.0, 2009):
+// Touchstone one-port files (.s1p, .ts) and two-port S-parameter files (.s2p),
+// versions 1.x and 2.0 (IBIS Touchstone specification 2.0, 2009):
 //   option line  "# <Hz|kHz|MHz|GHz> <S|Z|Y> <RI|MA|DB> R <z0>", any order,
 //                defaults GHz S MA R 50; only the first counts
 //   comments     '!' to the end of any line
@@ -10,8 +10,19 @@
 //                [Matrix Format], [Network Data], [End]; a point may span lines
 //   values       S11 -> Z = z0 (1 + S)/(1 − S); Z and Y are normalized to R in
 //                1.x (Z = value·R, Y = value/R) and in ohm / siemens in 2.0
-// Refused, with the reason: more than one port, G/H parameters, mixed-mode
-// and noise data, a count that disagrees with [Number of Frequencies].
+//   two ports    [Number of Ports] 2, a ".s2p" name, or 9 values on the first
+//                1.x data line (not named .s1p): S11 S21 S12 S22 per line
+//                (2.0: [Two-Port Data Order] 12_21 or 21_12). A transmission
+//                export: the device sits in series between the ports (the
+//                series-through fixture crystals and thin-film resonators are
+//                measured in), Z = 2·z0·(1 − S21)/S21 from S21, never S11 as
+//                a reflection; unless S21 is at noise level (median |S21|
+//                below −60 dB: nothing passes), when the device is on port 1
+//                and S11 is read as a reflection. A note says which.
+//                (Seen in a real file: an Agilent N5230A PNA-L .s2p, 1.x RI.)
+// Refused, with the reason: more than two ports, two-port Z/Y, G/H
+// parameters, mixed-mode and noise data, a count that disagrees with
+// [Number of Frequencies].
 #include <istream>
 #include <string>
 #include <vector>

@@ -6,6 +6,8 @@
 #include <unistd.h>
 
 #include <cmath>
+#include <complex>
+#include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <nlohmann/json.hpp>
@@ -121,4 +123,79 @@ TEST(CliFigures, ACapturesFiguresAreTheUpdatedModelsModes) {
   EXPECT_FALSE(j["circuit"]["free_capacitance_f"]["sigma"].is_null());
   EXPECT_EQ(run_cli("figures " + kFixtures + "eqcirc3/MD1.txt --method oe").exit_code, 2);
   EXPECT_EQ(run_cli("figures " + kFixtures + "eqcirc3/MD1.txt --method fft").exit_code, 2);
+}
+
+// Issue 39 item 2: a headerless table read with --columns, a HIOKI file with one parameter
+// OFF (|Z| alone: a magnitude-only fit), and the refusals that say what to do next.
+namespace {
+
+// One BVD mode: C0 2.5 nF, C1 0.25 nF, fs 50 kHz, R1 50 ohm.
+std::complex<double> bvd_z(double f) {
+  const double w = 2 * M_PI * f, c0 = 2.5e-9, c1 = 0.25e-9, r1 = 50;
+  const double l1 = 1 / (std::pow(2 * M_PI * 50e3, 2) * c1);
+  const std::complex<double> j(0, 1);
+  return 1.0 / (j * w * c0 + 1.0 / (r1 + j * w * l1 + 1.0 / (j * w * c1)));
+}
+
+}  // namespace
+
+TEST(CliFigures, ColumnsNameAHeaderlessTable) {
+  const std::string file = tmp("g_b.txt");
+  {
+    std::ofstream out(file);
+    out.precision(12);
+    for (int k = 0; k <= 200; ++k) {
+      const double f = 40e3 + 100.0 * k;
+      const auto y = 1.0 / bvd_z(f);
+      out << f / 1e3 << '\t' << y.real() * 1e6 << '\t' << y.imag() * 1e6 << "\t7\n";
+    }
+  }
+  const auto j = figures(file + " --columns f[kHz],G[uS],B[uS],- --modes 2");
+  ASSERT_GE(j["modes"].size(), 1u);
+  EXPECT_NEAR(j["modes"][0]["fs_hz"]["value"].get<double>() / 50e3, 1.0, 2e-3);
+  EXPECT_FALSE(j["magnitude_only"].get<bool>());
+  // Without the names: exit 2, the message names the file and the option.
+  const auto r = run_cli("figures " + file);
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_NE(r.err.find(file + ": line 1: no header, and 4 columns"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("--columns"), std::string::npos) << r.err;
+  EXPECT_EQ(r.err.find("read_"), std::string::npos) << r.err;
+  // A bad specification: exit 2, naming the item.
+  const auto bad = run_cli("figures " + file + " --columns f[kHz],Foo,B[uS]");
+  EXPECT_EQ(bad.exit_code, 2);
+  EXPECT_NE(bad.err.find("'Foo' is not a column we know"), std::string::npos) << bad.err;
+  std::filesystem::remove(file);
+}
+
+TEST(CliFigures, HiokiWithOneParameterOffFitsTheMagnitude) {
+  const std::string file = tmp("im3570.csv");
+  {
+    std::ofstream out(file, std::ios::binary);
+    out << "\"MODEL\",\"IM3570\"\r\n\"MODE\",\"ANALYZER\"\r\n"
+        << "\"No.\",\"FREQUENCY(Hz)\",\"Z[\x83\xb6]\",\"OFF\"\r\n";
+    char buf[128];
+    for (int k = 0; k <= 200; ++k) {
+      const double f = 40e3 + 100.0 * k;
+      std::snprintf(buf, sizeof buf, "\"%d\",\"%.6E\",\"%.6E\",\"\"\r\n", k + 1, f, std::abs(bvd_z(f)));
+      out << buf;
+    }
+  }
+  const auto j = figures(file + " --modes 2");
+  EXPECT_TRUE(j["magnitude_only"].get<bool>());
+  EXPECT_NE(j["format"].get<std::string>().find("HIOKI IM3570"), std::string::npos);
+  ASSERT_GE(j["modes"].size(), 1u);
+  EXPECT_NEAR(j["modes"][0]["fs_hz"]["value"].get<double>() / 50e3, 1.0, 5e-3);
+  // Conductance alone: refused, naming the file and what is missing.
+  {
+    std::ofstream out(file, std::ios::binary);
+    out << "\"No.\",\"FREQUENCY(Hz)\",\"G[S]\",\"OFF\"\r\n\"1\",\"1.0E+03\",\"1.0E-06\",\"\"\r\n";
+  }
+  const auto r = run_cli("figures " + file);
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_NE(r.err.find(file + ": line 1: the columns give [G[S]]: neither complex Z nor |Z|"),
+            std::string::npos)
+      << r.err;
+  std::filesystem::remove(file);
+  // --columns is a table's option: with a capture it is bad input.
+  EXPECT_EQ(run_cli("figures " + kFixtures + "h5py-bvd-exp-decay.h5 --columns f,R,X").exit_code, 2);
 }

@@ -7,6 +7,9 @@
 #include "tests/fuzz/impedance_files_check.hpp"
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
+  // Named .s1p, then .s2p (the name decides a 1.x file's port count).
+  piezo::fuzz::run_impedance_reader(data, size, piezo::dsp::ImpedanceFileFormat::Touchstone,
+                                    "x.s1p");
   return piezo::fuzz::run_impedance_reader(data, size, piezo::dsp::ImpedanceFileFormat::Touchstone,
-                                           "x.s1p");
+                                           "x.s2p");
 }

@@ -1,13 +1,16 @@
 #pragma once
 // Shared by the harnesses of dsp/impedance_files/ (fuzz_touchstone,
-// fuzz_hp4294a, fuzz_e4990a, fuzz_bode100, fuzz_impedance_table): the input is
+// fuzz_hp4294a, fuzz_e4990a, fuzz_bode100, fuzz_impedance_table, fuzz_hioki,
+// fuzz_labone; fuzz_impedance_columns uses check_imported): the input is
 // a file's text, read by one reader (forced) and by read_impedance_any (the
 // format detected). Documented rejection: std::invalid_argument.
 //
 // An accepted curve promises: at least one point; as many impedances as
 // frequencies; finite frequencies >= 0, strictly ascending; finite Z with a
 // finite |Z|; uncertainties empty or one finite σ >= 0 per point for |Z| and
-// phase; the reader's format, a format name and a quantity. When the content
+// phase; the reader's format, a format name and a quantity; a magnitude-only
+// curve holds |Z| + 0j; notes, format name and quantity are valid UTF-8
+// (they go into JSON). When the content
 // is detected as that reader's format, read_impedance_any gives the same
 // curve, bit for bit, or refuses it too.
 #include <cmath>
@@ -45,6 +48,25 @@ inline void check_imported(const dsp::ImportedImpedance& c, const char* who) {
                  "%s: sigma[%zu] = %g, %g", who, i, c.abs_sigma_ohm[i], c.phase_sigma_rad[i]);
   }
   FUZZ_CHECK(!c.format_name.empty() && !c.quantity.empty(), "%s: no format name or quantity", who);
+  if (c.magnitude_only)
+    for (std::size_t i = 0; i < n; ++i)
+      FUZZ_CHECK(c.z_ohm[i].imag() == 0 && c.z_ohm[i].real() >= 0,
+                 "%s: magnitude-only Z[%zu] = %g%+gj is not |Z| + 0j", who, i, c.z_ohm[i].real(),
+                 c.z_ohm[i].imag());
+  // Notes, names and quantity go into JSON: valid UTF-8.
+  const auto utf8 = [](const std::string& s) {
+    for (std::size_t i = 0; i < s.size();) {
+      const auto b = static_cast<unsigned char>(s[i]);
+      const std::size_t k = b < 0x80 ? 1 : (b >> 5) == 6 ? 2 : (b >> 4) == 14 ? 3 : (b >> 3) == 30 ? 4 : 0;
+      if (k == 0 || i + k > s.size()) return false;
+      for (std::size_t j = 1; j < k; ++j)
+        if ((static_cast<unsigned char>(s[i + j]) & 0xC0) != 0x80) return false;
+      i += k;
+    }
+    return true;
+  };
+  FUZZ_CHECK(utf8(c.format_name) && utf8(c.quantity), "%s: format name or quantity not UTF-8", who);
+  for (const auto& note : c.notes) FUZZ_CHECK(utf8(note), "%s: a note is not UTF-8", who);
 }
 
 // One harness: `format`'s reader on the text, then read_impedance_any.

@@ -132,7 +132,8 @@ impedance = {
 
 # ---------------------------------------------------------------- impedance file readers
 # Seeds of fuzz_touchstone, fuzz_hp4294a, fuzz_e4990a, fuzz_bode100 and
-# fuzz_impedance_table (dsp/impedance_files/): the BVD above in each format,
+# fuzz_impedance_table, fuzz_hioki, fuzz_labone and fuzz_impedance_columns
+# (dsp/impedance_files/): the BVD above in each format,
 # 10-20 points each (under libFuzzer's 4 KB), plus a cut of a real 4294A file.
 few = [40000.0 + 1000.0 * k for k in range(0, 21, 2)]  # 40..60 kHz, resonance at 50 kHz
 
@@ -268,6 +269,87 @@ table = {
 }
 
 
+# Issue 39: HIOKI IM3570 CSV (Shift-JIS units, quoted fields, CR LF), LabOne
+# exports, two-port Touchstone, and --columns (first line: the column spec).
+OHM_SJIS, THETA_SJIS, DEG_SJIS = b"\x83\xb6", b"\x83\xc6", b"\x81\x8b"
+
+
+def eng(v):
+    if v == 0:
+        return "0.0000E+00"
+    e = int(math.floor(math.log10(abs(v)) / 3)) * 3
+    return f"{v / 10 ** e:.4f}E{e:+03d}"
+
+
+def hioki(p1, p2, value1, value2):
+    s = (b'"MODEL","IM3570"\r\n"VERSION","V2.10"\r\n"MODE","ANALYZER"\r\n'
+         b'"\x91\xaa\x92\xe8","LCR"\r\n"No.","FREQUENCY(Hz)","' + p1 + b'","' + p2 + b'"\r\n')
+    for k, f in enumerate(few):
+        z = bvd(f)
+        s += (f'"{k + 1}","{eng(f)}","{value1(f, z)}","{value2(f, z)}"\r\n').encode()
+    return s
+
+
+hioki_files = {
+    "z_x.csv": hioki(b"Z[" + OHM_SJIS + b"]", b"X[" + OHM_SJIS + b"]",
+                     lambda f, z: eng(abs(z)), lambda f, z: eng(z.imag)),
+    "z_theta.csv": hioki(b"Z[" + OHM_SJIS + b"]", THETA_SJIS + b"[" + DEG_SJIS + b"]",
+                         lambda f, z: eng(abs(z)), lambda f, z: eng(math.degrees(cmath.phase(z)))),
+    "cs_d.csv": hioki(b"Cs[F]", b"D[]", lambda f, z: eng(-1 / (2 * math.pi * f * z.imag)),
+                      lambda f, z: eng(z.real / abs(z.imag))),
+    "g_b.csv": hioki(b"G[S]", b"B[S]", lambda f, z: eng((1 / z).real), lambda f, z: eng((1 / z).imag)),
+    "z_off.csv": hioki(b"Z[" + OHM_SJIS + b"]", b"OFF", lambda f, z: eng(abs(z)), lambda f, z: ""),
+    "g_off.csv": hioki(b"G[S]", b"OFF", lambda f, z: eng((1 / z).real), lambda f, z: ""),
+}
+
+labone = {
+    "sweeper.csv": "chunk;timestamp;grid;frequency;realz;imagz;absz;phasez;param0;param1\n" + "".join(
+        f"{c};{123456789 + 1000 * k};{f:.9g};{f:.9g};{bvd(f).real:.9g};{bvd(f).imag:.9g};{abs(bvd(f)):.9g};"
+        f"{cmath.phase(bvd(f)):.9g};1e-9;0.01\n" for c in (0, 1) for k, f in enumerate(few[:6])),
+    "text.txt": "% Zurich Instruments LabOne sweeper export\n% frequency absz phasez\n" + "".join(
+        f"{f:.9g} {abs(bvd(f)):.9g} {cmath.phase(bvd(f)):.9g}\n" for f in few) + "61000 nan nan\n",
+    "representation.csv": "% representation: Cp D\nfrequency;param0;param1\n" + "".join(
+        f"{f:.9g};{(1 / bvd(f)).imag / (2 * math.pi * f):.9g};{(1 / bvd(f)).real / abs((1 / bvd(f)).imag):.9g}\n"
+        for f in few),
+    "demod.csv": "chunk;timestamp;grid;frequency;x;y;r;phase\n0;1;1000;1000;0.1;0.2;0.22;1.1\n",
+    "transposed.csv": "chunk;timestamp;size;fieldname" + ";" * 6 + "\n" + "".join(
+        f"{c};{1000 + c};6;{name};" + ";".join(
+            "nan" if c == 2 and k < 2 else f"{value(few[k]):.9g}" for k in reversed(range(6))) + "\n"
+        for c in range(3)
+        for name, value in (("absz", lambda f: abs(bvd(f))), ("frequency", lambda f: f),
+                            ("imagz", lambda f: bvd(f).imag), ("realz", lambda f: bvd(f).real))),
+}
+
+
+def s2p_line(f, z):
+    a, b = z / (z + 100), 100 / (z + 100)  # a device in series between two 50-ohm ports
+    return f"{f:.9g} {a.real:.9g} {a.imag:.9g} {b.real:.9g} {b.imag:.9g} {b.real:.9g} {b.imag:.9g} " \
+           f"{a.real:.9g} {a.imag:.9g}\n"
+
+
+touchstone["series_through.s2p"] = "! N5230A\n# Hz S RI R 50\n" + "".join(s2p_line(f, bvd(f)) for f in few)
+touchstone["v2_two_port.s2p"] = (f"[Version] 2.0\n# Hz S RI R 50\n[Number of Ports] 2\n[Two-Port Data Order] 21_12\n"
+                                 f"[Number of Frequencies] {len(few[:6])}\n[Reference] 50 50\n[Network Data]\n"
+                                 + "".join(s2p_line(f, bvd(f)) for f in few[:6]) + "[End]\n")
+
+columns = {
+    "g_b_khz_us.txt": "f[kHz],G[uS],B[uS],-\n" + "".join(
+        f"{f / 1e3:.9g}\t{(1 / bvd(f)).real * 1e6:.9g}\t{(1 / bvd(f)).imag * 1e6:.9g}\t7\n" for f in few),
+    "z_theta.txt": "f,|Z|,theta(deg),skip,skip\n" + "".join(
+        f"{f:.9g} {abs(bvd(f)):.9g} {math.degrees(cmath.phase(bvd(f))):.9g} 1 2\n" for f in few),
+    "z_only_header.csv": "f[Hz],|Z|[ohm]\nfreq,mag\n" + "".join(f"{f:.9g},{abs(bvd(f)):.9g}\n" for f in few),
+    "cp_d.csv": "f[Hz],Cp[nF],D\n" + "".join(
+        f"{f:.9g};{(1 / bvd(f)).imag / (2 * math.pi * f) * 1e9:.9g};{(1 / bvd(f)).real / abs((1 / bvd(f)).imag):.9g}\n"
+        .replace(".", ",") for f in few),
+}
+table["s11_s21.csv"] = "Freq(Hz),S11(DB),S11(DEG),S21(DB),S21(DEG)\n" + "".join(
+    f"{f:.9g},{20 * math.log10(abs(bvd(f) / (bvd(f) + 100))):.9g},{math.degrees(cmath.phase(bvd(f) / (bvd(f) + 100))):.9g},"
+    f"{20 * math.log10(abs(100 / (bvd(f) + 100))):.9g},{math.degrees(cmath.phase(100 / (bvd(f) + 100))):.9g}\n" for f in few)
+table["z_x.csv"] = "f (kHz),|Z| (Ohm),X (Ohm)\n" + "".join(f"{f / 1e3:.9g},{abs(bvd(f)):.9g},{bvd(f).imag:.9g}\n" for f in few)
+table["repeated_f.txt"] = " Frequency      Resistance       Reactance\r\r\n\r\n" + "".join(
+    f"   {f:.6E}    {bvd(f).real:.6E}    {bvd(f).imag:.6E}\r\r\n" for f in [few[0]] + few)
+
+
 # ---------------------------------------------------------------- capture
 def recipes():
     rng = random.Random(16)
@@ -293,7 +375,8 @@ def main():
     for name, data in recipes().items():
         write("capture", name, data)
     for harness, files in (("touchstone", touchstone), ("hp4294a", hp4294a_files), ("e4990a", e4990a_files),
-                           ("bode100", bode100), ("impedance_table", table)):
+                           ("bode100", bode100), ("impedance_table", table), ("hioki", hioki_files),
+                           ("labone", labone), ("impedance_columns", columns)):
         for name, data in files.items():
             write(harness, name, data)
 

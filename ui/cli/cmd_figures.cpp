@@ -1,4 +1,4 @@
-// `piezobench figures FILE [--json|--csv] [--plot OUT.png] [--modes N] [--band LO:HI]`:
+// `piezobench figures FILE [--json|--csv] [--plot OUT.png] [--modes N] [--band LO:HI] [--columns SPEC]`:
 // per-mode figures (fs, fp, fm, fn, fr, fa, k_eff in its IEEE 176 and EN 50324-2
 // forms, Qm two ways, R1 L1 C1, the misfit) with σ, from a capture or any
 // impedance analyzer's file. The CLI's room (ui/cli): options and printing only;
@@ -109,7 +109,7 @@ void print_text(const nlohmann::json& j) {
 void register_figures_command(CLI::App& app, Context& ctx) {
   auto a = std::make_shared<FiguresArgs>();
   auto* cmd = app.add_subcommand(
-      "figures", "Per-mode figures with sigma from a capture (.h5) or an impedance file (Touchstone, 4294A, E4990A, Bode 100, CSV/TSV)");
+      "figures", "Per-mode figures with sigma from a capture (.h5) or an impedance file (Touchstone .s1p/.s2p, 4294A, E4990A, Bode 100, HIOKI, LabOne, CSV/TSV)");
   cmd->add_option("FILE", a->req.file, "Capture (.h5) or impedance file")->required();
   add_json_flag(cmd, ctx);
   cmd->add_flag("--csv", a->csv, "One CSV row per mode (value and sigma columns)");
@@ -121,6 +121,9 @@ void register_figures_command(CLI::App& app, Context& ctx) {
                   "figures), or fft, xspec, prony (the circuit fitted to that impedance estimate)")
       ->check(CLI::IsMember({"oe", "fft", "xspec", "prony"}));
   cmd->add_option("--material", a->req.material, "oe: the nominal material (default: the capture's own)");
+  cmd->add_option("--columns", a->req.columns,
+                  "A table's columns in order, as quantity[unit], e.g. f[kHz],G[uS],B[uS] or "
+                  "f[Hz],|Z|[ohm],theta[deg] (- skips one); for a file without a header, or one we cannot read");
   cmd->callback([&ctx, a] {
     ctx.exit_code = run_command(ctx, [&] {
       if (!a->band.empty()) parse_band(a->band, a->req);
