@@ -11,8 +11,10 @@ For each file:
            (never a crash, never an internal error);
   modes    every mode whose status is "ok" and Qm >= 20: fs within 3 sigma plus
            one grid step of the data's conductance maximum nearest it, fp of
-           the data's resistance maximum (the reference reader's lists; a mode
-           with no such extremum in its window counts as a violation);
+           the data's resistance maximum (the reference reader's lists; the
+           |Z| minimum and maximum for a file fitted in |Z| alone, its phase
+           untrusted; a mode with no such extremum in its window counts as a
+           violation);
   misfit   0 files whose |Z| misfit exceeds 10 % while a k_eff claims
            sigma below 2 % and neither the fit's nor the mode's status says so;
   analyzer where the analyzer saved its own circuit (manifest analyzer_circuit:
@@ -148,7 +150,10 @@ def main():
             if not ok or f is None or q is None or q < 20:
                 continue
             win = tuple(m.get("window_hz", [None, None]))
-            for name, x, s, key in (("fs", fs, sfs, "conductance_peaks_hz"), ("fp", fp, sfp, "r_max_hz")):
+            # A file whose phase cannot be trusted is fitted in |Z| alone: what its
+            # data show of fs and fp are then the |Z| minimum and maximum.
+            keys = ("z_min_hz", "z_max_hz") if j.get("magnitude_only") else ("conductance_peaks_hz", "r_max_hz")
+            for name, x, s, key in (("fs", fs, sfs, keys[0]), ("fp", fp, sfp, keys[1])):
                 if x is None:
                     continue
                 ref = nearest_in(win, e.get(key) or [], x)

@@ -557,10 +557,15 @@ ImportedImpedance read_table(const std::vector<TextLine>& lines, const std::stri
     if (layout->decimal_comma && f[col].find(',') != std::string::npos) comma_used = true;
     return v;
   };
+  std::size_t empty_rows = 0;
   for (std::size_t i = first; i < lines.size(); ++i) {
     const auto& L = lines[i];
     if (trim(L.text).empty() || is_comment(L.text)) continue;
     auto f = row_fields(L.text, *layout);
+    if (std::all_of(f.begin(), f.end(), [](const std::string& x) { return trim(x).empty(); })) {
+      ++empty_rows;  // separators only: a padded export's filler
+      continue;
+    }
     // Trailing columns left out (skipped ones, empty in the row: an instrument's "OFF").
     bool short_ok = given && f.size() < ncols;
     for (std::size_t k = f.size(); short_ok && k < ncols; ++k) short_ok = names[k] == "-";
@@ -572,6 +577,13 @@ ImportedImpedance read_table(const std::vector<TextLine>& lines, const std::stri
                 : given       ? opt.columns_origin + " names"
                               : "the header has") +
                " " + std::to_string(ncols));
+    // A row whose columns read are all empty (an export padded to a fixed
+    // length, or another sweep's longer columns beside them): no point here.
+    if (trim(f[fcol]).empty() && trim(f[pair.col_a]).empty() &&
+        (pair.col_b == kNone || trim(f[pair.col_b]).empty())) {
+      ++empty_rows;
+      continue;
+    }
     const double fhz = number(f, fcol, L.number) * cols[fcol].scale;
     const double a = number(f, pair.col_a, L.number) * cols[pair.col_a].scale;
     const double bv =
@@ -590,6 +602,8 @@ ImportedImpedance read_table(const std::vector<TextLine>& lines, const std::stri
     }
   }
   if (comma_used) b.out.notes.push_back("decimal commas read as decimal points");
+  if (empty_rows)
+    b.out.notes.push_back(std::to_string(empty_rows) + " rows without values in the columns read skipped");
   if (smag != kNone) {
     b.out.coverage_factor = coverage;
     if (coverage_varies)

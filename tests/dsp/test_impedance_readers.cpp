@@ -553,6 +553,23 @@ TEST(Columns, NamedColumnsForAHeaderlessTable) {
             std::string::npos);
 }
 
+TEST(Columns, PaddedRowsAreSkippedNotRefused) {
+  // A SARK-110 export written by a lab's control program: three sweeps side by
+  // side, the shorter ones' columns empty below their end, and the file padded
+  // with rows of separators only. Rows empty in the columns read are skipped
+  // (said in a note); a row with some of them empty is still an error.
+  const auto t = truth(11);
+  std::string s = "freq_a,rs_a,xs_a,freq_b,rs_b,xs_b\n";
+  for (std::size_t k = 0; k < t.f.size(); ++k)
+    s += fmt("%.15g,%.15g,%.15g,%.15g,1,2\n", t.f[k], t.z[k].real(), t.z[k].imag(), t.f[k]);
+  s += ",,,90e3,1,2\n,,,,,\n,,,,,\n";
+  const auto c = read(s, "sark.csv", "f[Hz],R[ohm],X[ohm],-,-,-");
+  expect_curve(c, t, 1e-13, "padded rows skipped");
+  EXPECT_TRUE(has_note(c, "3 rows without values in the columns read skipped"));
+  const std::string e = error_of(s + "5e4,,,1,2,3\n", "sark.csv", "f[Hz],R[ohm],X[ohm],-,-,-");
+  EXPECT_NE(e.find("is not a number"), std::string::npos) << e;
+}
+
 // ------------------------------------------------------------------ repeated frequencies, errors
 
 TEST(Table, RepeatedFrequenciesAreAveraged) {
