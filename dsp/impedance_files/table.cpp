@@ -546,6 +546,7 @@ ImportedImpedance read_table(const std::vector<TextLine>& lines, const std::stri
 
   // Rows.
   bool comma_used = false;
+  std::size_t empty_rows = 0;
   double coverage = std::nan("");
   bool coverage_varies = false;
   const auto number = [&](const std::vector<std::string>& f, std::size_t col, int line) {
@@ -561,6 +562,10 @@ ImportedImpedance read_table(const std::vector<TextLine>& lines, const std::stri
     const auto& L = lines[i];
     if (trim(L.text).empty() || is_comment(L.text)) continue;
     auto f = row_fields(L.text, *layout);
+    if (f.empty()) {  // ",,,,,,,,": a file padded with empty rows
+      ++empty_rows;
+      continue;
+    }
     // Trailing columns left out (skipped ones, empty in the row: an instrument's "OFF").
     bool short_ok = given && f.size() < ncols;
     for (std::size_t k = f.size(); short_ok && k < ncols; ++k) short_ok = names[k] == "-";
@@ -590,6 +595,8 @@ ImportedImpedance read_table(const std::vector<TextLine>& lines, const std::stri
     }
   }
   if (comma_used) b.out.notes.push_back("decimal commas read as decimal points");
+  if (empty_rows > 0)
+    b.out.notes.push_back(std::to_string(empty_rows) + " row(s) of empty fields skipped");
   if (smag != kNone) {
     b.out.coverage_factor = coverage;
     if (coverage_varies)

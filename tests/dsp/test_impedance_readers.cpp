@@ -462,6 +462,15 @@ TEST(Transmission, TwoPortTouchstoneIsSeriesThrough) {
   const auto r = read(one, "port1.s2p");
   expect_curve(r, t, 1e-9, "s2p, S21 at noise level");
   EXPECT_TRUE(has_note(r, "S11 is read as a reflection"));
+  // A two-port that is no series element (a filter: S11 + S21 far from 1): S11, said.
+  std::string filt = "# Hz S RI R 50\n";
+  for (std::size_t k = 0; k < t.f.size(); ++k) {
+    const cd g = (t.z[k] - 50.0) / (t.z[k] + 50.0);
+    filt += fmt("%.15g %.15g %.15g 0.5 0.5 0.5 0.5 0.1 0.1\n", t.f[k], g.real(), g.imag());
+  }
+  const auto fl = read(filt, "saw.s2p");
+  expect_curve(fl, t, 1e-9, "s2p, not a series element");
+  EXPECT_TRUE(has_note(fl, "not one element in series between the ports"));
   // A one-port S11 stays a reflection.
   std::string s1 = "# Hz S RI R 50\n";
   for (std::size_t k = 0; k < t.f.size(); ++k) {
@@ -568,6 +577,13 @@ TEST(Table, RepeatedFrequenciesAreAveraged) {
   EXPECT_NEAR(c.z_ohm[0].real(), (8.857049e3 + 8.883777e3) / 2, 1e-9);
   EXPECT_NEAR(c.z_ohm[0].imag(), (43.65435 - 1.657204) / 2, 1e-9);
   EXPECT_TRUE(has_note(c, "1 point(s) repeat the frequency"));
+  // A file padded with rows of empty fields (SARK-110 via IMES): skipped, said.
+  const auto p = read("freq__2019_,rs__2019_,xs__2019_\n4956111.0,7.09375,-921.5\n"
+                      "4956121.0,7.1,-921\n,,\n,,\n",
+                      "sark.csv");
+  ASSERT_EQ(p.size(), 2u);
+  EXPECT_EQ(p.z_ohm[1], cd(7.1, -921));
+  EXPECT_TRUE(has_note(p, "2 row(s) of empty fields skipped"));
 }
 
 TEST(ImpedanceFiles, MessagesNameTheFileNotTheFunction) {
