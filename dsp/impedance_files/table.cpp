@@ -577,6 +577,12 @@ ImportedImpedance read_table(const std::vector<TextLine>& lines, const std::stri
                 : given       ? opt.columns_origin + " names"
                               : "the header has") +
                " " + std::to_string(ncols));
+    // Side-by-side sweeps of different lengths: the columns read are empty past theirs.
+    if (fcol < f.size() && f[fcol].empty() && pair.col_a < f.size() && f[pair.col_a].empty() &&
+        (pair.col_b == kNone || (pair.col_b < f.size() && f[pair.col_b].empty()))) {
+      ++empty_rows;
+      continue;
+    }
     const double fhz = number(f, fcol, L.number) * cols[fcol].scale;
     const double a = number(f, pair.col_a, L.number) * cols[pair.col_a].scale;
     const double bv =
@@ -596,7 +602,8 @@ ImportedImpedance read_table(const std::vector<TextLine>& lines, const std::stri
   }
   if (comma_used) b.out.notes.push_back("decimal commas read as decimal points");
   if (empty_rows > 0)
-    b.out.notes.push_back(std::to_string(empty_rows) + " row(s) of empty fields skipped");
+    b.out.notes.push_back(std::to_string(empty_rows) +
+                          " row(s) with empty fields in the columns read skipped");
   if (smag != kNone) {
     b.out.coverage_factor = coverage;
     if (coverage_varies)

@@ -578,12 +578,13 @@ TEST(Table, RepeatedFrequenciesAreAveraged) {
   EXPECT_NEAR(c.z_ohm[0].imag(), (43.65435 - 1.657204) / 2, 1e-9);
   EXPECT_TRUE(has_note(c, "1 point(s) repeat the frequency"));
   // A file padded with rows of empty fields (SARK-110 via IMES): skipped, said.
-  const auto p = read("freq__2019_,rs__2019_,xs__2019_\n4956111.0,7.09375,-921.5\n"
-                      "4956121.0,7.1,-921\n,,\n,,\n",
+  // Three sweeps side by side; the first is shorter.
+  const auto p = read("freq__2019_,rs__2019_,xs__2019_,freq__b,rs__b,xs__b\n"
+                      "4956111.0,7.09375,-921.5,1,2,3\n4956121.0,7.1,-921,2,2,3\n,,,3,2,3\n,,\n",
                       "sark.csv");
   ASSERT_EQ(p.size(), 2u);
   EXPECT_EQ(p.z_ohm[1], cd(7.1, -921));
-  EXPECT_TRUE(has_note(p, "2 row(s) of empty fields skipped"));
+  EXPECT_TRUE(has_note(p, "2 row(s) with empty fields in the columns read skipped"));
 }
 
 TEST(ImpedanceFiles, MessagesNameTheFileNotTheFunction) {
