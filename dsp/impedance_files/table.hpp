@@ -6,7 +6,9 @@
 //               decimal commas with ';', tab or blank separators, and the
 //               "+1,5e+006,+2,0e+002" of a comma-locale instrument (every
 //               field split in two: twice the header's columns)
-//   lines       blank lines anywhere; '#' and '!' comments; text before the
+//   lines       blank lines, and rows whose columns read are empty (",,,": a
+//               padded file, side-by-side sweeps of different lengths),
+//               anywhere; '#' and '!' comments; text before the
 //               header (titles, settings) skipped with a note; a header in the
 //               last comment line before the data ("! Stimulus(Hz), ...") when
 //               there is no other; no header at all: f_hz, re_ohm, im_ohm
