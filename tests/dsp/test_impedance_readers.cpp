@@ -494,6 +494,16 @@ TEST(Transmission, S21ColumnsArePreferredToS11) {
   expect_curve(c, t, 1e-10, "S21 columns");
   EXPECT_TRUE(has_note(c, "S21 is preferred to any S11 column"));
   EXPECT_TRUE(has_note(c, "an equation of other traces"));
+  // S11 and S21 of a filter (S11 + S21 far from 1): S11, said.
+  std::string f2 = "Freq(Hz),S11(DB),S11(DEG),S21(DB),S21(DEG)\n";
+  for (std::size_t k = 0; k < t.f.size(); ++k) {
+    const cd g = (t.z[k] - 50.0) / (t.z[k] + 50.0);
+    f2 += fmt("%.15g,%.15g,%.15g,-3,170\n", t.f[k], 20 * std::log10(std::abs(g)),
+              std::arg(g) * kDeg);
+  }
+  const auto fc = read(f2, "filter.csv");
+  expect_curve(fc, t, 1e-9, "S11 of a filter");
+  EXPECT_TRUE(has_note(fc, "not those of one element in series"));
   // vna/J in transmission mode: "Transmission Loss(dB)" and Phase; its Rs/Xs are not read.
   std::string v = "Frequency(Hz),Transmission Loss(dB),Phase(deg),Rs,SWR,Xs,|Z|,Theta\n";
   for (std::size_t k = 0; k < t.f.size(); ++k) {
