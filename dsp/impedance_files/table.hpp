@@ -15,7 +15,8 @@
 //               (three columns only; any other count: name them, --columns)
 //   columns     the first usable pair, in this order: Z real/imaginary,
 //               |Z|/phase (linear or dB), Y real/imaginary, |Y|/phase, S21
-//               (transmission: series-through Z, preferred to S11), S11,
+//               (transmission: series-through Z, preferred to S11 unless S21
+//               is at noise level or S11 + S21 is not 1), S11,
 //               series Ls/Cs with Rs/D/Q, parallel Cp/Lp with G/Rp/D/Q; then
 //               any two parameters lcr_parameters.hpp turns into Z (|Z| and
 //               X, θ and R, X and D, ...) or |Z| alone (magnitude only); the
