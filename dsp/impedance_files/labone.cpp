@@ -153,7 +153,8 @@ std::optional<std::vector<TextLine>> untranspose(const std::vector<TextLine>& li
   }
   for (std::size_t c = chunks.size(); c-- > 0 && pick == chunks.size();)
     if (finite_count(field(chunks[c], "frequency")) > 0) pick = c;
-  for (std::size_t c = pick; c < chunks.size(); c = chunks.size()) {
+  if (pick < chunks.size()) {
+    const std::size_t c = pick;
     const auto& ch = chunks[c];
     const Field* freq = field(ch, "frequency");
     std::vector<TextLine> out;

@@ -468,16 +468,55 @@ ImportedImpedance read_table(const std::vector<TextLine>& lines, const std::stri
         for (auto& m : mags) m = 1.0 / m;
         s21_note = "transmission loss written positive: read as |S21| = -loss (dB); ";
       }
-      double median = 0;
-      if (!mags.empty()) {
-        std::nth_element(mags.begin(), mags.begin() + static_cast<std::ptrdiff_t>(mags.size() / 2),
-                         mags.end());
-        median = mags[mags.size() / 2];
-      }
+      const auto median_of = [](std::vector<double> v) {
+        if (v.empty()) return 0.0;
+        std::nth_element(v.begin(), v.begin() + static_cast<std::ptrdiff_t>(v.size() / 2), v.end());
+        return v[v.size() / 2];
+      };
+      const double median = median_of(mags);
       char db[32];
       std::snprintf(db, sizeof db, "%.3g", 20 * std::log10(std::max(median, 1e-300)));
       const auto s11 = choose_pair(cols, false);
-      if (median < 1e-3 && s11 && s11->spec.quantity == Quantity::S) {
+      // With S11 beside it: one element in series between the ports has S11 + S21 = 1.
+      double series_misfit = 0;
+      if (s11 && s11->spec.quantity == Quantity::S) {
+        const auto value = [&](const std::vector<std::string>& f, const PairChoice& p,
+                               std::complex<double>& x) {
+          double va, vb;
+          if (f.size() <= std::max(p.col_a, p.col_b) ||
+              !parse_number(f[p.col_a], va, layout->decimal_comma) ||
+              !parse_number(f[p.col_b], vb, layout->decimal_comma))
+            return false;
+          va *= cols[p.col_a].scale;
+          vb *= cols[p.col_b].scale;
+          if (p.spec.a == Part::Re) {
+            x = {va, vb};
+          } else {
+            const double m = p.spec.a == Part::Mag ? va : std::pow(10.0, va / 20.0);
+            x = {m * std::cos(vb), m * std::sin(vb)};
+          }
+          return true;
+        };
+        std::vector<double> d;
+        for (std::size_t i = first; i < lines.size(); ++i) {
+          if (trim(lines[i].text).empty() || is_comment(lines[i].text)) continue;
+          const auto f = row_fields(lines[i].text, *layout);
+          std::complex<double> a, t;
+          if (value(f, *s11, a) && value(f, pair, t)) d.push_back(std::abs(a + t - 1.0));
+        }
+        series_misfit = median_of(d);
+      }
+      char sm[32];
+      std::snprintf(sm, sizeof sm, "%.3g", series_misfit);
+      if (median >= 1e-3 && series_misfit > 0.1) {
+        pair = *s11;
+        s21_note += std::string("S11 and S21 are not those of one element in series between the "
+                                "ports (median |S11 + S21 - 1| ") +
+                    sm +
+                    ", 0 for a series element: a filter, or a fixture with shunt paths), so "
+                    "2*z0*(1 - S21)/S21 would not be the device's impedance: S11 read as the "
+                    "input impedance of port 1 with port 2 terminated in z0";
+      } else if (median < 1e-3 && s11 && s11->spec.quantity == Quantity::S) {
         pair = *s11;
         s21_note += std::string("S21 is at noise level (median |S21| ") + db +
                    " dB): nothing passes between the ports, so the device is taken to be on "
@@ -546,6 +585,7 @@ ImportedImpedance read_table(const std::vector<TextLine>& lines, const std::stri
 
   // Rows.
   bool comma_used = false;
+  std::size_t empty_rows = 0;
   double coverage = std::nan("");
   bool coverage_varies = false;
   const auto number = [&](const std::vector<std::string>& f, std::size_t col, int line) {
@@ -557,13 +597,12 @@ ImportedImpedance read_table(const std::vector<TextLine>& lines, const std::stri
     if (layout->decimal_comma && f[col].find(',') != std::string::npos) comma_used = true;
     return v;
   };
-  std::size_t empty_rows = 0;
   for (std::size_t i = first; i < lines.size(); ++i) {
     const auto& L = lines[i];
     if (trim(L.text).empty() || is_comment(L.text)) continue;
     auto f = row_fields(L.text, *layout);
-    if (std::all_of(f.begin(), f.end(), [](const std::string& x) { return trim(x).empty(); })) {
-      ++empty_rows;  // separators only: a padded export's filler
+    if (f.empty()) {  // ",,,,,,,,": a file padded with empty rows
+      ++empty_rows;
       continue;
     }
     // Trailing columns left out (skipped ones, empty in the row: an instrument's "OFF").
@@ -577,10 +616,9 @@ ImportedImpedance read_table(const std::vector<TextLine>& lines, const std::stri
                 : given       ? opt.columns_origin + " names"
                               : "the header has") +
                " " + std::to_string(ncols));
-    // A row whose columns read are all empty (an export padded to a fixed
-    // length, or another sweep's longer columns beside them): no point here.
-    if (trim(f[fcol]).empty() && trim(f[pair.col_a]).empty() &&
-        (pair.col_b == kNone || trim(f[pair.col_b]).empty())) {
+    // Side-by-side sweeps of different lengths: the columns read are empty past theirs.
+    if (fcol < f.size() && f[fcol].empty() && pair.col_a < f.size() && f[pair.col_a].empty() &&
+        (pair.col_b == kNone || (pair.col_b < f.size() && f[pair.col_b].empty()))) {
       ++empty_rows;
       continue;
     }
@@ -602,8 +640,9 @@ ImportedImpedance read_table(const std::vector<TextLine>& lines, const std::stri
     }
   }
   if (comma_used) b.out.notes.push_back("decimal commas read as decimal points");
-  if (empty_rows)
-    b.out.notes.push_back(std::to_string(empty_rows) + " rows without values in the columns read skipped");
+  if (empty_rows > 0)
+    b.out.notes.push_back(std::to_string(empty_rows) +
+                          " row(s) with empty fields in the columns read skipped");
   if (smag != kNone) {
     b.out.coverage_factor = coverage;
     if (coverage_varies)

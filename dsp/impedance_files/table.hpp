@@ -6,14 +6,17 @@
 //               decimal commas with ';', tab or blank separators, and the
 //               "+1,5e+006,+2,0e+002" of a comma-locale instrument (every
 //               field split in two: twice the header's columns)
-//   lines       blank lines anywhere; '#' and '!' comments; text before the
+//   lines       blank lines, and rows whose columns read are empty (",,,": a
+//               padded file, side-by-side sweeps of different lengths),
+//               anywhere; '#' and '!' comments; text before the
 //               header (titles, settings) skipped with a note; a header in the
 //               last comment line before the data ("! Stimulus(Hz), ...") when
 //               there is no other; no header at all: f_hz, re_ohm, im_ohm
 //               (three columns only; any other count: name them, --columns)
 //   columns     the first usable pair, in this order: Z real/imaginary,
 //               |Z|/phase (linear or dB), Y real/imaginary, |Y|/phase, S21
-//               (transmission: series-through Z, preferred to S11), S11,
+//               (transmission: series-through Z, preferred to S11 unless S21
+//               is at noise level or S11 + S21 is not 1), S11,
 //               series Ls/Cs with Rs/D/Q, parallel Cp/Lp with G/Rp/D/Q; then
 //               any two parameters lcr_parameters.hpp turns into Z (|Z| and
 //               X, θ and R, X and D, ...) or |Z| alone (magnitude only); the

@@ -51,7 +51,9 @@ std::string list(const std::vector<std::string>& items);
 
 // Collects the points of a curve with the line each came from, then checks it
 // (finish): at least one point, finite f >= 0 and finite Z, frequencies
-// strictly ascending (a strictly descending sweep is reversed, with a note).
+// strictly ascending (a strictly descending sweep is reversed, with a note; an
+// ascending one that repeats a frequency has each run of equal frequencies
+// averaged into one point, with a note, when it carries no σ).
 class CurveBuilder {
  public:
   CurveBuilder(const char* fn, std::string name) : fn_(fn), name_(std::move(name)) {}

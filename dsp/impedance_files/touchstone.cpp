@@ -269,17 +269,28 @@ ImportedImpedance read_touchstone(const std::vector<TextLine>& lines, const std:
     std::vector<std::complex<double>> s21;
     for (const auto& pt : points) s21.push_back(value(pt.second, k21));
     const double m = median_abs(s21);
-    through = m >= 1e-3;
+    // A bare series element has S11 + S21 = 1 exactly (S11 = Z/(Z + 2 z0)).
+    std::vector<std::complex<double>> series_misfit;
+    for (std::size_t i = 0; i < points.size(); ++i)
+      series_misfit.push_back(value(points[i].second, 1) + s21[i] - 1.0);
+    const double sm = median_abs(series_misfit);
+    through = m >= 1e-3 && sm <= 0.1;
     if (through)
       b.out.notes.push_back(
           "two-port file: read as a device in series between the ports (series-through "
-          "fixture), Z = 2*z0*(1 - S21)/S21 from S21; S11, S12, S22 not used; never read as "
-          "a reflection");
-    else
+          "fixture), Z = 2*z0*(1 - S21)/S21 from S21 (median |S11 + S21 - 1| " + fmt(sm) +
+          ", 0 for a bare series element); S11, S12, S22 not used; never read as a reflection");
+    else if (m < 1e-3)
       b.out.notes.push_back("two-port file whose S21 is at noise level (median |S21| " +
                             fmt(20 * std::log10(std::max(m, 1e-300))) +
                             " dB): nothing passes between the ports, so the device is taken to "
                             "be on port 1 and S11 is read as a reflection");
+    else
+      b.out.notes.push_back(
+          "two-port file that is not one element in series between the ports (median |S11 + "
+          "S21 - 1| " + fmt(sm) + ", 0 for a series element: a filter, or a fixture with shunt "
+          "paths), so 2*z0*(1 - S21)/S21 would not be the device's impedance: S11 read as the "
+          "input impedance of port 1 with port 2 terminated in z0");
     for (std::size_t i = 0; i < points.size(); ++i) {
       const double f = points[i].second[0] * unit;
       const auto x = through ? s21[i] : value(points[i].second, 1);

@@ -18,7 +18,12 @@
 //                measured in), Z = 2·z0·(1 − S21)/S21 from S21, never S11 as
 //                a reflection; unless S21 is at noise level (median |S21|
 //                below −60 dB: nothing passes), when the device is on port 1
-//                and S11 is read as a reflection. A note says which.
+//                and S11 is read as a reflection, or the two-port is not one
+//                series element (median |S11 + S21 − 1| above 0.1, where a
+//                series element has 0: a filter, shunt paths), when S11 is
+//                read as port 1's input impedance with port 2 terminated
+//                (a LibreVNA .s2p of a SAW filter: 1.58; the N5230A's MEMS
+//                resonator: 0.003). A note says which.
 //                (Seen in a real file: an Agilent N5230A PNA-L .s2p, 1.x RI.)
 // Refused, with the reason: more than two ports, two-port Z/Y, G/H
 // parameters, mixed-mode and noise data, a count that disagrees with

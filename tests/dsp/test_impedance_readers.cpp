@@ -462,6 +462,15 @@ TEST(Transmission, TwoPortTouchstoneIsSeriesThrough) {
   const auto r = read(one, "port1.s2p");
   expect_curve(r, t, 1e-9, "s2p, S21 at noise level");
   EXPECT_TRUE(has_note(r, "S11 is read as a reflection"));
+  // A two-port that is no series element (a filter: S11 + S21 far from 1): S11, said.
+  std::string filt = "# Hz S RI R 50\n";
+  for (std::size_t k = 0; k < t.f.size(); ++k) {
+    const cd g = (t.z[k] - 50.0) / (t.z[k] + 50.0);
+    filt += fmt("%.15g %.15g %.15g 0.5 0.5 0.5 0.5 0.1 0.1\n", t.f[k], g.real(), g.imag());
+  }
+  const auto fl = read(filt, "saw.s2p");
+  expect_curve(fl, t, 1e-9, "s2p, not a series element");
+  EXPECT_TRUE(has_note(fl, "not one element in series between the ports"));
   // A one-port S11 stays a reflection.
   std::string s1 = "# Hz S RI R 50\n";
   for (std::size_t k = 0; k < t.f.size(); ++k) {
@@ -485,6 +494,16 @@ TEST(Transmission, S21ColumnsArePreferredToS11) {
   expect_curve(c, t, 1e-10, "S21 columns");
   EXPECT_TRUE(has_note(c, "S21 is preferred to any S11 column"));
   EXPECT_TRUE(has_note(c, "an equation of other traces"));
+  // S11 and S21 of a filter (S11 + S21 far from 1): S11, said.
+  std::string f2 = "Freq(Hz),S11(DB),S11(DEG),S21(DB),S21(DEG)\n";
+  for (std::size_t k = 0; k < t.f.size(); ++k) {
+    const cd g = (t.z[k] - 50.0) / (t.z[k] + 50.0);
+    f2 += fmt("%.15g,%.15g,%.15g,-3,170\n", t.f[k], 20 * std::log10(std::abs(g)),
+              std::arg(g) * kDeg);
+  }
+  const auto fc = read(f2, "filter.csv");
+  expect_curve(fc, t, 1e-9, "S11 of a filter");
+  EXPECT_TRUE(has_note(fc, "not those of one element in series"));
   // vna/J in transmission mode: "Transmission Loss(dB)" and Phase; its Rs/Xs are not read.
   std::string v = "Frequency(Hz),Transmission Loss(dB),Phase(deg),Rs,SWR,Xs,|Z|,Theta\n";
   for (std::size_t k = 0; k < t.f.size(); ++k) {
@@ -565,7 +584,7 @@ TEST(Columns, PaddedRowsAreSkippedNotRefused) {
   s += ",,,90e3,1,2\n,,,,,\n,,,,,\n";
   const auto c = read(s, "sark.csv", "f[Hz],R[ohm],X[ohm],-,-,-");
   expect_curve(c, t, 1e-13, "padded rows skipped");
-  EXPECT_TRUE(has_note(c, "3 rows without values in the columns read skipped"));
+  EXPECT_TRUE(has_note(c, "3 row(s) with empty fields in the columns read skipped"));
   const std::string e = error_of(s + "5e4,,,1,2,3\n", "sark.csv", "f[Hz],R[ohm],X[ohm],-,-,-");
   EXPECT_NE(e.find("is not a number"), std::string::npos) << e;
 }
@@ -585,6 +604,14 @@ TEST(Table, RepeatedFrequenciesAreAveraged) {
   EXPECT_NEAR(c.z_ohm[0].real(), (8.857049e3 + 8.883777e3) / 2, 1e-9);
   EXPECT_NEAR(c.z_ohm[0].imag(), (43.65435 - 1.657204) / 2, 1e-9);
   EXPECT_TRUE(has_note(c, "1 point(s) repeat the frequency"));
+  // A file padded with rows of empty fields (SARK-110 via IMES): skipped, said.
+  // Three sweeps side by side; the first is shorter.
+  const auto p = read("freq__2019_,rs__2019_,xs__2019_,freq__b,rs__b,xs__b\n"
+                      "4956111.0,7.09375,-921.5,1,2,3\n4956121.0,7.1,-921,2,2,3\n,,,3,2,3\n,,\n",
+                      "sark.csv");
+  ASSERT_EQ(p.size(), 2u);
+  EXPECT_EQ(p.z_ohm[1], cd(7.1, -921));
+  EXPECT_TRUE(has_note(p, "2 row(s) with empty fields in the columns read skipped"));
 }
 
 TEST(ImpedanceFiles, MessagesNameTheFileNotTheFunction) {
