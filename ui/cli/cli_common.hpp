@@ -3,6 +3,7 @@
 // error reporting. Every command registers itself through a register_* function.
 // The CLI's room (ui/cli): commands parse options, call a job (jobs/) and print.
 #include <CLI/CLI.hpp>
+#include <cstddef>
 #include <functional>
 #include <iosfwd>
 #include <nlohmann/json.hpp>
@@ -55,6 +56,10 @@ class ProgressBar {
   bool finished_ = false;
   int last_permille_ = -1;
 };
+
+// `replay --jobs` by default: the number of cores (std::thread::hardware_concurrency,
+// at least 1, at most 256).
+std::size_t default_jobs();
 
 void register_capture_commands(CLI::App& app, Context& ctx);
 void register_demo_command(CLI::App& app, Context& ctx);
