@@ -1,6 +1,9 @@
 #include "jobs/json/mode_figures_json.hpp"
 
 #include <cmath>
+#include <cstdio>
+
+#include "jobs/text/uncertain_text.hpp"
 
 namespace piezo::jobs {
 
@@ -16,19 +19,16 @@ double num(const nlohmann::json& j, const char* key) {
   return j.contains(key) && j[key].is_number() ? j[key].get<double>() : NAN;
 }
 
-// "value±sigma" scaled, or "value" when σ is unknown, or "-" when the value is.
+// "value ± sigma" scaled (σ to two significant digits, jobs/text/uncertain_text.hpp),
+// or the value by `f` and "± —" when σ is not finite, or "-" when the value is not.
 std::string vs(const nlohmann::json& j, const char* key, const char* skey, double scale,
                const char* f) {
   const double v = num(j, key), s = num(j, skey);
   if (!std::isfinite(v)) return "-";
+  if (std::isfinite(s) && s > 0) return format_uncertain(v * scale, s * scale, {}, {true});
   char buf[96];
   std::snprintf(buf, sizeof buf, f, v * scale);
-  std::string out = buf;
-  if (std::isfinite(s)) {
-    std::snprintf(buf, sizeof buf, f, s * scale);
-    out += "±" + std::string(buf);
-  }
-  return out;
+  return std::string(buf) + (std::isfinite(s) ? "" : " ± —");
 }
 
 }  // namespace

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <iterator>
 
 namespace piezo::jobs {
 
@@ -41,7 +42,7 @@ std::string format_uncertain(double value, double sigma, std::string_view unit, 
   if (!std::isfinite(value)) return kDash;
   if (!std::isfinite(sigma) || sigma < 0) {
     if (style.compact) return with_unit(general(value, style.bare_digits) + " ± " + kDash, unit);
-    return format_value(value, unit, style.bare_digits) + " (σ not identifiable)";
+    return format_value(value, unit, style.bare_digits) + " (" + style.no_sigma + ")";
   }
   if (sigma == 0) return with_unit(general(value, 6) + " ± 0", unit) + (style.compact ? "" : " (exact)");
   // σ to two significant digits: its last kept digit has the weight q = 10^(e-1).
@@ -72,6 +73,9 @@ std::string format_uncertain(double value, double sigma, std::string_view unit, 
 
 std::string format_si(double value, double sigma, std::string_view base_unit, const UncertainStyle& style) {
   if (!std::isfinite(value)) return kDash;
+  static const char* const kSi[] = {"F", "H", "Hz", "s", "V", "A", "W", "m", "ohm", "Ω"};
+  if (std::find(std::begin(kSi), std::end(kSi), base_unit) == std::end(kSi))
+    return format_uncertain(value, sigma, base_unit, style);
   double mag = std::abs(value);
   if (std::isfinite(sigma) && sigma > mag) mag = sigma;
   static const char* const kPrefix[] = {"f", "p", "n", "µ", "m", "", "k", "M", "G"};

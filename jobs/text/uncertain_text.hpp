@@ -26,13 +26,16 @@ struct UncertainStyle {
   bool compact = false;
   // Significant digits of a value printed without a usable σ.
   int bare_digits = 6;
+  // What a σ that is not finite says (prose style).
+  const char* no_sigma = "σ not identifiable";
 };
 
 std::string format_uncertain(double value, double sigma, std::string_view unit = {},
                              const UncertainStyle& style = {});
 
 // The same with the SI prefix (f p n µ m – k M G) chosen from the larger of
-// |value| and σ; `base_unit` is the unprefixed unit ("F", "H", "Hz", "ohm").
+// |value| and σ when `base_unit` is an unprefixed SI unit (F, H, Hz, s, V, A, W,
+// m, ohm, Ω); any other unit is printed as format_uncertain does.
 std::string format_si(double value, double sigma, std::string_view base_unit,
                       const UncertainStyle& style = {});
 

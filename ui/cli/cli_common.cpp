@@ -5,6 +5,7 @@
 #include <cstdio>
 #include <iomanip>
 #include <iostream>
+#include <limits>
 #include <map>
 #include <optional>
 
@@ -79,6 +80,10 @@ int run_command(Context& ctx, const std::function<void()>& body) {
 void print_json(const nlohmann::json& j) {
   jobs::write_json(std::cout, j);
   std::cout << std::endl;
+}
+
+double json_number(const nlohmann::json& j) {
+  return j.is_number() ? j.get<double>() : std::numeric_limits<double>::quiet_NaN();
 }
 
 void add_chain_tolerance_options(CLI::App* cmd, update::OeOptions& o) {

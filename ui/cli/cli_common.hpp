@@ -34,6 +34,9 @@ int run_command(Context& ctx, const std::function<void()>& body);
 
 void print_json(const nlohmann::json& j);
 
+// A JSON number as a double; NaN for null (a value JSON cannot hold) or anything else.
+double json_number(const nlohmann::json& j);
+
 // Every command takes --json (also accepted before the command name).
 void add_json_flag(CLI::App* cmd, Context& ctx);
 // The measurement chain's tolerances that the output-error fit carries into
