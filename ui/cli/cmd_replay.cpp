@@ -15,6 +15,7 @@
 #include <thread>
 
 #include "acquisition/results_file.hpp"
+#include "jobs/text/user_message.hpp"
 #include "ui/cli/cli_common.hpp"
 #include "jobs/replay/merge.hpp"
 #include "jobs/replay/replay_batch.hpp"
@@ -179,11 +180,11 @@ void register_replay_commands(CLI::App& app, Context& ctx) {
       cb.issue = [&](const jobs::replay::ReplayIssue& i) {
         if (tty) std::fprintf(stderr, "\n");
         const char* what = i.kind == "report" ? "report not written" : "skipped";
-        if (i.message.rfind(i.path, 0) == 0)  // the message names the file already
-          std::fprintf(stderr, "piezobench: replay: %s: %s\n", what, i.message.c_str());
+        const std::string message = jobs::user_message(i.message);  // without internal function names
+        if (message.rfind(i.path, 0) == 0)  // the message names the file already
+          std::fprintf(stderr, "piezobench: replay: %s: %s\n", what, message.c_str());
         else
-          std::fprintf(stderr, "piezobench: replay: %s: %s: %s\n", what, i.path.c_str(),
-                       i.message.c_str());
+          std::fprintf(stderr, "piezobench: replay: %s: %s: %s\n", what, i.path.c_str(), message.c_str());
       };
       auto s = as_input([&] { return jobs::replay::run_replay(opt, cb, g_stop); });
       bar.finish();

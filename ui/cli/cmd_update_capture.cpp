@@ -9,6 +9,7 @@
 
 #include <cstdio>
 
+#include "jobs/text/user_message.hpp"
 #include "jobs/text/uncertain_text.hpp"
 #include "jobs/update_capture_job.hpp"
 
@@ -23,7 +24,7 @@ void run_update_capture(Context& ctx, const std::string& file, const std::string
   req.isotropic = isotropic;
   req.oe = oe;
   req.warn = [&](const std::string& w) {
-    std::fprintf(stderr, "piezobench: update: %s: %s\n", file.c_str(), w.c_str());
+    std::fprintf(stderr, "piezobench: update: %s: %s\n", file.c_str(), jobs::user_message(w).c_str());
   };
   auto r = jobs::run_update_capture(req);
   nlohmann::json& out = r.json;
