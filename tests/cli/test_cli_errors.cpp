@@ -82,6 +82,23 @@ TEST(CliErrors, RefusedConnectionNamesTheNextStepAndIsExitTwo) {
   EXPECT_NE(e["message"].get<std::string>().find("refused the connection"), std::string::npos) << j.out;
 }
 
+TEST(CliErrors, APortInUseNamesAnotherPort) {
+  int fd = ::socket(AF_INET, SOCK_STREAM, 0);  // holds a loopback port while sim-instrument tries it
+  sockaddr_in a{};
+  a.sin_family = AF_INET;
+  a.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+  ASSERT_EQ(::bind(fd, reinterpret_cast<sockaddr*>(&a), sizeof a), 0);
+  ASSERT_EQ(::listen(fd, 1), 0);
+  socklen_t len = sizeof a;
+  ::getsockname(fd, reinterpret_cast<sockaddr*>(&a), &len);
+  const std::string port = std::to_string(ntohs(a.sin_port));
+  const auto r = run_cli("sim-instrument --host 127.0.0.1 --port " + port + " --seconds 1");
+  ::close(fd);
+  EXPECT_EQ(r.exit_code, 2) << r.err;
+  EXPECT_NE(r.err.find("cannot listen on 127.0.0.1:" + port), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("choose another --port"), std::string::npos) << r.err;
+}
+
 TEST(CliErrors, AnExistingOutIsNeverOverwrittenWithoutOverwrite) {
   TmpCleanup cleanup;
   const auto out = tmp_dir() / "s.h5";

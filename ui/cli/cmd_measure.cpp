@@ -299,6 +299,20 @@ void register_measure_commands(CLI::App& app, Context& ctx) {
       std::signal(SIGTERM, on_sigint);
       const auto port = static_cast<std::uint16_t>(sa->port);
       std::vector<std::unique_ptr<drivers::sim::TcpServer>> servers;
+      // A port in use or a host that is not an address: the user's to fix (exit 2), with the next step.
+      auto serve = [&](std::shared_ptr<drivers::sim::ScpiDevice> dev, std::uint16_t p) {
+        try {
+          servers.push_back(std::make_unique<drivers::sim::TcpServer>(std::move(dev), sa->host, p));
+        } catch (const std::runtime_error& e) {
+          const std::string what = e.what();
+          if (what.find("cannot listen") != std::string::npos)
+            throw InputError(what + ". Another program (another sim-instrument?) may hold the port: choose another "
+                                    "--port (the DAQ takes PORT+1 too), or stop that program");
+          if (what.find("not an IPv4 address") != std::string::npos)
+            throw InputError(what + ": give --host as a dotted IPv4 address, e.g. 127.0.0.1 or 0.0.0.0");
+          throw;
+        }
+      };
       if (sa->dialect == "redpitaya") {  // one instrument, both roles, one port
         std::shared_ptr<drivers::sim::ScpiDevice> dev;
         try {
@@ -306,7 +320,7 @@ void register_measure_commands(CLI::App& app, Context& ctx) {
         } catch (const std::invalid_argument& e) {
           throw InputError(std::string(e.what()) + " (--adc-bits)");
         }
-        servers.push_back(std::make_unique<drivers::sim::TcpServer>(dev, sa->host, port));
+        serve(dev, port);
         servers.back()->start();
         if (ctx.json)
           print_json({{"port", servers[0]->port()}, {"awg_port", servers[0]->port()},
@@ -320,9 +334,8 @@ void register_measure_commands(CLI::App& app, Context& ctx) {
         if (tek) awg_dev = std::make_shared<drivers::sim::SimTektronixAwg>(bench);
         else awg_dev = std::make_shared<drivers::sim::SimAwg>(bench);
         const char* awg_name = tek ? "Tektronix AWG5014C" : "Keysight 33522B";
-        servers.push_back(std::make_unique<drivers::sim::TcpServer>(awg_dev, sa->host, port));
-        servers.push_back(std::make_unique<drivers::sim::TcpServer>(
-            std::make_shared<drivers::sim::SimDaq>(bench), sa->host, static_cast<std::uint16_t>(port + 1)));
+        serve(awg_dev, port);
+        serve(std::make_shared<drivers::sim::SimDaq>(bench), static_cast<std::uint16_t>(port + 1));
         for (auto& srv : servers) srv->start();
         if (ctx.json)
           print_json({{"awg_port", servers[0]->port()}, {"daq_port", servers[1]->port()}, {"host", sa->host},
