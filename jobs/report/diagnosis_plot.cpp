@@ -6,6 +6,8 @@
 #include <cstdio>
 #include <ranges>
 #include <stdexcept>
+#include <string_view>
+#include <utility>
 
 #include "jobs/report/svg_plot.hpp"
 #include "jobs/text/uncertain_text.hpp"
@@ -102,6 +104,25 @@ std::vector<Point> points(const std::vector<double>& x, const std::vector<double
   return p;
 }
 
+// The plot's font is ASCII: "±" as "+/-", "µ" as "u", "σ" as "sigma", "—" as "-".
+std::string ascii_text(const std::string& t) {
+  static const std::pair<std::string_view, std::string_view> kMap[] = {
+      {"±", "+/-"}, {"µ", "u"}, {"σ", "sigma"}, {"—", "-"}};
+  std::string out;
+  for (std::size_t i = 0; i < t.size();) {
+    bool mapped = false;
+    for (const auto& [from, to] : kMap)
+      if (t.compare(i, from.size(), from) == 0) {
+        out += to;
+        i += from.size();
+        mapped = true;
+        break;
+      }
+    if (!mapped) out += t[i++];
+  }
+  return out;
+}
+
 std::string verdict_line(const update::GapDiagnosis& d) {
   std::string s;
   if (d.verdict_effect == "none") {
@@ -109,11 +130,7 @@ std::string verdict_line(const update::GapDiagnosis& d) {
   } else if (!d.steps.empty()) {
     const auto& e = d.steps.front();
     // σ to two significant digits, the value to match; ASCII "+/-" (the plot's font is ASCII).
-    std::string v = format_si(e.value, e.sigma, e.unit);
-    for (std::size_t at; (at = v.find("±")) != std::string::npos;) v.replace(at, std::string("±").size(), "+/-");
-    for (std::size_t at; (at = v.find("µ")) != std::string::npos;) v.replace(at, std::string("µ").size(), "u");
-    for (std::size_t at; (at = v.find("σ")) != std::string::npos;) v.replace(at, std::string("σ").size(), "sigma");
-    s = e.name + " = " + v;
+    s = e.name + " = " + ascii_text(format_si(e.value, e.sigma, e.unit));
     for (std::size_t i = 1; i < d.steps.size(); ++i) s += ", then " + d.steps[i].name;
     if (d.heldout_shrink) s += fmt("; held-out gap shrinks by %.0f %%", 100 * *d.heldout_shrink);
   } else {
