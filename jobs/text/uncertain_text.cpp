@@ -4,6 +4,7 @@
 #include <cmath>
 #include <cstdio>
 #include <iterator>
+#include <utility>
 
 namespace piezo::jobs {
 
@@ -67,8 +68,10 @@ std::string format_uncertain(double value, double sigma, std::string_view unit, 
   // One common power of ten.
   const double scale = std::pow(10.0, mag_exp);
   const int d = decimals + mag_exp;
-  return with_unit("(" + fixed(v / scale, d) + " ± " + fixed(s / scale, d) + ")e" + std::to_string(mag_exp),
-                   unit);
+  std::string out = "(";  // appended piecewise: GCC 12's -Wrestrict misfires on "(" + std::string
+  out.append(fixed(v / scale, d)).append(" ± ").append(fixed(s / scale, d)).append(")e");
+  out.append(std::to_string(mag_exp));
+  return with_unit(std::move(out), unit);
 }
 
 std::string format_si(double value, double sigma, std::string_view base_unit, const UncertainStyle& style) {
