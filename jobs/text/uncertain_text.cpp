@@ -61,7 +61,7 @@ std::string format_uncertain(double value, double sigma, std::string_view unit, 
   const int decimals = 1 - e;  // of σ's last kept digit
   const double mag = std::max(std::abs(v), s);
   const int mag_exp = static_cast<int>(std::floor(std::log10(mag)));
-  if (mag_exp >= -3 && mag_exp < 6 && decimals <= 5) {
+  if (mag_exp >= -3 && mag_exp < 6 && decimals <= 6) {
     const int d = std::max(decimals, 0);
     return with_unit(fixed(v, d) + " ± " + fixed(s, d), unit);
   }

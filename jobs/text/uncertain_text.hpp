@@ -14,7 +14,7 @@
 //   format_uncertain(2.5, 0)                    "2.5 ± 0 (exact)"
 //
 // Plain notation while the printed magnitudes stay between 1e-3 and 1e6 and σ
-// needs at most 5 decimals; otherwise one common power of ten, "(m ± s)eE".
+// needs at most 6 decimals; otherwise one common power of ten, "(m ± s)eE".
 #include <string>
 #include <string_view>
 

@@ -52,6 +52,8 @@ TEST(UncertainText, VerySmallAndVeryLargeMagnitudesShareOnePowerOfTen) {
   EXPECT_EQ(format_uncertain(6.66e10, 1.2e8, "Pa"), "(6.660 ± 0.012)e10 Pa");
   EXPECT_EQ(format_uncertain(1.04e6, 2.2e9, "Hz"), "(0.0 ± 2.2)e9 Hz");
   EXPECT_EQ(format_uncertain(-0.000214, 0.00003), "(-2.14 ± 0.30)e-4");
+  EXPECT_EQ(format_uncertain(0.538490, 0.000072), "0.538490 ± 0.000072");  // six decimals still plain
+  EXPECT_EQ(format_uncertain(0.5384901, 0.0000072), "(5.384901 ± 0.000072)e-1");
   // σ below the value's resolution: the value in full, σ as it is.
   EXPECT_EQ(format_uncertain(1.0, 1e-300), "1 ± 1e-300");
 }
