@@ -83,7 +83,8 @@ std::string format_si(double value, double sigma, std::string_view base_unit, co
   if (std::isfinite(sigma) && sigma > mag) mag = sigma;
   static const char* const kPrefix[] = {"f", "p", "n", "µ", "m", "", "k", "M", "G"};
   int k = 5;  // no prefix
-  if (mag > 0) k = std::clamp(static_cast<int>(std::floor(std::log10(mag) / 3.0)) + 5, 0, 8);
+  if (mag > 0) k = static_cast<int>(std::floor(std::log10(mag) / 3.0)) + 5;
+  if (k < 0 || k > 8) k = 5;  // beyond f..G: the unprefixed unit and a power of ten
   const double scale = std::pow(10.0, 3 * (k - 5));
   const std::string unit = std::string(kPrefix[k]) + std::string(base_unit);
   return format_uncertain(value / scale, std::isfinite(sigma) ? sigma / scale : sigma, unit, style);

@@ -65,6 +65,7 @@ TEST(UncertainText, SiPrefixesForSiUnits) {
   EXPECT_EQ(format_si(1.0e-7, 2.3e-9, "s"), "100.0 ± 2.3 ns");
   EXPECT_EQ(format_si(50350, 34, "Hz"), "50.350 ± 0.034 kHz");
   EXPECT_EQ(format_si(6.66e10, 1.2e8, "Pa"), "(6.660 ± 0.012)e10 Pa");  // not an SI-prefixed unit here
+  EXPECT_EQ(format_si(0.0, 5e275, "F"), "(0.0 ± 5.0)e275 F");           // beyond the prefixes: none
 }
 
 TEST(UncertainText, NeverInfOrNanAsASigma) {
