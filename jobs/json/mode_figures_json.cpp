@@ -1,6 +1,12 @@
 #include "jobs/json/mode_figures_json.hpp"
 
 #include <cmath>
+#include <algorithm>
+#include <cstdio>
+#include <string>
+#include <vector>
+
+#include "jobs/text/uncertain_text.hpp"
 
 namespace piezo::jobs {
 
@@ -16,19 +22,23 @@ double num(const nlohmann::json& j, const char* key) {
   return j.contains(key) && j[key].is_number() ? j[key].get<double>() : NAN;
 }
 
-// "value±sigma" scaled, or "value" when σ is unknown, or "-" when the value is.
+// "value ± sigma" scaled (σ to two significant digits, jobs/text/uncertain_text.hpp),
+// or the value by `f` and "± —" when σ is not finite, or "-" when the value is not.
 std::string vs(const nlohmann::json& j, const char* key, const char* skey, double scale,
                const char* f) {
   const double v = num(j, key), s = num(j, skey);
   if (!std::isfinite(v)) return "-";
+  if (std::isfinite(s) && s > 0) return format_uncertain(v * scale, s * scale, {}, {true});
   char buf[96];
   std::snprintf(buf, sizeof buf, f, v * scale);
-  std::string out = buf;
-  if (std::isfinite(s)) {
-    std::snprintf(buf, sizeof buf, f, s * scale);
-    out += "±" + std::string(buf);
-  }
-  return out;
+  return std::string(buf) + (std::isfinite(s) ? "" : " ± —");
+}
+
+// `t` padded with spaces to `width` characters (UTF-8 continuation bytes not counted).
+std::string pad(const std::string& t, int width) {
+  int chars = 0;
+  for (unsigned char c : t) chars += (c & 0xC0) != 0x80;
+  return t + std::string(static_cast<std::size_t>(std::max(0, width - chars)), ' ');
 }
 
 }  // namespace
@@ -88,21 +98,22 @@ void print_mode_figures(std::FILE* out, const nlohmann::json& modes, const nlohm
   std::fprintf(out, "  mode figures (IEEE 176 / EN 50324-2; %s, ±1σ)\n",
                s.contains("source") && s["source"].is_string() ? s["source"].get<std::string>().c_str()
                                                                : "BVD fit per mode");
-  std::fprintf(out, "  %-3s %-20s %-20s %-12s %-14s %-14s %-16s %-18s %-18s %-18s\n", "#",
-               "fs [Hz]", "fp [Hz]", "k_eff", "Qm (R1 C1)", "Qm (fs/df)", "R1 [ohm]", "L1 [mH]",
-               "C1 [pF]", "C0 [pF]");
+  // Columns padded by characters, not bytes ("±" is two bytes in UTF-8).
+  static const int kWidth[] = {3, 20, 20, 19, 16, 16, 16, 19, 19, 17};
+  auto row = [&](const std::vector<std::string>& cells) {
+    std::string line = " ";
+    for (std::size_t c = 0; c < cells.size(); ++c) line.append(" ").append(pad(cells[c], kWidth[c]));
+    while (!line.empty() && line.back() == ' ') line.pop_back();
+    std::fprintf(out, "%s\n", line.c_str());
+  };
+  row({"#", "fs [Hz]", "fp [Hz]", "k_eff", "Qm (R1 C1)", "Qm (fs/df)", "R1 [ohm]", "L1 [mH]", "C1 [pF]", "C0 [pF]"});
   for (std::size_t k = 0; k < modes.size(); ++k) {
     const auto& m = modes[k];
-    std::fprintf(out, "  %-3zu %-20s %-20s %-12s %-14s %-14s %-16s %-18s %-18s %-18s\n", k + 1,
-                 vs(m, "fs_hz", "fs_sigma_hz", 1, "%.2f").c_str(),
-                 vs(m, "fp_hz", "fp_sigma_hz", 1, "%.2f").c_str(),
-                 vs(m, "k_eff", "k_eff_sigma", 1, "%.4f").c_str(),
-                 vs(m, "qm_branch", "qm_branch_sigma", 1, "%.1f").c_str(),
-                 vs(m, "qm_bandwidth", "qm_bandwidth_sigma", 1, "%.1f").c_str(),
-                 vs(m, "r1_ohm", "r1_sigma_ohm", 1, "%.3g").c_str(),
-                 vs(m, "l1_h", "l1_sigma_h", 1e3, "%.4g").c_str(),
-                 vs(m, "c1_f", "c1_sigma_f", 1e12, "%.4g").c_str(),
-                 vs(m, "c0_f", "c0_sigma_f", 1e12, "%.4g").c_str());
+    row({std::to_string(k + 1), vs(m, "fs_hz", "fs_sigma_hz", 1, "%.2f"), vs(m, "fp_hz", "fp_sigma_hz", 1, "%.2f"),
+         vs(m, "k_eff", "k_eff_sigma", 1, "%.4f"), vs(m, "qm_branch", "qm_branch_sigma", 1, "%.1f"),
+         vs(m, "qm_bandwidth", "qm_bandwidth_sigma", 1, "%.1f"), vs(m, "r1_ohm", "r1_sigma_ohm", 1, "%.3g"),
+         vs(m, "l1_h", "l1_sigma_h", 1e3, "%.4g"), vs(m, "c1_f", "c1_sigma_f", 1e12, "%.4g"),
+         vs(m, "c0_f", "c0_sigma_f", 1e12, "%.4g")});
     std::fprintf(
         out, "      fm %s Hz, fn %s Hz, N = fs*D_mean %s Hz*m\n",
         vs(m, "fm_hz", "fm_sigma_hz", 1, "%.2f").c_str(),

@@ -82,7 +82,7 @@ std::vector<fs::path> find_captures(const std::vector<std::string>& inputs,
 
 std::vector<fs::path> select_shard(const std::vector<fs::path>& sorted, const ShardSpec& shard) {
   if (shard.count == 0 || shard.index >= shard.count)
-    throw std::invalid_argument("select_shard: bad shard");
+    throw std::invalid_argument("--shard: bad shard (I/N with I < N)");
   std::vector<fs::path> out;
   for (std::size_t k = shard.index; k < sorted.size(); k += shard.count) out.push_back(sorted[k]);
   return out;

@@ -1,5 +1,6 @@
 #include "jobs/report/capture_report.hpp"
 
+#include <cmath>
 #include <cstdio>
 #include <fstream>
 #include <sstream>
@@ -8,6 +9,8 @@
 #include "jobs/report/mode_report.hpp"
 #include "jobs/export/report_export.hpp"
 #include "jobs/report/markdown.hpp"
+#include "jobs/text/uncertain_text.hpp"
+#include "jobs/text/user_message.hpp"
 
 namespace piezo::jobs::report {
 
@@ -44,18 +47,18 @@ std::string capture_summary_markdown(const jobs::PipelineResult& r, const Captur
   if (!r.verdict.empty()) o << "**Gap verdict:** " << cell(r.verdict) << "\n\n";
   o << "## Stages\n\n| stage | ran | note |\n| --- | --- | --- |\n";
   for (const auto& s : r.stages)
-    o << "| " << s.name << " | " << (s.ran ? "yes" : "no") << " | " << cell(s.note) << " |\n";
+    o << "| " << s.name << " | " << (s.ran ? "yes" : "no") << " | " << cell(user_message(s.note)) << " |\n";
   if (!r.params.empty()) {
     o << "\n## Parameters\n\nUpdate: " << r.update_method
-      << "\n\n| parameter | unit | original | updated | sigma | change | status | CMCM (seed) |\n"
-         "| --- | --- | --- | --- | --- | --- | --- | --- |\n";
-    for (const auto& p : r.params)
+      << "\n\n| parameter | unit | original | updated ± sigma | change | status | CMCM (seed) |\n"
+         "| --- | --- | --- | --- | --- | --- | --- |\n";
+    for (const auto& p : r.params)  // σ to two significant digits, the value to match; "—" for no σ
       o << "| " << p.name << " | " << p.unit << " | " << fmt("%.6g", p.original) << " | "
-        << fmt("%.6g", p.updated) << " | " << (p.sigma ? fmt("%.3g", *p.sigma) : "-") << " | "
+        << format_uncertain(p.updated, p.sigma.value_or(NAN), {}, {true}) << " | "
         << (p.original != 0 ? fmt("%+.2f %%", 100.0 * (p.updated - p.original) / p.original) : "-")
         << " | " << cell(p.status) << " | " << (p.cmcm ? fmt("%.6g", *p.cmcm) : "-") << " |\n";
     if (r.output_error && r.output_error->ok())
-      o << "\ncorr(nu12, d31) " << fmt("%+.3f", r.output_error->corr_nu12_d31) << ", chi2/dof "
+      o << "\ncorr(nu12, d31) " << format_value(r.output_error->corr_nu12_d31, {}, 3) << ", chi2/dof "
         << fmt("%.3g", r.output_error->chi2_per_dof) << " (limit "
         << fmt("%.3g", r.output_error->chi2_limit) << "), "
         << update::damping_summary(*r.output_error) << "\n";
@@ -71,7 +74,7 @@ std::string capture_summary_markdown(const jobs::PipelineResult& r, const Captur
   list("anti-resonances", r.antiresonances_hz);
   if (!r.warnings.empty()) {
     o << "\n## Warnings\n\n";
-    for (const auto& w : r.warnings) o << "- " << w << "\n";
+    for (const auto& w : r.warnings) o << "- " << user_message(w) << "\n";
   }
   o << mode_figures_markdown(r);
   o << "\n## Impedance\n\n![|Z| and phase: measured, original and updated model](impedance.svg)\n\n"

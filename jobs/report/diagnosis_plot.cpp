@@ -6,8 +6,11 @@
 #include <cstdio>
 #include <ranges>
 #include <stdexcept>
+#include <string_view>
+#include <utility>
 
 #include "jobs/report/svg_plot.hpp"
+#include "jobs/text/uncertain_text.hpp"
 
 namespace piezo::jobs::report {
 
@@ -90,7 +93,7 @@ void check_curve(const update::GapCurve& c, const char* which) {
   if (n < 2 || c.residual_db.size() != n || c.sigma_db.size() != n ||
       c.measured_abs_ohm.size() != n)
     throw std::invalid_argument(
-        std::string("render_diagnosis_plot: the diagnosis holds no complete '") + which +
+        std::string("the diagnosis plot: the diagnosis holds no complete '") + which +
         "' curve");
 }
 
@@ -101,13 +104,33 @@ std::vector<Point> points(const std::vector<double>& x, const std::vector<double
   return p;
 }
 
+// The plot's font is ASCII: "±" as "+/-", "µ" as "u", "σ" as "sigma", "—" as "-".
+std::string ascii_text(const std::string& t) {
+  static const std::pair<std::string_view, std::string_view> kMap[] = {
+      {"±", "+/-"}, {"µ", "u"}, {"σ", "sigma"}, {"—", "-"}};
+  std::string out;
+  for (std::size_t i = 0; i < t.size();) {
+    bool mapped = false;
+    for (const auto& [from, to] : kMap)
+      if (t.compare(i, from.size(), from) == 0) {
+        out += to;
+        i += from.size();
+        mapped = true;
+        break;
+      }
+    if (!mapped) out += t[i++];
+  }
+  return out;
+}
+
 std::string verdict_line(const update::GapDiagnosis& d) {
   std::string s;
   if (d.verdict_effect == "none") {
     s = "no gap: the updated model matches within the noise";
   } else if (!d.steps.empty()) {
     const auto& e = d.steps.front();
-    s = e.name + fmt(" = %.4g +/- %.2g ", e.value, e.sigma) + e.unit;
+    // σ to two significant digits, the value to match; ASCII "+/-" (the plot's font is ASCII).
+    s = e.name + " = " + ascii_text(format_si(e.value, e.sigma, e.unit));
     for (std::size_t i = 1; i < d.steps.size(); ++i) s += ", then " + d.steps[i].name;
     if (d.heldout_shrink) s += fmt("; held-out gap shrinks by %.0f %%", 100 * *d.heldout_shrink);
   } else {
@@ -216,7 +239,7 @@ void magnitude_panel(const Frame& F, const std::vector<double>& f, const std::ve
   for (const auto* v : {&meas, &z_before, &z_after})
     for (double z : *v)
       if (z > 0 && std::isfinite(z)) lo = std::min(lo, z), hi = std::max(hi, z);
-  if (!(hi > lo)) throw std::invalid_argument("render_diagnosis_plot: no positive |Z| to plot");
+  if (!(hi > lo)) throw std::invalid_argument("the diagnosis plot: no positive |Z| to plot");
   const double pad = std::pow(hi / lo, 0.05);
   const Axis ax = F.x(P), ay{lo / pad, hi * pad, P.y1, P.y0, true};
   for (double t : log_minor(ay.lo, ay.hi))
@@ -377,7 +400,7 @@ PngCanvas render_diagnosis_plot(const update::GapDiagnosis& d, const DiagnosisPl
   const auto [fmin_it, fmax_it] = std::minmax_element(f.begin(), f.end());
   const double fmin = snap_down(*fmin_it), fmax = snap_up(*fmax_it);
   if (!(fmin > 0) || !(fmax > fmin))
-    throw std::invalid_argument("render_diagnosis_plot: no frequency band to plot");
+    throw std::invalid_argument("the diagnosis plot: no frequency band to plot");
 
   PngCanvas cv(opt.width, opt.height);
   const Frame F{cv, diagnosis_plot_layout(opt.width, opt.height), fmin, fmax};

@@ -5,16 +5,18 @@
 
 #include "jobs/mode_nyquist.hpp"
 #include "jobs/report/markdown.hpp"
+#include "jobs/text/uncertain_text.hpp"
 
 namespace piezo::jobs::report {
 
 namespace {
 
+// σ to two significant digits, the value to match (jobs/text/uncertain_text.hpp);
+// the value by `f` and "± —" when σ is not finite, by `f` alone when it is 0.
 std::string pm(const dsp::Uncertain& u, double scale, const char* f) {
   if (!std::isfinite(u.value)) return "-";
-  std::string s = fmt(f, u.value * scale);
-  if (std::isfinite(u.sigma)) s += " ± " + fmt("%.2g", u.sigma * scale);
-  return s;
+  if (std::isfinite(u.sigma) && u.sigma > 0) return format_uncertain(u.value * scale, u.sigma * scale, {}, {true});
+  return fmt(f, u.value * scale) + (std::isfinite(u.sigma) ? "" : " ± —");
 }
 
 const jobs::Curve* estimate_curve(const jobs::PipelineResult& r) {

@@ -5,16 +5,23 @@
 #include <cstdio>
 #include <iomanip>
 #include <iostream>
+#include <limits>
 #include <map>
+#include <optional>
 
 #include "acquisition/capture.hpp"
+#include "drivers/scpi_client.hpp"  // drivers::InstrumentError
+#include "drivers/transport.hpp"    // drivers::TransportError
+#include "dsp/impedance_files/read_any.hpp"
 #include "jobs/json/json_text.hpp"
 #include "jobs/pipeline/capture_fit.hpp"  // update::OeOptions, the output-error fit's options
+#include "jobs/text/user_message.hpp"
 
 namespace piezo::cli {
 
 namespace {
-void report(Context& ctx, const char* kind, const std::string& msg, const nlohmann::json& extra) {
+void report(Context& ctx, const char* kind, const std::string& what, const nlohmann::json& extra) {
+  const std::string msg = jobs::user_message(what);  // without the libraries' function names
   std::cerr << "piezobench: " << kind << ": " << msg << "\n";
   if (ctx.json) {
     nlohmann::json j = {{"error", {{"kind", kind}, {"message", msg}}}};
@@ -22,6 +29,21 @@ void report(Context& ctx, const char* kind, const std::string& msg, const nlohma
     print_json(j);
   }
 }
+// A capture that is not HDF5 but an impedance analyzer's file (Touchstone,
+// 4294A, E4990A, Bode 100, a table): says so and names the command that reads it.
+std::optional<std::string> impedance_file_instead(const acq::CaptureError& e) {
+  if (e.problem().rfind("not a readable HDF5 file", 0) != 0) return std::nullopt;
+  try {
+    const dsp::ImportedImpedance im = dsp::read_impedance_file(e.file());
+    return e.file() + " is an impedance analyzer's file (" + im.format_name + ", " + std::to_string(im.size()) +
+           " points), not a capture: this command needs a capture's recorded time records (.h5, written by "
+           "`piezobench measure` or `demo`). For the per-mode figures of an impedance file run `piezobench "
+           "figures " + e.file() + "`";
+  } catch (const std::exception&) {
+    return std::nullopt;  // not an impedance file either: the capture reader's message stands
+  }
+}
+
 }  // namespace
 
 int run_command(Context& ctx, const std::function<void()>& body) {
@@ -29,6 +51,10 @@ int run_command(Context& ctx, const std::function<void()>& body) {
     body();
     return ctx.exit_code;
   } catch (const acq::CaptureError& e) {
+    if (auto why = impedance_file_instead(e)) {
+      report(ctx, "bad input", *why, {{"file", e.file()}, {"problem", "impedance file, not a capture"}});
+      return kBadInput;
+    }
     report(ctx, "bad capture", e.what(),
            {{"file", e.file()}, {"path", e.h5path()}, {"problem", e.problem()}});
     return kBadInput;
@@ -37,6 +63,12 @@ int run_command(Context& ctx, const std::function<void()>& body) {
     return kBadInput;
   } catch (const std::invalid_argument& e) {
     report(ctx, "bad input", e.what(), nlohmann::json::object());
+    return kBadInput;
+  } catch (const drivers::TransportError& e) {  // an instrument that cannot be reached or stopped answering
+    report(ctx, "instrument", e.what(), nlohmann::json::object());
+    return kBadInput;
+  } catch (const drivers::InstrumentError& e) {  // an instrument that refused a setting or answered nonsense
+    report(ctx, "instrument", e.what(), nlohmann::json::object());
     return kBadInput;
   } catch (const std::exception& e) {
     report(ctx, "internal error", e.what(), nlohmann::json::object());
@@ -48,6 +80,10 @@ int run_command(Context& ctx, const std::function<void()>& body) {
 void print_json(const nlohmann::json& j) {
   jobs::write_json(std::cout, j);
   std::cout << std::endl;
+}
+
+double json_number(const nlohmann::json& j) {
+  return j.is_number() ? j.get<double>() : std::numeric_limits<double>::quiet_NaN();
 }
 
 void add_chain_tolerance_options(CLI::App* cmd, update::OeOptions& o) {

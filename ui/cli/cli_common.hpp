@@ -3,6 +3,7 @@
 // error reporting. Every command registers itself through a register_* function.
 // The CLI's room (ui/cli): commands parse options, call a job (jobs/) and print.
 #include <CLI/CLI.hpp>
+#include <cstddef>
 #include <functional>
 #include <iosfwd>
 #include <nlohmann/json.hpp>
@@ -33,6 +34,9 @@ int run_command(Context& ctx, const std::function<void()>& body);
 
 void print_json(const nlohmann::json& j);
 
+// A JSON number as a double; NaN for null (a value JSON cannot hold) or anything else.
+double json_number(const nlohmann::json& j);
+
 // Every command takes --json (also accepted before the command name).
 void add_json_flag(CLI::App* cmd, Context& ctx);
 // The measurement chain's tolerances that the output-error fit carries into
@@ -55,6 +59,10 @@ class ProgressBar {
   bool finished_ = false;
   int last_permille_ = -1;
 };
+
+// `replay --jobs` by default: the number of cores (std::thread::hardware_concurrency,
+// at least 1, at most 256).
+std::size_t default_jobs();
 
 void register_capture_commands(CLI::App& app, Context& ctx);
 void register_demo_command(CLI::App& app, Context& ctx);

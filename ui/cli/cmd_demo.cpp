@@ -11,6 +11,8 @@
 #include "jobs/demo_job.hpp"
 #include "jobs/json/mode_figures_json.hpp"
 #include "jobs/export/report_export.hpp"
+#include "jobs/text/uncertain_text.hpp"
+#include "jobs/text/user_message.hpp"
 #include "ui/cli/cli_common.hpp"
 #include "ui/cli/diagnosis_text.hpp"
 
@@ -51,13 +53,14 @@ void register_demo_command(CLI::App& app, Context& ctx) {
       }
       std::cout << "piezobench demo — the main job on the embedded simulated bench\n";
       for (const auto& s : res.stages)
-        std::cout << "  " << (s.ran ? "[ran]     " : "[skipped] ") << s.name << ": " << s.note << "\n";
+        std::cout << "  " << (s.ran ? "[ran]     " : "[skipped] ") << s.name << ": " << jobs::user_message(s.note)
+                  << "\n";
       if (!res.params.empty()) {
         // The pipeline's update (output-error: value, sigma, status) beside
         // the seed's extended CMCM and least squares on the same features.
         std::printf("\n  update used: %s\n", res.update_method.c_str());
-        std::printf("  %-11s %11s %11s | %11s %7s %8s %-16s | %11s %8s | %11s %8s\n", "parameter", "original",
-                    "true (sim)", "oe", "sigma%", "error%", "oe status", "cmcm", "error%", "lm", "error%");
+        std::printf("  %-11s %11s %11s | %-26s %7s %8s %-16s | %11s %8s | %11s %8s\n", "parameter", "original",
+                    "true (sim)", "oe ± sigma", "sigma%", "error%", "oe status", "cmcm", "error%", "lm", "error%");
         auto err = [](const std::optional<double>& v, const std::optional<double>& t, char* buf, std::size_t n) {
           if (v && t) std::snprintf(buf, n, "%+.3f", 100.0 * (*v - *t) / *t);
           else std::snprintf(buf, n, "-");
@@ -67,21 +70,26 @@ void register_demo_command(CLI::App& app, Context& ctx) {
           else std::snprintf(buf, n, "-");
         };
         for (const auto& p : res.params) {
-          char t[32], oe[32], os[32] = "-", oee[32], cm[32], cme[32], lm[32], lme[32];
+          char t[32], os[32] = "-", oee[32], cm[32], cme[32], lm[32], lme[32];
           val(p.truth, t, sizeof t);
-          val(p.oe, oe, sizeof oe);
-          if (p.oe) std::snprintf(os, sizeof os, "%.3f", 100.0 * p.oe_sigma.value_or(NAN) / std::abs(*p.oe));
+          // σ to two significant digits, the value to match; "—" for a σ that is not finite.
+          const std::string oe =
+              p.oe ? jobs::format_uncertain(*p.oe, p.oe_sigma.value_or(NAN), {}, {true}) : std::string("-");
+          const double rel = p.oe ? 100.0 * p.oe_sigma.value_or(NAN) / std::abs(*p.oe) : NAN;
+          if (p.oe) std::snprintf(os, sizeof os, "%s", std::isfinite(rel) ? jobs::format_value(rel, {}, 2).c_str() : "—");
           err(p.oe, p.truth, oee, sizeof oee);
           val(p.cmcm, cm, sizeof cm);
           err(p.cmcm, p.truth, cme, sizeof cme);
           val(p.lm, lm, sizeof lm);
           err(p.lm, p.truth, lme, sizeof lme);
-          std::printf("  %-11s %11.6g %11s | %11s %7s %8s %-16s | %11s %8s | %11s %8s\n", p.name.c_str(), p.original,
-                      t, oe, os, oee, p.oe_status.c_str(), cm, cme, lm, lme);
+          std::printf("  %-11s %11.6g %11s | %-26s %7s %8s %-16s | %11s %8s | %11s %8s\n", p.name.c_str(),
+                      p.original, t, oe.c_str(), os, oee, p.oe_status.c_str(), cm, cme, lm, lme);
         }
         if (res.output_error)
-          std::printf("  corr(nu12, d31) of the output-error fit: %+.3f; fitted %s\n",
-                      res.output_error->corr_nu12_d31,
+          std::printf("  corr(nu12, d31) of the output-error fit: %s; fitted %s\n",
+                      std::isfinite(res.output_error->corr_nu12_d31)
+                          ? jobs::format_value(res.output_error->corr_nu12_d31, {}, 3).c_str()
+                          : "— (not identifiable)",
                       update::damping_summary(*res.output_error).c_str());
       }
       // The per-mode figures (issue 34): the updated model's modes with sigma
@@ -95,7 +103,7 @@ void register_demo_command(CLI::App& app, Context& ctx) {
       if (res.diagnosis) print_diagnosis(std::cout, *res.diagnosis);
       if (!res.damping_from_resonances.empty())
         std::cout << "  damping from the resonances: " << res.damping_from_resonances << "\n";
-      for (const auto& w : res.warnings) std::cout << "  warning: " << w << "\n";
+      for (const auto& w : res.warnings) std::cout << "  warning: " << jobs::user_message(w) << "\n";
       std::cout << "\n  capture: " << res.capture_path << " (inspect: piezobench capture info " << res.capture_path
                 << ")\n";
     });

@@ -13,6 +13,7 @@
 #include <iostream>
 
 #include "jobs/diagnose_job.hpp"
+#include "jobs/text/user_message.hpp"
 #include "ui/cli/cli_common.hpp"
 #include "ui/cli/diagnosis_text.hpp"
 
@@ -29,7 +30,7 @@ void run_diagnose(Context& ctx, const DiagnoseArgs& args) {
   jobs::DiagnoseRequest req = args.req;
   const jobs::DiagnoseRequest& a = req;
   req.warn = [&](const std::string& w) {
-    std::fprintf(stderr, "piezobench: diagnose: %s: %s\n", a.fit.c_str(), w.c_str());
+    std::fprintf(stderr, "piezobench: diagnose: %s: %s\n", a.fit.c_str(), jobs::user_message(w).c_str());
   };
   jobs::DiagnoseResult r;
   {

@@ -4,11 +4,13 @@
 // impedance analyzer's file. The CLI's room (ui/cli): options and printing only;
 // the work is jobs/figures_job.hpp.
 #include <algorithm>
+#include <cmath>
 #include <cstdio>
 #include <iostream>
 #include <memory>
 
 #include "jobs/figures_job.hpp"
+#include "jobs/text/uncertain_text.hpp"
 #include "ui/cli/cli_common.hpp"
 
 namespace piezo::cli {
@@ -33,17 +35,11 @@ void parse_band(const std::string& s, jobs::FiguresRequest& r) {
   }
 }
 
-std::string pm(const nlohmann::json& f, const char* fmt_value) {
-  if (f["value"].is_null()) return "-";
-  char buf[96];
-  if (f["sigma"].is_null()) {
-    std::snprintf(buf, sizeof buf, fmt_value, f["value"].get<double>());
-    return buf;
-  }
-  char v[48], s[48];
-  std::snprintf(v, sizeof v, fmt_value, f["value"].get<double>());
-  std::snprintf(s, sizeof s, fmt_value, f["sigma"].get<double>());
-  return std::string(v) + " +/- " + s;
+// A figure {"value", "sigma"} with its unit: σ to two significant digits, the
+// value to match, an SI prefix for F, H, Hz and ohm (jobs/text/uncertain_text.hpp).
+std::string pm(const nlohmann::json& f, const char* unit = "") {
+  if (!f["value"].is_number()) return "-";
+  return jobs::format_si(f["value"].get<double>(), json_number(f["sigma"]), unit);
 }
 
 void print_text(const nlohmann::json& j) {
@@ -65,16 +61,16 @@ void print_text(const nlohmann::json& j) {
   if (j.contains("output_error") && j["output_error"].contains("parameters")) {
     std::printf("  model          ");
     for (const auto& p : j["output_error"]["parameters"]) {
-      const double v = p["value"].get<double>(), s = p["sigma"].get<double>();
-      std::printf(" %s %.5g +/- %.2g %%%s", p["name"].get<std::string>().c_str(), v,
-                  v != 0 ? 100 * s / std::abs(v) : 0.0, p["status"] == "ok" ? "" : " (not identifiable)");
+      const double v = json_number(p["value"]), s = json_number(p["sigma"]);
+      std::printf(" %s %s%s;", p["name"].get<std::string>().c_str(),
+                  jobs::format_uncertain(v, s, p.value("unit", std::string())).c_str(),
+                  p["status"] == "ok" || !std::isfinite(s) ? "" : " (not identifiable)");
     }
     std::printf("\n");
   }
   const auto& c = j["circuit"];
-  std::printf("  C0              %s F, tan d %s, Rs %s ohm, C^T %s F\n", pm(c["c0_f"], "%.5g").c_str(),
-              pm(c["tan_delta"], "%.3g").c_str(), pm(c["rs_ohm"], "%.3g").c_str(),
-              pm(c["free_capacitance_f"], "%.5g").c_str());
+  std::printf("  C0              %s, tan d %s, Rs %s, C^T %s\n", pm(c["c0_f"], "F").c_str(),
+              pm(c["tan_delta"]).c_str(), pm(c["rs_ohm"], "ohm").c_str(), pm(c["free_capacitance_f"], "F").c_str());
   for (const auto& m : j["modes"]) {
     const double lo = std::max(m["window_hz"][0].is_null() ? 0.0 : m["window_hz"][0].get<double>(),
                                j["band_hz"][0].get<double>());
@@ -89,15 +85,14 @@ void print_text(const nlohmann::json& j) {
         for (const auto& r : m["reasons"]) std::printf("    UNRELIABLE: %s\n", r.get<std::string>().c_str());
       for (const auto& r : m["sigma_notes"]) std::printf("    (%s)\n", r.get<std::string>().c_str());
     }
-    std::printf("    fs %s Hz   fp %s Hz\n", pm(m["fs_hz"], "%.7g").c_str(), pm(m["fp_hz"], "%.7g").c_str());
-    std::printf("    fm %s Hz   fn %s Hz\n", pm(m["fm_hz"], "%.7g").c_str(), pm(m["fn_hz"], "%.7g").c_str());
-    std::printf("    fr %s Hz   fa %s Hz\n", pm(m["fr_hz"], "%.7g").c_str(), pm(m["fa_hz"], "%.7g").c_str());
-    std::printf("    k_eff %s (IEEE 176, fs/fp)   %s (EN 50324-2, fm/fn)\n", pm(m["k_eff_ieee176"], "%.4g").c_str(),
-                pm(m["k_eff_en50324"], "%.4g").c_str());
-    std::printf("    Qm %s (branch)   %s (bandwidth)\n", pm(m["qm_branch"], "%.4g").c_str(),
-                pm(m["qm_bandwidth"], "%.4g").c_str());
-    std::printf("    R1 %s ohm   L1 %s H   C1 %s F\n", pm(m["r1_ohm"], "%.5g").c_str(), pm(m["l1_h"], "%.5g").c_str(),
-                pm(m["c1_f"], "%.5g").c_str());
+    std::printf("    fs %s   fp %s\n", pm(m["fs_hz"], "Hz").c_str(), pm(m["fp_hz"], "Hz").c_str());
+    std::printf("    fm %s   fn %s\n", pm(m["fm_hz"], "Hz").c_str(), pm(m["fn_hz"], "Hz").c_str());
+    std::printf("    fr %s   fa %s\n", pm(m["fr_hz"], "Hz").c_str(), pm(m["fa_hz"], "Hz").c_str());
+    std::printf("    k_eff %s (IEEE 176, fs/fp)   %s (EN 50324-2, fm/fn)\n", pm(m["k_eff_ieee176"]).c_str(),
+                pm(m["k_eff_en50324"]).c_str());
+    std::printf("    Qm %s (branch)   %s (bandwidth)\n", pm(m["qm_branch"]).c_str(), pm(m["qm_bandwidth"]).c_str());
+    std::printf("    R1 %s   L1 %s   C1 %s\n", pm(m["r1_ohm"], "ohm").c_str(), pm(m["l1_h"], "H").c_str(),
+                pm(m["c1_f"], "F").c_str());
   }
   for (const auto& n : j["notes"]) std::printf("  note: %s\n", n.get<std::string>().c_str());
   if (j.contains("warnings"))

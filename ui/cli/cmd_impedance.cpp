@@ -5,6 +5,7 @@
 // printing only; the work (estimators, trust, JSON) is jobs/impedance_job.hpp.
 // Per-mode figures: key "modes" in --json always, the table after the
 // impedance with --figures.
+#include <cmath>
 #include <cstdio>
 #include <fstream>
 #include <iostream>
@@ -13,6 +14,7 @@
 #include "jobs/impedance_job.hpp"
 #include "jobs/json/json_text.hpp"
 #include "jobs/json/mode_figures_json.hpp"
+#include "jobs/text/uncertain_text.hpp"
 #include "ui/cli/cli_common.hpp"
 
 namespace piezo::cli {
@@ -63,16 +65,19 @@ void print_text(const nlohmann::json& j) {
   auto row = [&](const char* name, const char* key, const char* skey) {
     std::printf("  %-15s", name);
     for (std::size_t k = 0; k < f[key].size(); ++k) {
-      const double s = f[skey][k].is_number() ? f[skey][k].get<double>() : -1.0;
-      if (s >= 0) std::printf(" %.2f±%.2f Hz", f[key][k].get<double>(), s);
-      else std::printf(" %.2f Hz", f[key][k].get<double>());
+      // σ to two significant digits, the value to match (jobs/text/uncertain_text.hpp).
+      const double v = json_number(f[key][k]);
+      if (f[skey].is_array() && k < f[skey].size() && f[skey][k].is_number())
+        std::printf(" %s;", jobs::format_uncertain(v, f[skey][k].get<double>(), "Hz").c_str());
+      else
+        std::printf(" %s;", jobs::format_value(v, "Hz", 7).c_str());
     }
     std::printf("\n");
   };
   row("resonances", "resonances_hz", "resonances_sigma_hz");
   row("antiresonances", "antiresonances_hz", "antiresonances_sigma_hz");
   if (f["capacitance_f"].is_number())
-    std::printf("  capacitance     %.5g F\n", f["capacitance_f"].get<double>());
+    std::printf("  capacitance     %s\n", jobs::format_value(f["capacitance_f"].get<double>() * 1e12, "pF", 5).c_str());
 }
 
 void run(const ImpedanceArgs& a, Context& ctx) {

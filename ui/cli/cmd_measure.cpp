@@ -6,6 +6,7 @@
 // --dialect redpitaya serves one Red Pitaya STEMlab 125-14 on PORT alone
 // (generator and acquisition on one SCPI server, as on the board's port 5000).
 #include <csignal>
+#include <filesystem>
 #include <iostream>
 #include <memory>
 #include <thread>
@@ -21,6 +22,7 @@
 #include "drivers/sim/sim_redpitaya.hpp"
 #include "drivers/sim/sim_tektronix_awg.hpp"
 #include "drivers/sim/tcp_server.hpp"
+#include "drivers/transport.hpp"
 #include "ui/cli/cli_common.hpp"
 
 namespace piezo::cli {
@@ -80,6 +82,38 @@ bool terminal_prompt(const std::string& instruction) {
   return line != "q" && line != "Q";
 }
 
+// The next step when an instrument cannot be reached: `what` is the transport's
+// message ("tcp://127.0.0.1:5999: cannot connect: Connection refused"),
+// `instrument` the --instrument address.
+std::string unreachable_advice(const std::string& what, const std::string& instrument) {
+  const auto sep = what.find(": ");
+  const std::string addr = sep == std::string::npos ? instrument : what.substr(0, sep);
+  const bool tcp = addr.rfind("tcp://", 0) == 0;
+  std::string port = "PORT";
+  if (tcp && instrument.rfind("tcp://", 0) == 0) {
+    const auto colon = instrument.rfind(':');
+    if (colon != std::string::npos && colon > 5) port = instrument.substr(colon + 1);
+  }
+  std::string head;
+  if (what.find("Connection refused") != std::string::npos)
+    head = "the instrument at " + addr + " refused the connection (nothing listens on that port)";
+  else if (what.find("timed out") != std::string::npos)
+    head = "the instrument at " + addr + " did not answer in time";
+  else if (what.find("cannot resolve host") != std::string::npos)
+    head = "the host of " + addr + " is unknown (" + what.substr(what.rfind(": ") + 2) + ")";
+  else
+    head = "the instrument at " + addr + " cannot be reached (" + what.substr(sep == std::string::npos ? 0 : sep + 2) +
+           ")";
+  if (!tcp)
+    return head + ". Check that it is switched on and plugged in, the VID:PID (lsusb) and your access to "
+                  "the USB device (udev rule); `piezobench instruments` lists the drivers.";
+  return head + ". Check that the instrument is switched on and on this network, and the address and port "
+                "(raw SCPI: 5025 on Keysight and Tektronix, 5000 on a Red Pitaya; the DAQ at PORT+1 unless --daq "
+                "says otherwise). For the simulated bench over TCP, start `piezobench sim-instrument --port " +
+         port + "` first (it serves the AWG on that port and the DAQ on the next), or measure with "
+                "--instrument sim.";
+}
+
 }  // namespace
 
 void register_measure_commands(CLI::App& app, Context& ctx) {
@@ -126,7 +160,7 @@ void register_measure_commands(CLI::App& app, Context& ctx) {
   m->add_option("--r1", a->r1, "Series resistor R1 (ohm)")->capture_default_str();
   m->add_option("--shots", a->shots, "Shots per excitation step")->capture_default_str();
   m->add_option("--out", a->out, "Capture file to write (.h5)")->required();
-  m->add_flag("--overwrite", a->overwrite, "Replace an existing capture");
+  m->add_flag("--overwrite", a->overwrite, "Replace an existing capture (without it an existing --out is an error)");
   m->add_flag("--allow-clipping", a->allow_clipping, "Keep going after a clipped shot");
   m->add_option("--calibrate", a->calibrate,
                 "Measure fixture standards first, e.g. open,short,load (the simulator swaps them itself; "
@@ -159,6 +193,9 @@ void register_measure_commands(CLI::App& app, Context& ctx) {
         plan.setup.divider_r1_ohm = a->r1;
       }
       plan.validate();
+      std::error_code ec;
+      if (!a->overwrite && std::filesystem::exists(a->out, ec))  // before any instrument is touched
+        throw InputError(a->out + " already exists: give --overwrite to replace it, or another --out");
       acq::BenchAddress addr{a->instrument, a->daq.empty() ? std::nullopt : std::optional(a->daq)};
       std::shared_ptr<drivers::sim::SimBench> sim;
       if (drivers::is_sim_address(a->instrument)) {
@@ -171,7 +208,12 @@ void register_measure_commands(CLI::App& app, Context& ctx) {
             "--disturbance applies to the simulated bench only (--instrument sim; "
             "or serve it with sim-instrument --disturbance)");
       }
-      acq::Bench bench = acq::open_bench(addr, sim);
+      acq::Bench bench;
+      try {
+        bench = acq::open_bench(addr, sim);
+      } catch (const drivers::TransportError& e) {
+        throw drivers::TransportError(e.kind(), unreachable_advice(e.what(), a->instrument));
+      }
       acq::RunnerOptions ro;
       ro.overwrite = a->overwrite;
       ro.stop_on_clipping = !a->allow_clipping;
@@ -257,6 +299,20 @@ void register_measure_commands(CLI::App& app, Context& ctx) {
       std::signal(SIGTERM, on_sigint);
       const auto port = static_cast<std::uint16_t>(sa->port);
       std::vector<std::unique_ptr<drivers::sim::TcpServer>> servers;
+      // A port in use or a host that is not an address: the user's to fix (exit 2), with the next step.
+      auto serve = [&](std::shared_ptr<drivers::sim::ScpiDevice> dev, std::uint16_t p) {
+        try {
+          servers.push_back(std::make_unique<drivers::sim::TcpServer>(std::move(dev), sa->host, p));
+        } catch (const std::runtime_error& e) {
+          const std::string what = e.what();
+          if (what.find("cannot listen") != std::string::npos)
+            throw InputError(what + ". Another program (another sim-instrument?) may hold the port: choose another "
+                                    "--port (the DAQ takes PORT+1 too), or stop that program");
+          if (what.find("not an IPv4 address") != std::string::npos)
+            throw InputError(what + ": give --host as a dotted IPv4 address, e.g. 127.0.0.1 or 0.0.0.0");
+          throw;
+        }
+      };
       if (sa->dialect == "redpitaya") {  // one instrument, both roles, one port
         std::shared_ptr<drivers::sim::ScpiDevice> dev;
         try {
@@ -264,7 +320,7 @@ void register_measure_commands(CLI::App& app, Context& ctx) {
         } catch (const std::invalid_argument& e) {
           throw InputError(std::string(e.what()) + " (--adc-bits)");
         }
-        servers.push_back(std::make_unique<drivers::sim::TcpServer>(dev, sa->host, port));
+        serve(dev, port);
         servers.back()->start();
         if (ctx.json)
           print_json({{"port", servers[0]->port()}, {"awg_port", servers[0]->port()},
@@ -278,9 +334,8 @@ void register_measure_commands(CLI::App& app, Context& ctx) {
         if (tek) awg_dev = std::make_shared<drivers::sim::SimTektronixAwg>(bench);
         else awg_dev = std::make_shared<drivers::sim::SimAwg>(bench);
         const char* awg_name = tek ? "Tektronix AWG5014C" : "Keysight 33522B";
-        servers.push_back(std::make_unique<drivers::sim::TcpServer>(awg_dev, sa->host, port));
-        servers.push_back(std::make_unique<drivers::sim::TcpServer>(
-            std::make_shared<drivers::sim::SimDaq>(bench), sa->host, static_cast<std::uint16_t>(port + 1)));
+        serve(awg_dev, port);
+        serve(std::make_shared<drivers::sim::SimDaq>(bench), static_cast<std::uint16_t>(port + 1));
         for (auto& srv : servers) srv->start();
         if (ctx.json)
           print_json({{"awg_port", servers[0]->port()}, {"daq_port", servers[1]->port()}, {"host", sa->host},

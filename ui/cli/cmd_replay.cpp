@@ -8,11 +8,14 @@
 // verdicts are data (the records, the lot summary), not errors of the run.
 #include <unistd.h>
 
+#include <algorithm>
 #include <csignal>
 #include <cstdio>
 #include <iostream>
+#include <thread>
 
 #include "acquisition/results_file.hpp"
+#include "jobs/text/user_message.hpp"
 #include "ui/cli/cli_common.hpp"
 #include "jobs/replay/merge.hpp"
 #include "jobs/replay/replay_batch.hpp"
@@ -80,6 +83,11 @@ void print_lot(const jobs::report::Limits& l, const jobs::report::LotSummary& s,
 
 }  // namespace
 
+std::size_t default_jobs() {
+  const unsigned cores = std::thread::hardware_concurrency();  // 0: unknown
+  return std::clamp<std::size_t>(cores, 1, 256);                 // run_replay's range
+}
+
 void register_replay_commands(CLI::App& app, Context& ctx) {
   // ------------------------------------------------------------------ replay
   auto* r = app.add_subcommand("replay",
@@ -87,7 +95,7 @@ void register_replay_commands(CLI::App& app, Context& ctx) {
   struct Args {
     std::vector<std::string> inputs;
     std::string out, shard = "0/1", report, jsonl, material, limits;
-    std::size_t jobs = 1;
+    std::size_t jobs = default_jobs();
     double timeout_s = 600.0;
     bool transverse = false;
     bool seed_chain = false;
@@ -100,7 +108,8 @@ void register_replay_commands(CLI::App& app, Context& ctx) {
   r->add_option("--out", a->out, "Results file (HDF5, piezo-replay/1); an existing one is resumed")
       ->required();
   r->add_option("--jobs", a->jobs,
-                "Captures replayed in parallel (worker processes: a crash costs one capture)")
+                "Captures replayed in parallel (worker processes: a crash costs one capture); "
+                "default: the number of cores")
       ->capture_default_str();
   r->add_option("--timeout", a->timeout_s,
                 "Seconds one capture may take before its worker is killed and the capture "
@@ -171,11 +180,11 @@ void register_replay_commands(CLI::App& app, Context& ctx) {
       cb.issue = [&](const jobs::replay::ReplayIssue& i) {
         if (tty) std::fprintf(stderr, "\n");
         const char* what = i.kind == "report" ? "report not written" : "skipped";
-        if (i.message.rfind(i.path, 0) == 0)  // the message names the file already
-          std::fprintf(stderr, "piezobench: replay: %s: %s\n", what, i.message.c_str());
+        const std::string message = jobs::user_message(i.message);  // without internal function names
+        if (message.rfind(i.path, 0) == 0)  // the message names the file already
+          std::fprintf(stderr, "piezobench: replay: %s: %s\n", what, message.c_str());
         else
-          std::fprintf(stderr, "piezobench: replay: %s: %s: %s\n", what, i.path.c_str(),
-                       i.message.c_str());
+          std::fprintf(stderr, "piezobench: replay: %s: %s: %s\n", what, i.path.c_str(), message.c_str());
       };
       auto s = as_input([&] { return jobs::replay::run_replay(opt, cb, g_stop); });
       bar.finish();

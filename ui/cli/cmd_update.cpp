@@ -11,6 +11,7 @@
 #include <string>
 
 #include "jobs/update_features_job.hpp"
+#include "jobs/text/user_message.hpp"
 #include "ui/cli/cli_common.hpp"
 #include "ui/cli/cmd_update_capture.hpp"
 
@@ -40,7 +41,7 @@ void run_update(Context& ctx, const UpdateArgs& a) {
 void run_update_features(Context& ctx, const UpdateArgs& a0, const std::string& method) {
   jobs::UpdateFeaturesRequest a = a0.f;
   a.method = method;
-  a.warn = [](const std::string& w) { std::fprintf(stderr, "piezobench: %s\n", w.c_str()); };
+  a.warn = [](const std::string& w) { std::fprintf(stderr, "piezobench: %s\n", jobs::user_message(w).c_str()); };
   auto r = jobs::run_update_features(a);
   nlohmann::json& out = r.json;
   const bool converged = r.converged;

@@ -9,6 +9,8 @@
 
 #include <cstdio>
 
+#include "jobs/text/user_message.hpp"
+#include "jobs/text/uncertain_text.hpp"
 #include "jobs/update_capture_job.hpp"
 
 namespace piezo::cli {
@@ -22,7 +24,7 @@ void run_update_capture(Context& ctx, const std::string& file, const std::string
   req.isotropic = isotropic;
   req.oe = oe;
   req.warn = [&](const std::string& w) {
-    std::fprintf(stderr, "piezobench: update: %s: %s\n", file.c_str(), w.c_str());
+    std::fprintf(stderr, "piezobench: update: %s: %s\n", file.c_str(), jobs::user_message(w).c_str());
   };
   auto r = jobs::run_update_capture(req);
   nlohmann::json& out = r.json;
@@ -49,16 +51,19 @@ void run_update_capture(Context& ctx, const std::string& file, const std::string
                   u["epsT33_rel"].get<double>(), m["status"].get<std::string>().c_str());
     }
     if (methods.contains("oe") && methods["oe"].contains("parameters")) {
-      std::printf("  output-error fit: %-10s %14s %12s  %s\n", "", "value", "sigma", "status");
+      std::printf("  output-error fit: %-10s %-28s  %s\n", "", "value ± sigma", "status");
       for (const auto& p : methods["oe"]["parameters"])
-        std::printf("    %-10s %14.6g %12.3g  %s%s%s\n", p["name"].get<std::string>().c_str(),
-                    p["value"].get<double>(), p["sigma"].get<double>(),
+        std::printf("    %-10s %-28s  %s%s%s\n", p["name"].get<std::string>().c_str(),
+                    jobs::format_uncertain(json_number(p["value"]), json_number(p["sigma"]),
+                                           p.value("unit", std::string()), {true})
+                        .c_str(),
                     p["status"].get<std::string>().c_str(),
                     p["note"].get<std::string>().empty() ? "" : ": ",
                     p["note"].get<std::string>().c_str());
       const auto& fit = methods["oe"]["fit"];
-      std::printf("    corr(nu12, d31) %.3f; chi2/dof %.3g (noise from %s); %d shot(s), band %.0f Hz\n",
-                  methods["oe"]["corr_nu12_d31"].get<double>(), fit["chi2_per_dof"].get<double>(),
+      std::printf("    corr(nu12, d31) %s; chi2/dof %s (noise from %s); %d shot(s), band %.0f Hz\n",
+                  jobs::format_value(json_number(methods["oe"]["corr_nu12_d31"]), {}, 3).c_str(),
+                  jobs::format_value(json_number(fit["chi2_per_dof"]), {}, 3).c_str(),
                   fit["noise_source"].get<std::string>().c_str(), fit["shots"].get<int>(),
                   fit["band_hz"].get<double>());
       // Issue 33: the slow disturbances modelled, and the shots' agreement.

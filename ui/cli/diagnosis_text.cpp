@@ -1,7 +1,11 @@
 #include "ui/cli/diagnosis_text.hpp"
 
+#include <cmath>
 #include <cstdio>
 #include <string>
+
+#include "jobs/text/uncertain_text.hpp"
+#include "model/effects.hpp"
 
 namespace piezo::cli {
 
@@ -10,6 +14,11 @@ std::string fmt(const char* f, double a, double b = 0, double c = 0) {
   char buf[128];
   std::snprintf(buf, sizeof buf, f, a, b, c);
   return buf;
+}
+
+std::string effect_unit(const std::string& name) {
+  const model::EffectInfo* e = model::find_effect(name);
+  return e ? std::string(e->unit) : std::string();
 }
 }  // namespace
 
@@ -38,7 +47,9 @@ void print_diagnosis(std::ostream& os, const update::GapDiagnosis& d) {
   if (!d.measured.empty()) {
     os << "    measured (fixture calibration), held in the model:\n";
     for (const auto& m : d.measured)
-      os << "      " << m.name << fmt(": %.4g +/- %.2g", m.value, m.sigma) << "\n";
+      os << "      " << m.name << ": "
+         << jobs::format_si(m.value, m.sigma > 0 ? m.sigma : NAN, effect_unit(m.name), {false, 6, "σ not known"})
+         << "\n";
   }
   os << "    candidate effects (refitted with the constants; held-out shrink decides):\n";
   for (const auto& e : d.effects) {
@@ -49,7 +60,7 @@ void print_diagnosis(std::ostream& os, const update::GapDiagnosis& d) {
          << fmt(", YE11 %+.2f %%)", e.bias_y_e11_pct) << "\n";
       continue;
     }
-    os << fmt("%.4g +/- %.2g ", e.value, e.sigma) << e.unit << fmt(", delta chi2 %.1f", e.delta_chi2)
+    os << jobs::format_si(e.value, e.sigma, e.unit) << fmt(", delta chi2 %.1f", e.delta_chi2)
        << (e.significant ? " (significant)" : "");
     if (e.heldout_shrink) os << fmt(", held-out shrink %.0f %%", 100 * *e.heldout_shrink);
     os << "\n";

@@ -3,6 +3,7 @@
 #include <iostream>
 
 #include "ui/cli/cli_common.hpp"
+#include "ui/cli/suggest.hpp"
 #include "ui/version.hpp"
 
 int main(int argc, char** argv) {
@@ -29,6 +30,7 @@ int main(int argc, char** argv) {
     return app.exit(e);
   } catch (const CLI::ParseError& e) {
     app.exit(e);
+    std::cerr << did_you_mean(app);  // the nearest command or option to a mistyped one
     return kBadInput;
   }
   return ctx.exit_code;
