@@ -44,6 +44,27 @@ dsp::DriveBand capture_drive_band(const acq::Capture& cap, const std::vector<std
                          static_cast<std::size_t>(std::max<std::int64_t>(0, first->pretrigger_samples)));
 }
 
+void widen_by_order_spread(dsp::ImpedanceFeatures& f, const std::vector<dsp::ImpedanceFeatures>& others) {
+  auto widen = [&](std::vector<dsp::Feature>& mine, auto member) {
+    for (auto& x : mine) {
+      double d = 0;
+      for (const auto& o : others) {
+        double best = INFINITY;
+        for (const auto& y : o.*member)
+          if (std::abs(y.f_hz / x.f_hz - 1) < 0.03) best = std::min(best, std::abs(y.f_hz - x.f_hz));
+        if (std::isfinite(best)) d = std::max(d, best);
+      }
+      if (std::isfinite(x.sigma_hz)) x.sigma_hz = std::hypot(x.sigma_hz, d);
+    }
+  };
+  widen(f.resonances, &dsp::ImpedanceFeatures::resonances);
+  widen(f.antiresonances, &dsp::ImpedanceFeatures::antiresonances);
+  double dc = 0;
+  for (const auto& o : others)
+    if (std::isfinite(o.capacitance_f)) dc = std::max(dc, std::abs(o.capacitance_f - f.capacitance_f));
+  if (std::isfinite(f.capacitance_sigma_f)) f.capacitance_sigma_f = std::hypot(f.capacitance_sigma_f, dc);
+}
+
 SeedFeatures select_seed_features(const dsp::ImpedanceFeatures& z, double estimate_hi_hz, const dsp::DriveBand& drive,
                                   const CaptureModel& cm) {
   SeedFeatures sf;

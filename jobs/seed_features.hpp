@@ -22,6 +22,15 @@ namespace piezo::jobs {
 // the shots an estimate used), its band. Throws std::invalid_argument without such a shot.
 dsp::DriveBand capture_drive_band(const acq::Capture& cap, const std::vector<std::string>& shots = {});
 
+// The estimator's model-order part of the features' σ (issue 40): Prony's
+// parametric bootstrap holds the noise at its chosen order p only; a mode the
+// order leaves out moves the others and the low-frequency capacitance (refsim
+// case 03 at order 4: C 0.43 % low, 3.6 bootstrap σ). Each feature's σ is
+// widened in quadrature by how far it moves at the orders in `others` (p ± 2,
+// as the impedance command's uncertainty band does for Z): the nearest feature
+// of the same kind within 3 %; the capacitance always.
+void widen_by_order_spread(dsp::ImpedanceFeatures& f, const std::vector<dsp::ImpedanceFeatures>& others);
+
 struct SeedFeatures {
   update::MeasuredFeatures features;  // in the band, with σ; possibly no resonance at all
   update::FeatureBand band;           // the drive's band ∩ the model's mode range (∩ the estimate's)

@@ -45,9 +45,44 @@ nlohmann::json feature_methods(const std::string& file, const CaptureModel& m, b
   ir.no_kk = ir.no_validity = ir.no_stabilization = true;
   std::optional<SeedFeatures> sf;
   try {
-    const auto z = run_impedance(ir);
+    auto z = run_impedance(ir);
     const auto drive = capture_drive_band(z.capture, z.shots);
+    // The features' σ: Prony's bootstrap at its order, widened by the estimate at orders p ± 2.
+    std::vector<dsp::ImpedanceFeatures> others;
+    nlohmann::json orders = nlohmann::json::array();
+    if (z.z.prony)
+      for (int step : {-2, 2}) {
+        const long q = static_cast<long>(z.z.prony->order) + step;
+        if (q < 2) continue;
+        ImpedanceRequest iq = ir;
+        iq.order = static_cast<std::size_t>(q);
+        iq.bootstrap = 0;
+        try {
+          others.push_back(run_impedance(iq).z.features);
+          orders.push_back(q);
+        } catch (const std::exception&) {
+          // the data cannot carry that order: no spread from it
+        }
+      }
+    widen_by_order_spread(z.z.features, others);
+    // The low-frequency capacitance from the impedance command's FFT ratio
+    // (`impedance CAP.h5 --method fft`): model-free, its σ from the noise. Prony's
+    // depends on the order the noise sets (refsim 03: −0.43 % at order 4, its
+    // bootstrap σ 0.12 %; orders 6 and 8 break down), the FFT ratio's does not
+    // (03, 11, 12, 15: −0.51, −0.23, +0.12, +0.57 % of the truth, σ 0.6–1.6 %).
+    ImpedanceRequest fr = ir;
+    fr.method = "fft";
+    std::string c_source = "the FFT ratio (impedance --method fft)";
+    try {
+      const auto zf = run_impedance(fr);
+      z.z.features.capacitance_f = zf.z.features.capacitance_f;
+      z.z.features.capacitance_sigma_f = zf.z.features.capacitance_sigma_f;
+    } catch (const std::exception& e) {
+      c_source = std::string("Prony-SS (the FFT ratio failed: ") + e.what() + ")";
+    }
     sf = select_seed_features(z.z.features, z.band_hz, drive, m);
+    sf->json["sigma_orders"] = orders;
+    sf->json["capacitance_source"] = c_source;
     sf->json["estimate"] = {{"method", "prony"}, {"shots", z.shots}, {"band_hz", z.band_hz},
                             {"order", z.z.prony ? nlohmann::json(z.z.prony->order) : nlohmann::json(nullptr)}};
   } catch (const std::exception& e) {
