@@ -36,7 +36,8 @@ nlohmann::json oe_json(const jobs::CaptureFit& f) { return jobs::output_error_js
 // squares with an honest status and σ (update/feature_update.hpp). The
 // uncertainty band, Kramers-Kronig, validity and stabilization checks of the
 // impedance command do not change its estimate or features and are skipped.
-nlohmann::json feature_methods(const std::string& file, const CaptureModel& m, bool cmcm, bool lm) {
+nlohmann::json feature_methods(const std::string& file, const CaptureModel& m, bool cmcm, bool lm,
+                               const pu::OeOptions& chain) {
   nlohmann::json out;
   ImpedanceRequest ir;
   ir.file = file;
@@ -80,8 +81,20 @@ nlohmann::json feature_methods(const std::string& file, const CaptureModel& m, b
     } catch (const std::exception& e) {
       c_source = std::string("Prony-SS (the FFT ratio failed: ") + e.what() + ")";
     }
+    // The measurement chain's tolerances the samples cannot tell from C (the
+    // output-error fit's, OeOptions: R1 1 %, channel gain 0.5 %, 30 pF across the
+    // transducer): C_m ∝ 1/R1, ∝ 1/(1 + g), C + Cp — in quadrature with the noise.
+    double c_type_b = 0;
+    if (z.z.features.capacitance_f > 0) {
+      const double c = z.z.features.capacitance_f;
+      c_type_b = c * std::sqrt(chain.r1_rel_sigma * chain.r1_rel_sigma + chain.gain_rel_sigma * chain.gain_rel_sigma +
+                               (chain.cp_sigma_f / c) * (chain.cp_sigma_f / c));
+      if (std::isfinite(z.z.features.capacitance_sigma_f))
+        z.z.features.capacitance_sigma_f = std::hypot(z.z.features.capacitance_sigma_f, c_type_b);
+    }
     sf = select_seed_features(z.z.features, z.band_hz, drive, m);
     sf->json["sigma_orders"] = orders;
+    sf->json["capacitance_sigma_chain_f"] = c_type_b;
     sf->json["capacitance_source"] = c_source;
     sf->json["estimate"] = {{"method", "prony"}, {"shots", z.shots}, {"band_hz", z.band_hz},
                             {"order", z.z.prony ? nlohmann::json(z.z.prony->order) : nlohmann::json(nullptr)}};
@@ -139,7 +152,7 @@ UpdateCaptureResult run_update_capture(const UpdateCaptureRequest& r) {
   }
   if (method != "oe") {
     const jobs::CaptureModel cm = jobs::capture_model(cap, material, isotropic);
-    auto fm = feature_methods(file, cm, method == "cmcm" || method == "all", method == "lm" || method == "all");
+    auto fm = feature_methods(file, cm, method == "cmcm" || method == "all", method == "lm" || method == "all", r.oe);
     for (auto& [k, v] : fm.items()) methods[k] = v;
   }
   const std::string lead = method == "all" ? "oe" : method;
