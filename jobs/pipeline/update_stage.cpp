@@ -91,7 +91,17 @@ SeedUpdate seed_update_stage(const PipelineRequest& req, const acq::Capture& cap
   try {
     const auto drive = capture_drive_band(cap);
     const double band_hi = z.f_hz.size() ? z.f_hz.maxCoeff() : 0.0;
-    const SeedFeatures sf = select_seed_features(z.features, band_hi, drive, cm);
+    // The capacitance's σ also holds the chain's tolerances the output-error fit
+    // states (R1, channel gain, Cp; a measured fixture's are already corrected for).
+    dsp::ImpedanceFeatures zf = z.features;
+    if (zf.capacitance_f > 0 && std::isfinite(zf.capacitance_sigma_f) && !(req.use_calibration && out.fixture)) {
+      const auto& o = req.oe_options;
+      const double c = zf.capacitance_f;
+      zf.capacitance_sigma_f = std::hypot(zf.capacitance_sigma_f,
+                                          c * std::sqrt(o.r1_rel_sigma * o.r1_rel_sigma + o.gain_rel_sigma * o.gain_rel_sigma +
+                                                        (o.cp_sigma_f / c) * (o.cp_sigma_f / c)));
+    }
+    const SeedFeatures sf = select_seed_features(zf, band_hi, drive, cm);
     auto describe = [](const char* name, const update::FeatureUpdate& u) {
       std::string n = std::string(name) + " " + (u.ok() ? "converged" : "refused (" + u.check.status + ")");
       if (u.cmcm) {
