@@ -86,6 +86,10 @@ TEST_P(UpdateMethodsCorpus, ConvergedWithinThreeSigmaOrRefusedWithReason) {
   }
 }
 
+#ifdef PIEZO_UPDATE_METHODS_ALL
+INSTANTIATE_TEST_SUITE_P(RefsimV1All, UpdateMethodsCorpus, ::testing::ValuesIn(kCases));  // make validate
+#else
 INSTANTIATE_TEST_SUITE_P(RefsimV1, UpdateMethodsCorpus, ::testing::ValuesIn(kCases));
+#endif
 
 }  // namespace
