@@ -29,9 +29,10 @@ nlohmann::json params_of(const pu::TubeParams& p) { return jobs::tube_params_jso
 nlohmann::json oe_json(const jobs::CaptureFit& f) { return jobs::output_error_json(f.result, f.excitation); }
 
 // The seed's chain on a capture (issue 40): the features of the estimate
-// `piezobench impedance CAP.h5` gives (jobs/impedance_job: Prony-SS on the
-// first exp_decay dut shot, its band, the capture's fixture compensation; the
-// features' σ from its parametric bootstrap), kept inside the drive's band and
+// `piezobench impedance CAP.h5 --average` gives (jobs/impedance_job: Prony-SS
+// on the dut shots of the first drive averaged — one shot where there is one —,
+// its band, the capture's fixture compensation; the features' σ from its
+// parametric bootstrap, widened by the orders p ± 2), kept inside the drive's band and
 // the model's mode range (jobs/seed_features.hpp), then extended CMCM or least
 // squares with an honest status and σ (update/feature_update.hpp). The
 // uncertainty band, Kramers-Kronig, validity and stabilization checks of the
@@ -42,6 +43,7 @@ nlohmann::json feature_methods(const std::string& file, const CaptureModel& m, b
   ImpedanceRequest ir;
   ir.file = file;
   ir.method = "prony";
+  ir.average = true;  // repeated shots of the drive averaged (`impedance --average`): the best the capture supports
   ir.uncertainty = "none";
   ir.no_kk = ir.no_validity = ir.no_stabilization = true;
   std::optional<SeedFeatures> sf;

@@ -276,10 +276,11 @@ FeatureCheck check_feature_update(const FeatureCheckInput& in, const FeatureChec
       w = "; worst: " + worst->kind + " " + std::to_string(worst->index + 1) + " " +
           (worst->kind == "capacitance" ? fmt("%.5g F", worst->measured) : fmt("%.6g Hz", worst->measured)) +
           " off by " + fmt("%.3g sigma", worst->z);
-    return refuse("not_identifiable",
-                  "the updated model does not reproduce the measured features: chi2 " + fmt("%.4g", out.chi2) + " on " +
-                      std::to_string(out.dof) + " dof (chance 1e" + fmt("%.1f", out.log10_chance) + " < " +
-                      fmt("%.0e", opt.chi2_chance) + ")" + w);
+    const std::string test =
+        out.dof >= 1 ? "chi2 " + fmt("%.4g", out.chi2) + " on " + std::to_string(out.dof) + " dof (chance 1e" +
+                           fmt("%.1f", out.log10_chance) + " < " + fmt("%.0e", opt.chi2_chance) + ")"
+                     : "no degree of freedom left and a residual beyond 3 sigma (chi2 " + fmt("%.4g", out.chi2) + ")";
+    return refuse("not_identifiable", "the updated model does not reproduce the measured features: " + test + w);
   }
   if (out.dof >= 1 && out.chi2 > out.dof) {
     out.birge = std::sqrt(out.chi2 / out.dof);
