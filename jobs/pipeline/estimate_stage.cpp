@@ -152,6 +152,9 @@ dsp::ImpedanceResult estimate(const acq::Capture& cap, bool refine_features, Pip
         }
       }
       prony.features.capacitance_f = fit.features.low_frequency_capacitance();
+      if (fit.features.low_z_sigma_ohm > 0)  // σ_C/C = σ_|Z|/|Z| at f_L (issue 40: the seed chain needs it)
+        prony.features.capacitance_sigma_f =
+            prony.features.capacitance_f * fit.features.low_z_sigma_ohm / fit.features.low_z_ohm;
       fixture_in_fit = fx.has_value();
     } catch (const std::exception& e) {
       out.warnings.push_back(

@@ -46,7 +46,7 @@ PipelineResult run_pipeline(const PipelineRequest& req, const std::function<void
   progress(0.55, "update: extended CMCM (the seed's chain)");
   SeedUpdate seed;
   if (!req.seed_chain) out.stages.push_back({"update (CMCM)", false, "not requested (the seed's chain is off)"});
-  else if (z) seed = seed_update_stage(req, cm, *z, out);
+  else if (z) seed = seed_update_stage(req, cap, cm, *z, out);
   else out.stages.push_back({"update (CMCM)", false, "needs the impedance estimate"});
   const std::string seed_note = out.stages.back().note;
   if (cancel) return out;
@@ -68,6 +68,11 @@ PipelineResult run_pipeline(const PipelineRequest& req, const std::function<void
   // The pipeline's update: the output-error fit where it converged (its
   // constants carry sigma and status), else the seed's chain.
   UpdateOutcome u;
+  // The seed's chain refused (issue 40): said, and the method that holds is used.
+  if (!seed.refused.empty())
+    out.warnings.push_back(std::string("the seed's chain is refused (") + seed.refused + "); " +
+                           (oe && oe->ok() ? "the output-error fit's constants are used"
+                                           : "and the output-error fit did not converge"));
   if (oe && oe->ok()) {
     u = {true, "output-error", oe->updated, oe->damping, 50e3};
     if (!out.resonances_hz.empty()) u.first_resonance_hz = out.resonances_hz.front();
@@ -80,15 +85,15 @@ PipelineResult run_pipeline(const PipelineRequest& req, const std::function<void
     u.damping = damping_from_features(*z, out, &port);
     out.warnings.push_back(std::string("the output-error fit did not converge: the seed's chain (") +
                            (u.method == "cmcm" ? "extended CMCM" : "least squares on features") +
-                           ") is used, without sigma");
+                           ") is used, with the sigmas its features give");
   }
   out.update_method = u.ok ? u.method : "";
   {
     std::string note;
     if (u.ok) {
       note = u.method == "output-error" ? "the output-error fit's constants and beta (with sigma)"
-                                        : u.method == "cmcm" ? "the seed's extended CMCM (no sigma)"
-                                                             : "least squares (LM) on the seed's features (no sigma)";
+                                        : u.method == "cmcm" ? "the seed's extended CMCM (sigma from its features)"
+                                                             : "least squares (LM) on the seed's features (sigma from them)";
       if (u.method == "output-error" && oe->lack_of_fit) note += "; the model class does not explain the capture";
     } else {
       note = "neither the output-error fit nor the seed's chain converged";

@@ -82,7 +82,7 @@ struct ParamRow {
   // its sigma and status when it has them.
   double original = 0, updated = 0;
   std::optional<double> sigma;
-  std::string status;           // "ok" | "not identifiable" (output-error); "ok (no sigma)" for the seed's chain
+  std::string status;           // "ok" | "not identifiable" (output-error); "ok (seed's chain)" / "not identifiable (seed's chain)" with its sigma (issue 40)
   std::optional<double> truth;  // only when the bench is simulated (shown for the demo)
   // Side by side: the seed's extended CMCM (or its LM fallback) on the
   // features, least squares (LM) on the same features when asked for, and the

@@ -17,6 +17,7 @@
 #include "jobs/pipeline/capture_fit.hpp"
 #include "jobs/pipeline/pipeline.hpp"
 #include "model/modal.hpp"
+#include "update/feature_update.hpp"
 
 namespace piezo::jobs::detail {
 
@@ -53,16 +54,18 @@ struct UpdateOutcome {
 // least squares (LM) on the same features where CMCM does not converge (or
 // beside it, `req.compare_lm`). Never throws: its failure is a stage note.
 struct SeedUpdate {
-  UpdateOutcome chosen;                     // CMCM's, else LM's
+  UpdateOutcome chosen;                     // CMCM's, else LM's: only where its status is converged (issue 40)
   std::optional<update::TubeParams> cmcm, lm;
+  std::optional<update::FeatureUpdate> cmcm_run, lm_run;  // each method's answer, honest status and sigmas
+  std::string refused;                      // why neither holds ("" when one does, or the chain did not run)
 };
 
 model::RayleighDamping damping_from_features(const dsp::ImpedanceResult& z, PipelineResult& out,
                                              const model::ModalPortModel* port);
 std::vector<std::complex<double>> model_z(model::ModalSolver& solver, const model::PiezoMaterialE& m,
                                           const std::vector<double>& f, const model::RayleighDamping& d);
-SeedUpdate seed_update_stage(const PipelineRequest& req, const CaptureModel& cm, const dsp::ImpedanceResult& z,
-                             PipelineResult& out);
+SeedUpdate seed_update_stage(const PipelineRequest& req, const acq::Capture& cap, const CaptureModel& cm,
+                             const dsp::ImpedanceResult& z, PipelineResult& out);
 std::vector<std::string> scanned_effects(const PipelineRequest& req);
 std::optional<update::OeResult> output_error_stage(const PipelineRequest& req, const acq::Capture& cap,
                                                    const CaptureModel& cm, PipelineResult& out);

@@ -9,12 +9,12 @@
 #include "acquisition/contained_read.hpp"
 #include "acquisition/capture_file.hpp"
 #include "jobs/pipeline/stages.hpp"
+#include "jobs/seed_features.hpp"
 #include "model/harmonic.hpp"
 #include "model/material_spec.hpp"
 #include "update/gap_diagnosis.hpp"
-#include "update/least_squares.hpp"
+#include "update/feature_update.hpp"
 #include "update/rayleigh.hpp"
-#include "update/updater.hpp"
 
 namespace piezo::jobs::detail {
 
@@ -80,38 +80,45 @@ std::vector<std::complex<double>> model_z(model::ModalSolver& solver, const mode
   return model::impedance_from_admittance(y);
 }
 
-SeedUpdate seed_update_stage(const PipelineRequest& req, const CaptureModel& cm, const dsp::ImpedanceResult& z,
-                             PipelineResult& out) {
+SeedUpdate seed_update_stage(const PipelineRequest& req, const acq::Capture& cap, const CaptureModel& cm,
+                             const dsp::ImpedanceResult& z, PipelineResult& out) {
+  // The seed's chain on the estimate's features (issue 40): only those inside
+  // the drive's band and the model's mode range, each with its σ (the port
+  // fit's for the first three pairs), and an honest status
+  // (update/feature_update.hpp): a method's answer is used only when it is
+  // physical and reproduces the features it was given.
   SeedUpdate s;
   try {
-    update::MeasuredFeatures feat;
-    feat.resonances_hz = out.resonances_hz;
-    feat.antiresonances_hz = out.antiresonances_hz;
-    if (feat.resonances_hz.size() > 3) feat.resonances_hz.resize(3);
-    if (feat.antiresonances_hz.size() > 3) feat.antiresonances_hz.resize(3);
-    if (!(z.features.capacitance_f > 0))
-      throw std::runtime_error("the estimate has no low-frequency capacitance");
-    feat.low_z_hz = 400.0;  // the seed's low-frequency point (Table 4/5)
-    feat.low_z_ohm = 1.0 / (2 * M_PI * feat.low_z_hz * z.features.capacitance_f);
-    feat.validate();
-
-    update::UpdateOptions uo;
-    // Measured features are not exactly reachable by the model (noise, three
-    // resonances for two stiffnesses), so the outer sweeps settle to a
-    // least-squares point more slowly than on exact data: allow more sweeps and
-    // stop at 1e-6 relative change (far below the features' uncertainty).
-    uo.max_sweeps = 40;
-    uo.sweep_tolerance = 1e-6;
-    const auto r = update::update_cmcm(*cm.tube, *cm.solver, cm.cls, cm.p0, feat, uo);
-    std::string note;
-    {
-      char buf[200];
-      std::snprintf(buf, sizeof buf, "extended CMCM %s: %d elastic + %d piezo iterations in %d sweeps",
-                    r.ok() ? "converged" : "did NOT converge", r.iterations_elastic, r.iterations_piezo,
-                    r.sweeps);
-      note = buf;
-      if (!r.ok()) note += ": " + r.message;
+    const auto drive = capture_drive_band(cap);
+    const double band_hi = z.f_hz.size() ? z.f_hz.maxCoeff() : 0.0;
+    // The capacitance's σ also holds the chain's tolerances the output-error fit
+    // states (R1, channel gain, Cp; a measured fixture's are already corrected for).
+    dsp::ImpedanceFeatures zf = z.features;
+    if (zf.capacitance_f > 0 && std::isfinite(zf.capacitance_sigma_f) && !(req.use_calibration && out.fixture)) {
+      const auto& o = req.oe_options;
+      const double c = zf.capacitance_f;
+      zf.capacitance_sigma_f = std::hypot(zf.capacitance_sigma_f,
+                                          c * std::sqrt(o.r1_rel_sigma * o.r1_rel_sigma + o.gain_rel_sigma * o.gain_rel_sigma +
+                                                        (o.cp_sigma_f / c) * (o.cp_sigma_f / c)));
     }
+    const SeedFeatures sf = select_seed_features(zf, band_hi, drive, cm);
+    auto describe = [](const char* name, const update::FeatureUpdate& u) {
+      std::string n = std::string(name) + " " + (u.ok() ? "converged" : "refused (" + u.check.status + ")");
+      if (u.cmcm) {
+        char buf[160];
+        std::snprintf(buf, sizeof buf, ": %d elastic + %d piezo iterations in %d sweeps", u.cmcm->iterations_elastic,
+                      u.cmcm->iterations_piezo, u.cmcm->sweeps);
+        n += buf;
+      } else if (u.lm) {
+        n += ": " + std::to_string(u.lm->iterations) + " iterations";
+      }
+      if (!u.ok()) n += "; " + u.check.reason;
+      return n;
+    };
+    const auto r = update::update_from_features(*cm.tube, *cm.solver, cm.cls, cm.p0, sf.features, sf.band,
+                                                update::FeatureMethod::cmcm, {}, sf.no_features);
+    std::string note = describe("extended CMCM", r);
+    s.cmcm_run = r;
     if (r.ok()) {
       s.cmcm = r.updated;
       s.chosen = {true, "cmcm", r.updated, {}, 50e3};
@@ -120,25 +127,21 @@ SeedUpdate seed_update_stage(const PipelineRequest& req, const CaptureModel& cm,
       // Second, independent updater on the same features (update/least_squares.hpp):
       // no mode-shape pairing, so a start far from the answer (mode veering, an
       // ambiguous MAC) does not stop it.
-      try {
-        const auto lm = update::update_lm(*cm.tube, *cm.solver, cm.cls, cm.p0, feat);
-        char buf[200];
-        std::snprintf(buf, sizeof buf, "; least squares (LM) on the same features %s in %d iterations",
-                      lm.ok() ? "converged" : "did NOT converge", lm.iterations);
-        note += buf;
-        if (!lm.ok()) note += ": " + lm.message;
-        if (lm.ok()) {
-          s.lm = lm.updated;
-          if (!s.chosen.ok) s.chosen = {true, "lm", lm.updated, {}, 50e3};
-        }
-      } catch (const std::exception& e) {
-        note += std::string("; least squares (LM) refused: ") + e.what();
+      const auto lm = update::update_from_features(*cm.tube, *cm.solver, cm.cls, cm.p0, sf.features, sf.band,
+                                                   update::FeatureMethod::lm, {}, sf.no_features);
+      note += "; " + describe("least squares (LM) on the same features", lm);
+      s.lm_run = lm;
+      if (lm.ok()) {
+        s.lm = lm.updated;
+        if (!s.chosen.ok) s.chosen = {true, "lm", lm.updated, {}, 50e3};
       }
     }
-    if (!feat.resonances_hz.empty()) s.chosen.first_resonance_hz = feat.resonances_hz.front();
+    if (!s.chosen.ok) s.refused = note;
+    if (!sf.features.resonances_hz.empty()) s.chosen.first_resonance_hz = sf.features.resonances_hz.front();
     out.stages.push_back({"update (CMCM)", s.chosen.ok, note});
   } catch (const std::exception& e) {
     out.stages.push_back({"update (CMCM)", false, std::string("the seed's chain could not run: ") + e.what()});
+    s.refused = e.what();
   }
   return s;
 }
@@ -292,8 +295,15 @@ void parameter_rows(const update::TubeParams& p0, const UpdateOutcome& u, const 
     if (u.method == "output-error") {
       row.sigma = row.oe_sigma;
       row.status = row.oe_status;
-    } else if (u.ok) {
-      row.status = "ok (seed's chain, no sigma)";
+    } else if (u.ok) {  // the seed's chain, where it holds (issue 40): with its sigma
+      const auto& run = u.method == "cmcm" ? seed.cmcm_run : seed.lm_run;
+      row.status = "ok (seed's chain)";
+      if (run)
+        for (const auto& c : run->check.constants)
+          if (c.name == n) {
+            if (std::isfinite(c.sigma)) row.sigma = c.sigma;
+            row.status = c.status + " (seed's chain)";
+          }
     }
     out.params.push_back(row);
   }

@@ -7,6 +7,7 @@
 // with ours.
 #include "ui/cli/cmd_update_capture.hpp"
 
+#include <cmath>
 #include <cstdio>
 
 #include "jobs/text/user_message.hpp"
@@ -49,6 +50,17 @@ void run_update_capture(Context& ctx, const std::string& file, const std::string
       std::printf("  %-5s YE11 %.5g  nu12 %.4f  d31 %.5g  epsT33_rel %.5g  (%s)\n", name.c_str(),
                   u["YE11"].get<double>(), u["nu12"].get<double>(), u["d31"].get<double>(),
                   u["epsT33_rel"].get<double>(), m["status"].get<std::string>().c_str());
+    }
+    // The seed's chain (issue 40): each constant with its sigma and status, the reason of a refusal.
+    for (const char* name : {"cmcm", "lm"}) {
+      if (!methods.contains(name) || !methods[name].contains("parameters")) continue;
+      const auto& m = methods[name];
+      std::printf("  %s: %s%s%s\n", name, m.value("status", std::string()).c_str(),
+                  m.value("message", std::string()).empty() ? "" : ": ", m.value("message", std::string()).c_str());
+      for (const auto& p : m["parameters"])
+        std::printf("    %-10s %14.6g %12.3g  %s%s%s\n", p["name"].get<std::string>().c_str(), p["value"].get<double>(),
+                    p["sigma"].is_number() ? p["sigma"].get<double>() : NAN, p["status"].get<std::string>().c_str(),
+                    p["note"].get<std::string>().empty() ? "" : ": ", p["note"].get<std::string>().c_str());
     }
     if (methods.contains("oe") && methods["oe"].contains("parameters")) {
       std::printf("  output-error fit: %-10s %-28s  %s\n", "", "value ± sigma", "status");

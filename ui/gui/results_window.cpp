@@ -15,8 +15,8 @@ void parameter_table(const jobs::PipelineResult& r) {
   // Which method `updated` holds, and the fit's summary: a tooltip on the
   // values (the table keeps its height, the exports stay in view).
   const char* method = r.update_method == "output-error" ? "output-error fit of the samples (with sigma)"
-                       : r.update_method == "cmcm"       ? "the seed's extended CMCM (no sigma)"
-                                                         : "least squares on the seed's features (no sigma)";
+                       : r.update_method == "cmcm"       ? "the seed's extended CMCM (sigma from its features)"
+                                                         : "least squares on the seed's features (sigma from them)";
   const int cols = 6 + (seed ? 1 : 0) + (sim ? 1 : 0);
   if (!ImGui::BeginTable("params", cols, ImGuiTableFlags_Borders | ImGuiTableFlags_RowBg))
     return;
