@@ -59,9 +59,9 @@ std::vector<std::string> disturbance_findings(const OeBaseline& b) {
     }
     std::snprintf(buf, sizeof buf,
                   "Baseline wander between the channels (offset, slope to degree %d%s): projected out of the residual "
-                  "(it took chi2 %.0f for %d parameters, chance 1e%.0f under white noise); slope %.3g +/- %.2g V/s.",
-                  b.poly_degree, b.harmonics > 0 ? ", hum" : "", b.delta_chi2, b.dof, b.log10_p, b.slope_v_per_s,
-                  b.slope_sigma_v_per_s);
+                  "(it took chi2 %.0f for %d parameters, chance %s1e%.0f under white noise); slope %.3g +/- %.2g V/s.",
+                  b.poly_degree, b.harmonics > 0 ? ", hum" : "", b.delta_chi2, b.dof, b.log10_p < -300 ? "below " : "",
+                  std::max(b.log10_p, -300.0), b.slope_v_per_s, b.slope_sigma_v_per_s);
     out.push_back(std::string(buf) + hum);
   }
   if (b.pink) {
