@@ -12,7 +12,7 @@
 namespace piezo::dsp {
 
 DriveBand drive_band(std::span<const double> x, double fs_hz, std::size_t pretrigger, double min_snr) {
-  if (x.size() < 64 || !(fs_hz > 0)) throw std::invalid_argument("drive_band: need >= 64 samples and fs > 0");
+  if (x.size() < 64 || !(fs_hz > 0)) throw std::invalid_argument("the drive's band: need >= 64 samples and a sample rate > 0");
   const std::size_t n = x.size();
   Eigen::VectorXd v = Eigen::Map<const Eigen::VectorXd>(x.data(), static_cast<Eigen::Index>(n));
   if (pretrigger >= 16 && pretrigger < n) v.array() -= v.head(static_cast<Eigen::Index>(pretrigger)).mean();

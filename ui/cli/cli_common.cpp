@@ -52,7 +52,8 @@ int run_command(Context& ctx, const std::function<void()>& body) {
     return ctx.exit_code;
   } catch (const acq::CaptureError& e) {
     if (auto why = impedance_file_instead(e)) {
-      report(ctx, "bad input", *why, {{"file", e.file()}, {"problem", "impedance file, not a capture"}});
+      report(ctx, "bad input", *why,
+             {{"file", e.file()}, {"path", e.h5path()}, {"problem", "impedance file, not a capture"}});
       return kBadInput;
     }
     report(ctx, "bad capture", e.what(),
