@@ -7,6 +7,8 @@
 
 #include <gtest/gtest.h>
 
+#include "circuit_networks.hpp"
+
 #include <cmath>
 #include <random>
 
@@ -14,23 +16,9 @@ using namespace piezo::dsp;
 
 namespace {
 
-constexpr double kTwoPi = 2.0 * M_PI;
-
-CircuitBranch branch(double fs, double q, double c) {
-  CircuitBranch b;
-  b.c_f = c;
-  b.l_h = 1.0 / (std::pow(kTwoPi * fs, 2) * c);
-  b.r_ohm = kTwoPi * fs * b.l_h / q;
-  return b;
-}
-
-EquivalentCircuit tube_like() {
-  EquivalentCircuit c;
-  c.c0_f = 4e-9;
-  c.tan_delta = 0.01;
-  c.branches = {branch(26e3, 60, 0.15e-9), branch(52e3, 80, 0.6e-9), branch(101e3, 50, 0.08e-9)};
-  return c;
-}
+using test_networks::branch;
+using test_networks::kTwoPi;
+using test_networks::tube_like;
 
 struct Grid {
   Eigen::VectorXd f;
