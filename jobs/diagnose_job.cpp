@@ -166,10 +166,11 @@ nlohmann::json diagnose_json(const DiagnoseRequest& a, const DiagnoseResult& r) 
   c["material"] = r.material;
   c["material_class"] = a.transverse ? "transversely isotropic" : "isotropic";
   c["shots"] = res.shots;
-  c["parameters"] = nlohmann::json::array();
-  for (const auto& p : res.params)
-    c["parameters"].push_back(
-        {{"name", p.name}, {"unit", p.unit}, {"original", p.original}, {"updated", p.updated}});
+  {  // the rows of the pipeline's report: updated (corrected when an effect was named) with sigma and status
+    const nlohmann::json rep = report_json(res);
+    c["parameters"] = rep["parameters"];
+    c["corrected_for"] = rep["corrected_for"];
+  }
   c["stages"] = nlohmann::json::array();
   for (const auto& s : res.stages)
     c["stages"].push_back({{"name", s.name}, {"ran", s.ran}, {"note", s.note}});

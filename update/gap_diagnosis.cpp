@@ -285,6 +285,8 @@ GapDiagnosis diagnose_gap(model::ModalSolver& solver, const MaterialClass& cls, 
       const bool stands_clear = sx > 0 ? std::fabs(xe) / sx >= opt.min_effect_sigma : xe != 0.0;
       rep.significant = rep.delta_chi2 / scale > opt.significance && stands_clear;
       rep.material = m.material(f.x);
+      for (std::size_t i = 0; i < 4 && i < f.sigma_x.size(); ++i)  // x: 1 % per unit (gap_model.hpp)
+        rep.material_rel_sigma[i] = f.converged && f.sigma_x[i] > 0 ? 0.01 * f.sigma_x[i] : NAN;
       if (!f.converged) rep.note = f.message;
       else if (!law.empty()) rep.note = "law in frequency: " + law + " (the better fit of the two)";
       else if (rep.name == "mass_loading")  // tests/update/test_gap_validation, GAP_EFFECTS=mass_loading

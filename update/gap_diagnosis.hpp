@@ -23,6 +23,7 @@
 //     Greedy: the best significant effect is added and the rest refitted, at
 //     most `max_effects` times.
 #include <atomic>
+#include <cmath>
 #include <functional>
 #include <optional>
 #include <string>
@@ -47,6 +48,9 @@ struct EffectReport {
   bool significant = false;
   std::optional<double> heldout_chi2_after, heldout_shrink;
   TubeParams material;  // refitted with the effect
+  // Its relative standard errors (YE11, nu12, d31, εT33), scaled by
+  // max(1, χ²/dof) as GapFit::sigma_x; NaN where the refit had none.
+  double material_rel_sigma[4] = {NAN, NAN, NAN, NAN};
   // Other candidates whose signature, after the constants took what they can,
   // points the same way (|cos| >= GapOptions::indistinguishable_cos): this
   // data cannot tell them from this one.

@@ -65,7 +65,24 @@ nlohmann::json report_json(const PipelineResult& r) {
     if (p.cmcm) row["cmcm"] = *p.cmcm;
     if (p.lm) row["lm"] = *p.lm;
     if (p.oe) row["output_error"] = {{"value", *p.oe}, {"sigma", p.oe_sigma.value_or(NAN)}, {"status", p.oe_status}};
+    if (p.uncorrected)  // the update's own constants, without the effect the diagnosis named
+      row["uncorrected"] = {{"value", *p.uncorrected},
+                            {"sigma", p.uncorrected_sigma ? nlohmann::json(*p.uncorrected_sigma) : nlohmann::json(nullptr)},
+                            {"status", p.uncorrected_status}};
     j["parameters"].push_back(row);
+  }
+  if (r.corrected) {  // the parameters' "updated" are the constants refitted with this effect
+    const auto& c = *r.corrected;
+    j["corrected_for"] = {{"effect", c.effect},
+                          {"unit", c.unit},
+                          {"value", c.value},
+                          {"sigma", c.sigma},
+                          {"heldout_shrink", c.heldout_shrink ? nlohmann::json(*c.heldout_shrink) : nlohmann::json(nullptr)},
+                          {"heldout_without_gap", c.heldout_without_gap},
+                          {"source", c.source},
+                          {"label", c.label}};
+  } else {
+    j["corrected_for"] = nullptr;
   }
   j["stages"] = nlohmann::json::array();
   for (const auto& s : r.stages) j["stages"].push_back({{"name", s.name}, {"ran", s.ran}, {"note", s.note}});

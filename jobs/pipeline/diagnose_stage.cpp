@@ -218,6 +218,7 @@ void diagnose_stage(const PipelineRequest& req, const acq::Capture& cap, const C
     out.stages.push_back({"diagnose", true, note});
     out.verdict = d.verdict;
     out.diagnosis = std::move(d);
+    correct_constants(req, cap, cm, r, out);
     return;
   }
   const update::GapData fit = gap_data(cap, fit_shots, req.gap_floor, "fit data");
@@ -246,6 +247,7 @@ void diagnose_stage(const PipelineRequest& req, const acq::Capture& cap, const C
   out.stages.push_back({"diagnose", true, note});
   out.verdict = d.verdict;
   out.diagnosis = std::move(d);
+  correct_constants(req, cap, cm, nullptr, out);
 }
 
 }  // namespace piezo::jobs::detail

@@ -90,6 +90,22 @@ struct ParamRow {
   std::optional<double> cmcm, lm;
   std::optional<double> oe, oe_sigma;
   std::string oe_status;
+  // When the diagnosis named an effect (PipelineResult::corrected), `updated`,
+  // `sigma` and `status` are the constants refitted WITH it (issue 41 item 2)
+  // and these hold the update's own, without it.
+  std::optional<double> uncorrected, uncorrected_sigma;
+  std::string uncorrected_status;
+};
+
+// The constants refitted with the effect the gap diagnosis named: the result
+// (ParamRow::updated) when there is one, labelled with the effect and its value.
+struct CorrectedConstants {
+  std::string effect, unit;
+  double value = 0, sigma = 0;            // SI
+  std::optional<double> heldout_shrink;   // of the held-out gap, 0..1 (none: not checked on held-out data)
+  bool heldout_without_gap = false;       // the held-out data had no gap of their own
+  std::string source;                     // "output-error" | "impedance" (the diagnosis' path)
+  std::string label;                      // one line for the technician
 };
 
 struct StageReport {
@@ -121,6 +137,7 @@ struct PipelineResult {
   std::string update_method;  // "output-error" | "cmcm" | "lm": whose constants `updated` holds
   std::string verdict;
   std::optional<update::GapDiagnosis> diagnosis;
+  std::optional<CorrectedConstants> corrected;  // the params' `updated` are these (see ParamRow)
   std::optional<update::OeResult> output_error;  // the output-error fit (issue 17), when it ran
   std::string output_error_excitation;          // the drive of the shots it fitted
   std::string heldout_path;  // the held-out capture, when there is one

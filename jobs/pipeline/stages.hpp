@@ -75,6 +75,12 @@ void parameter_rows(const update::TubeParams& p0, const UpdateOutcome& u, const 
                     PipelineResult& out);
 
 // diagnose_stage.cpp
+// The result corrected for the effect the diagnosis named (corrected_constants.cpp):
+// from the output-error fit's refit with it (`r`: the fit the diagnosis used),
+// or from the impedance-domain diagnosis' own refit. No effect named: nothing.
+void correct_constants(const PipelineRequest& req, const acq::Capture& cap, const CaptureModel& cm,
+                       const update::OeResult* r, PipelineResult& out);
+
 void diagnose_stage(const PipelineRequest& req, const acq::Capture& cap, const CaptureModel& cm,
                     const acq::Capture* heldout_cap, const UpdateOutcome& u, PipelineResult& out,
                     const Stages& progress, const std::atomic<bool>& cancel);

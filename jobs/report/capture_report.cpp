@@ -49,14 +49,21 @@ std::string capture_summary_markdown(const jobs::PipelineResult& r, const Captur
   for (const auto& s : r.stages)
     o << "| " << s.name << " | " << (s.ran ? "yes" : "no") << " | " << cell(user_message(s.note)) << " |\n";
   if (!r.params.empty()) {
-    o << "\n## Parameters\n\nUpdate: " << r.update_method
-      << "\n\n| parameter | unit | original | updated ± sigma | change | status | CMCM (seed) |\n"
-         "| --- | --- | --- | --- | --- | --- | --- |\n";
-    for (const auto& p : r.params)  // σ to two significant digits, the value to match; "—" for no σ
+    o << "\n## Parameters\n\nUpdate: " << r.update_method;
+    if (r.corrected) o << "; **" << cell(r.corrected->label) << "** (the updated constants below are refitted with it)";
+    o << "\n\n| parameter | unit | original | updated ± sigma | change | status | CMCM (seed) |"
+      << (r.corrected ? " without the effect ± sigma | its status |" : "") << "\n"
+      << "| --- | --- | --- | --- | --- | --- | --- |" << (r.corrected ? " --- | --- |" : "") << "\n";
+    for (const auto& p : r.params) {  // σ to two significant digits, the value to match; "—" for no σ
       o << "| " << p.name << " | " << p.unit << " | " << fmt("%.6g", p.original) << " | "
         << format_uncertain(p.updated, p.sigma.value_or(NAN), {}, {true}) << " | "
         << (p.original != 0 ? fmt("%+.2f %%", 100.0 * (p.updated - p.original) / p.original) : "-")
-        << " | " << cell(p.status) << " | " << (p.cmcm ? fmt("%.6g", *p.cmcm) : "-") << " |\n";
+        << " | " << cell(p.status) << " | " << (p.cmcm ? fmt("%.6g", *p.cmcm) : "-") << " |";
+      if (r.corrected)
+        o << " " << (p.uncorrected ? format_uncertain(*p.uncorrected, p.uncorrected_sigma.value_or(NAN), {}, {true}) : "-")
+          << " | " << cell(p.uncorrected_status) << " |";
+      o << "\n";
+    }
     if (r.output_error && r.output_error->ok())
       o << "\ncorr(nu12, d31) " << format_value(r.output_error->corr_nu12_d31, {}, 3) << ", chi2/dof "
         << fmt("%.3g", r.output_error->chi2_per_dof) << " (limit "

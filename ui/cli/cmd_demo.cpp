@@ -101,6 +101,7 @@ void register_demo_command(CLI::App& app, Context& ctx) {
         std::fflush(stdout);
       }
       if (res.diagnosis) print_diagnosis(std::cout, *res.diagnosis);
+      print_corrected(std::cout, res);
       if (!res.damping_from_resonances.empty())
         std::cout << "  damping from the resonances: " << res.damping_from_resonances << "\n";
       for (const auto& w : res.warnings) std::cout << "  warning: " << jobs::user_message(w) << "\n";

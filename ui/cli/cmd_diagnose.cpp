@@ -9,12 +9,14 @@
 // invalid file, too few dut shots, a diagnosis that could not run (each named
 // with its file); 1 internal failure. The CLI's room (ui/cli): the checks,
 // the pipeline and the plot are jobs/diagnose_job.hpp.
+#include <cmath>
 #include <cstdio>
 #include <iostream>
 
 #include "jobs/diagnose_job.hpp"
 #include "jobs/text/user_message.hpp"
 #include "ui/cli/cli_common.hpp"
+#include "jobs/text/uncertain_text.hpp"
 #include "ui/cli/diagnosis_text.hpp"
 
 namespace piezo::cli {
@@ -52,12 +54,18 @@ void run_diagnose(Context& ctx, const DiagnoseArgs& args) {
             << (a.transverse ? "transversely isotropic" : "isotropic") << " class)\n";
   for (const auto& s : res.stages)
     std::cout << "  " << (s.ran ? "[ran]     " : "[skipped] ") << s.name << ": " << s.note << "\n";
-  if (!res.params.empty()) {
-    std::printf("\n  %-12s %14s %14s\n", "parameter", "original", "updated");
-    for (const auto& p : res.params)
-      std::printf("  %-12s %14.6g %14.6g\n", p.name.c_str(), p.original, p.updated);
+  if (!res.params.empty()) {  // the update's constants with sigma (the corrected ones below, when named)
+    std::printf("\n  %-12s %14s   %-28s %s\n", "parameter", "original", "updated ± sigma", "status");
+    for (const auto& p : res.params) {
+      const double v = p.uncorrected ? *p.uncorrected : p.updated;
+      const auto s = p.uncorrected ? p.uncorrected_sigma : p.sigma;
+      std::printf("  %-12s %14.6g   %-28s %s\n", p.name.c_str(), p.original,
+                  jobs::format_uncertain(v, s.value_or(NAN), {}, {true}).c_str(),
+                  (p.uncorrected ? p.uncorrected_status : p.status).c_str());
+    }
   }
   print_diagnosis(std::cout, d);
+  print_corrected(std::cout, res);
   for (const auto& w : res.warnings) std::cout << "  warning: " << w << "\n";
   if (!plot.empty()) std::cout << "\n  plot: " << plot << "\n";
 }

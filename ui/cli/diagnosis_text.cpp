@@ -68,4 +68,27 @@ void print_diagnosis(std::ostream& os, const update::GapDiagnosis& d) {
   os << "    verdict: " << d.verdict << "\n";
 }
 
+void print_corrected(std::ostream& os, const jobs::PipelineResult& r) {
+  if (!r.corrected) return;
+  os << "\n  result: " << r.corrected->label << "\n";
+  char line[256];
+  std::snprintf(line, sizeof line, "  %-11s %-28s %-17s | %-28s %s\n", "parameter", "corrected ± sigma", "status",
+                "without it ± sigma", "status");
+  os << line;
+  for (const auto& p : r.params) {
+    const jobs::UncertainStyle compact{true};
+    const std::string a = jobs::format_uncertain(p.updated, p.sigma.value_or(NAN), {}, compact);
+    const std::string b = p.uncorrected
+                              ? jobs::format_uncertain(*p.uncorrected, p.uncorrected_sigma.value_or(NAN), {}, compact)
+                              : std::string("-");
+    std::snprintf(line, sizeof line, "  %-11s %-28s %-17s | %-28s %s", p.name.c_str(), a.c_str(), p.status.c_str(),
+                  b.c_str(), p.uncorrected_status.c_str());
+    os << line;
+    if (p.truth && p.sigma && *p.sigma > 0)  // the simulated bench's truth (demo only)
+      os << "   (true " << jobs::format_value(*p.truth, {}, 6) << ": "
+         << jobs::format_value((p.updated - *p.truth) / *p.sigma, {}, 2) << " sigma)";
+    os << "\n";
+  }
+}
+
 }  // namespace piezo::cli

@@ -17,7 +17,12 @@ void parameter_table(const jobs::PipelineResult& r) {
   const char* method = r.update_method == "output-error" ? "output-error fit of the samples (with sigma)"
                        : r.update_method == "cmcm"       ? "the seed's extended CMCM (sigma from its features)"
                                                          : "least squares on the seed's features (sigma from them)";
-  const int cols = 6 + (seed ? 1 : 0) + (sim ? 1 : 0);
+  const bool corr = r.corrected.has_value();
+  if (corr) {  // the result is the model refitted with the effect the diagnosis named
+    ImGui::TextColored(ImVec4(0.4f, 0.8f, 1.0f, 1.0f), "Result %s", r.corrected->label.c_str());
+    ImGui::TextDisabled("(\"without effect\": the update's constants before the diagnosis)");
+  }
+  const int cols = 6 + (seed ? 1 : 0) + (sim ? 1 : 0) + (corr ? 1 : 0);
   if (!ImGui::BeginTable("params", cols, ImGuiTableFlags_Borders | ImGuiTableFlags_RowBg))
     return;
   ImGui::TableSetupColumn("parameter");
@@ -26,6 +31,7 @@ void parameter_table(const jobs::PipelineResult& r) {
   ImGui::TableSetupColumn("sigma");
   ImGui::TableSetupColumn("change %");
   ImGui::TableSetupColumn("status");
+  if (corr) ImGui::TableSetupColumn("without effect");
   if (seed) ImGui::TableSetupColumn("CMCM (seed)");
   if (sim) ImGui::TableSetupColumn("true (sim)");
   ImGui::TableHeadersRow();
@@ -58,9 +64,16 @@ void parameter_table(const jobs::PipelineResult& r) {
       ImGui::TextUnformatted("ok");
     } else {
       ImGui::TextColored(ImVec4(1.0f, 0.6f, 0.2f, 1.0f), "%s", p.status.c_str());
-      if (ImGui::IsItemHovered() && r.output_error)  // why, and what would pin it
+      if (ImGui::IsItemHovered() && r.output_error && !corr)  // why, and what would pin it
         for (const auto& q : r.output_error->parameters)
           if (q.name == p.name && !q.note.empty()) ImGui::SetTooltip("%s", q.note.c_str());
+    }
+    if (corr) {
+      ImGui::TableNextColumn();
+      if (p.uncorrected)
+        ImGui::Text("%.5g (%s)", *p.uncorrected, p.uncorrected_status.c_str());
+      else
+        ImGui::TextDisabled("-");
     }
     if (seed) {
       ImGui::TableNextColumn();
