@@ -43,6 +43,10 @@ struct Setup {
   std::optional<double> inner_diameter_m, outer_diameter_m, length_m, density_kg_m3;
   std::optional<std::string> material;
   std::optional<std::string> notes;
+  // An extension of piezo-capture/1 (readers ignore what they do not know):
+  // this capture is the held-out partner of the capture of this file name in
+  // the same folder (written by `measure`/`demo` for NAME-heldout.h5).
+  std::optional<std::string> heldout_of;
 
   // The tube geometry with the project's defaults filled in where absent.
   model::TubeGeometry geometry() const;

@@ -363,6 +363,11 @@ Capture read_capture(const fs::path& path, const ReadOptions& opt) {
     s.density_kg_m3 = rd.double_attr(g.get(), "density_kg_m3", "/setup");
     s.material = rd.string_attr(g.get(), "material", "/setup");
     s.notes = rd.string_attr(g.get(), "notes", "/setup");
+    try {  // not in piezo-capture/1: another writer's attribute of that name is ignored, never an error
+      s.heldout_of = rd.string_attr(g.get(), "heldout_of", "/setup");
+    } catch (const CaptureError&) {
+      s.heldout_of.reset();
+    }
     validate_setup(s, file);
   }
 
@@ -451,6 +456,7 @@ CaptureWriter::CaptureWriter(fs::path final_path, const Setup& setup, const Writ
   write_opt(g.get(), "density_kg_m3", setup.density_kg_m3);
   write_opt(g.get(), "material", setup.material);
   write_opt(g.get(), "notes", setup.notes);
+  write_opt(g.get(), "heldout_of", setup.heldout_of);
   impl_->shots = h5::group(H5Gcreate2(f, "shots", H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT));
   if (!impl_->shots) throw std::runtime_error("HDF5: cannot create /shots: " + h5::last_error());
   impl_->flush_to_disk();

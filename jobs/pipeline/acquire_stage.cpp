@@ -68,7 +68,9 @@ acq::Capture acquire_heldout(const PipelineRequest& req, const acq::MeasurementP
   acq::RunnerOptions ro;
   ro.overwrite = true;
   ro.software = "piezobench";
-  auto res = acq::run_measurement(bench, plan, path, ro, {}, &cancel);
+  acq::MeasurementPlan linked = plan;  // the link back to the fit capture (/setup/heldout_of)
+  linked.setup.heldout_of = main.filename().string();
+  auto res = acq::run_measurement(bench, linked, path, ro, {}, &cancel);
   out.heldout_path = res.capture.string();
   out.stages.push_back({"acquire held-out", true, std::to_string(res.shots_written) + " shot(s) into " + out.heldout_path});
   return acq::read_capture(res.capture);

@@ -26,6 +26,7 @@
 #include "jobs/report/batch_summary.hpp"
 #include "jobs/report/capture_report.hpp"
 #include "jobs/report/lot_report.hpp"
+#include "jobs/export/report_export.hpp"
 #include "jobs/json/json_text.hpp"
 #include "jobs/nominal_material.hpp"
 
@@ -182,6 +183,38 @@ std::optional<fs::path> heldout_for(const fs::path& file, const std::string& pat
   return ho;
 }
 
+}  // namespace
+
+std::vector<std::string> effective_holdout_patterns(const std::string& holdout) {
+  if (!holdout.empty()) return {holdout};
+  return {"{stem}-heldout.h5", "{stem}-holdout.h5", "holdout.h5", "heldout.h5"};
+}
+
+std::optional<fs::path> heldout_partner(const fs::path& file, const std::vector<std::string>& patterns) {
+  for (const auto& p : patterns)
+    if (auto ho = heldout_for(file, p)) return ho;
+  return std::nullopt;
+}
+
+std::vector<fs::path> without_heldout_partners(const std::vector<fs::path>& all,
+                                               const std::vector<std::string>& patterns, std::size_t* left_out) {
+  std::set<fs::path> partners;
+  const std::set<fs::path> present(all.begin(), all.end());
+  for (const auto& f : all)
+    if (const auto ho = heldout_partner(f, patterns); ho && present.count(ho->lexically_normal()))
+      partners.insert(ho->lexically_normal());
+  std::vector<fs::path> tubes;
+  for (const auto& f : all)
+    if (!partners.count(f)) tubes.push_back(f);
+  // Every file a partner (a folder of held-out captures alone, or a pattern
+  // that pairs each file with another): nothing would be a tube; replay all.
+  if (tubes.empty()) tubes = all;
+  if (left_out) *left_out = all.size() - tubes.size();
+  return tubes;
+}
+
+namespace {
+
 // ------------------------------------------------------------- one capture
 // Runs in a worker process: everything but the results file. `stage` tells the
 // batch what the worker is doing, so that a crash can be named.
@@ -198,7 +231,7 @@ Outcome replay_capture(const fs::path& file, const ReplayOptions& opt, const Sin
     if (opt.report_dir) {
       try {
         report::write_failed_capture_report(
-            {path, sha, "", out.record.elapsed_s}, msg,
+            {path, sha, "", out.record.elapsed_s, {}, {}}, msg,
             *opt.report_dir / report::capture_report_folder(path, out.key));
       } catch (const std::exception& e) {
         out.report_issue = WireIssue{path, "report", e.what()};
@@ -240,7 +273,7 @@ Outcome replay_capture(const fs::path& file, const ReplayOptions& opt, const Sin
     req.oe_options = opt.oe_options;
     // --jobs workers keep the cores busy already: one thread per fit then.
     if (opt.jobs > 1) req.oe_options.threads = 1;
-    if (const auto ho = heldout_for(file, opt.holdout)) {
+    if (const auto ho = heldout_partner(file, effective_holdout_patterns(opt.holdout))) {
       req.heldout_capture = ho->string();
       req.heldout_optional = true;
     }
@@ -260,8 +293,13 @@ Outcome replay_capture(const fs::path& file, const ReplayOptions& opt, const Sin
   const double elapsed = seconds_since(t0);
   if (opt.report_dir) {
     try {
-      report::write_capture_report(result, {path, sha, material, elapsed},
-                                   *opt.report_dir / report::capture_report_folder(path, out.key));
+      report::CaptureInfo info{path, sha, material, elapsed, {}, {}};
+      if (opt.limits) {  // the capture's own PASS/FAIL on its page (the batch stores the same verdict)
+        const auto v = report::evaluate_result(*opt.limits, jobs::report_json(result));
+        info.limits_status = v.status == "pass" ? "PASS" : v.status == "fail" ? "FAIL" : "ERROR";
+        info.limits_reasons = v.reasons;
+      }
+      report::write_capture_report(result, info, *opt.report_dir / report::capture_report_folder(path, out.key));
     } catch (const std::exception& e) {
       out.issue = WireIssue{path, "report", e.what()};
     }
@@ -527,7 +565,7 @@ class WorkerPool {
     if (opt_.report_dir) {
       try {
         report::write_failed_capture_report(
-            {path, sha, "", elapsed}, msg,
+            {path, sha, "", elapsed, {}, {}}, msg,
             *opt_.report_dir / report::capture_report_folder(path, rec.key));
       } catch (const std::exception& e) {
         sink_.issue({path, "report", e.what()});
@@ -565,10 +603,12 @@ ReplaySummary run_replay(const ReplayOptions& opt, const ReplayCallbacks& cb,
   if (opt.out.empty()) throw std::invalid_argument("replay: --out RESULTS.h5 is required");
   const auto t0 = Clock::now();
   ReplaySummary sum;
-  const auto all = find_captures(opt.inputs, {opt.out, acq::partial_path_for(opt.out)});
-  sum.found = all.size();
-  if (all.empty())
+  const auto found = find_captures(opt.inputs, {opt.out, acq::partial_path_for(opt.out)});
+  sum.found = found.size();
+  if (found.empty())
     throw std::invalid_argument("replay: no capture (*.h5, *.hdf5) found under the given paths");
+  // A capture's held-out partner is part of that tube's record, not a tube.
+  const auto all = without_heldout_partners(found, effective_holdout_patterns(opt.holdout), &sum.heldout_partners);
   const auto mine = select_shard(all, opt.shard);
   if (opt.report_dir) {
     std::error_code ec;

@@ -50,8 +50,10 @@ struct ReplayOptions {
   // Each capture's held-out capture, by name in the capture's folder: "{stem}"
   // stands for the capture's file name without ".h5" (the refsim corpus:
   // "holdout.h5"; piezobench's own demo/measure pairs: "{stem}-heldout.h5").
-  // Empty, missing, or the capture itself: none. A held-out file is also
-  // replayed as a capture of its own.
+  // Empty: piezobench's own pairs and files named holdout/heldout (see
+  // effective_holdout_patterns). Missing, or the capture itself: none. A file
+  // that is another capture's held-out partner is not a tube: it is not
+  // replayed on its own (ReplaySummary::heldout_partners; issue 41).
   std::string holdout;
   std::string software = "piezobench replay";
   // A capture whose worker has not answered after this long is a hang: the
@@ -78,7 +80,10 @@ struct ReplayIssue {
 };
 
 struct ReplaySummary {
-  std::size_t found = 0;  // captures under the inputs (all shards)
+  std::size_t found = 0;  // captures under the inputs (all shards), held-out partners included
+  // Of `found`: files that are another capture's held-out partner (by the
+  // holdout pattern), used by that capture's diagnosis and not replayed as tubes.
+  std::size_t heldout_partners = 0;
   ReplayProgress counts;  // of this shard
   double wall_s = 0;
   bool interrupted = false;
@@ -91,6 +96,23 @@ struct ReplayCallbacks {
   std::function<void(const ReplayProgress&)> progress;  // after each capture, in the batch process
   std::function<void(const ReplayIssue&)> issue;        // as it happens
 };
+
+// The held-out patterns a replay tries, first match wins: `holdout` alone
+// when given; else piezobench's own pairs ("{stem}-heldout.h5", written by
+// `measure`/`demo` with /setup/heldout_of) and a file named for what it is
+// ("{stem}-holdout.h5", "holdout.h5", "heldout.h5" beside the capture).
+std::vector<std::string> effective_holdout_patterns(const std::string& holdout);
+
+// The held-out capture of `file` by the first of `patterns` that names an
+// existing file other than `file` itself.
+std::optional<std::filesystem::path> heldout_partner(const std::filesystem::path& file,
+                                                     const std::vector<std::string>& patterns);
+
+// The captures of `all` that are not another one's held-out partner (order kept),
+// and how many were left out.
+std::vector<std::filesystem::path> without_heldout_partners(const std::vector<std::filesystem::path>& all,
+                                                            const std::vector<std::string>& patterns,
+                                                            std::size_t* left_out);
 
 // Throws std::invalid_argument for bad options or inputs, acq::ResultsError for
 // a results file that cannot be used, std::runtime_error when the results file

@@ -29,12 +29,28 @@ BatchEntry batch_entry(const std::string& key, const nlohmann::json& rec) {
       if (p.contains("name") && p.contains("updated") && p["updated"].is_number())
         e.values.push_back(
             {p["name"].get<std::string>(), p.value("unit", ""), p["updated"].get<double>()});
-  for (const auto& [field, prefix] :
-       {std::pair("resonances_hz", "f_r"), std::pair("antiresonances_hz", "f_a")})
-    if (r.contains(field) && r[field].is_array())
-      for (std::size_t k = 0; k < r[field].size() && k < 3; ++k)
-        if (r[field][k].is_number())
-          e.values.push_back({prefix + std::to_string(k + 1), "Hz", r[field][k].get<double>()});
+  // Frequencies per identified mode (issue 41 item 3): the per-mode figures'
+  // modes in order of frequency — the updated model's electrically active
+  // modes, so "mode 2" is the same mode in every capture — a mode its own
+  // status calls unreliable left out. The raw feature lists (whatever the
+  // estimate found first) only where a capture has no mode figures.
+  const bool modes = r.contains("modes") && r["modes"].is_array() && !r["modes"].empty();
+  if (modes) {
+    for (std::size_t k = 0; k < r["modes"].size() && k < 3; ++k) {
+      const auto& m = r["modes"][k];
+      if (!m.is_object() || m.value("status", std::string("ok")) != "ok") continue;
+      for (const auto& [field, prefix] : {std::pair("fs_hz", "fs_mode"), std::pair("fp_hz", "fp_mode")})
+        if (m.contains(field) && m[field].is_number())
+          e.values.push_back({prefix + std::to_string(k + 1), "Hz", m[field].get<double>()});
+    }
+  } else {
+    for (const auto& [field, prefix] :
+         {std::pair("resonances_hz", "f_r"), std::pair("antiresonances_hz", "f_a")})
+      if (r.contains(field) && r[field].is_array())
+        for (std::size_t k = 0; k < r[field].size() && k < 3; ++k)
+          if (r[field][k].is_number())
+            e.values.push_back({prefix + std::to_string(k + 1) + " (estimate order)", "Hz", r[field][k].get<double>()});
+  }
   return e;
 }
 
@@ -58,7 +74,7 @@ BatchSummary summarize(std::vector<BatchEntry> entries) {
       if (std::none_of(qs.begin(), qs.end(), [&](const auto& q) { return q.name == v.name; }))
         qs.push_back(v);
   std::stable_partition(qs.begin(), qs.end(),
-                        [](const auto& q) { return q.name.rfind("f_", 0) != 0; });
+                        [](const auto& q) { return q.unit != "Hz"; });
   for (const auto& q : qs) {
     Distribution d;
     d.name = q.name;
@@ -81,7 +97,13 @@ BatchSummary summarize(std::vector<BatchEntry> entries) {
 }
 
 std::string capture_report_folder(const std::string& path, const std::string& key) {
-  std::string stem = fs::path(path).stem().string();
+  // The folder it sits in, then its name ("05-fit" for refsim-v1/05/fit.h5: the
+  // case or tube a lot's files are filed under), and the first 8 digits of
+  // the record key (the same name in two places).
+  const fs::path p(path);
+  std::string stem = p.stem().string();
+  const std::string parent = p.parent_path().filename().string();
+  if (!parent.empty() && parent != "." && parent != "..") stem = parent + "-" + stem;
   for (char& c : stem)
     if (!(std::isalnum(static_cast<unsigned char>(c)) || c == '-' || c == '_' || c == '.')) c = '_';
   if (stem.empty()) stem = "capture";

@@ -23,7 +23,8 @@ struct BatchEntry {
     std::string name, unit;
     double value = 0;
   };
-  // Updated parameters in the pipeline's order, then f_r1..3, f_a1..3 (Hz).
+  // Updated parameters in the pipeline's order, then fs_mode1..3, fp_mode1..3
+  // (Hz; the per-mode figures' modes), or f_r1..3, f_a1..3 "(estimate order)" without them.
   std::vector<Value> values;
   const Value* find(const std::string& name) const;
 };

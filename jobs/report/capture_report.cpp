@@ -42,6 +42,12 @@ void make_dir(const fs::path& dir) {
 std::string capture_summary_markdown(const jobs::PipelineResult& r, const CaptureInfo& info) {
   std::ostringstream o;
   header(o, info);
+  if (!info.limits_status.empty()) {
+    o << "## " << info.limits_status << "\n\n";
+    for (const auto& why : info.limits_reasons) o << "- " << cell(why) << "\n";
+    if (!info.limits_reasons.empty()) o << "\n";
+  }
+  if (r.diagnosis) o << "- verdict: **" << cell(r.diagnosis->verdict_effect) << "**\n";
   o << "- shots: " << r.shots << " (" << r.shots_averaged
     << " averaged for the Prony-SS fit, order " << r.order << ")\n\n";
   if (!r.verdict.empty()) o << "**Gap verdict:** " << cell(r.verdict) << "\n\n";

@@ -8,6 +8,7 @@
 // A capture that failed gets a summary.md with the error only.
 #include <filesystem>
 #include <string>
+#include <vector>
 
 #include "jobs/pipeline/pipeline.hpp"
 
@@ -17,6 +18,10 @@ struct CaptureInfo {
   std::string input_path, sha256;
   std::string material;  // the nominal model that was updated
   double elapsed_s = 0;
+  // With acceptance limits: "PASS" / "FAIL" and the failed checks' reasons,
+  // shown at the top of the capture's page (empty: no limits loaded).
+  std::string limits_status;
+  std::vector<std::string> limits_reasons;
 };
 
 std::string capture_summary_markdown(const jobs::PipelineResult& r, const CaptureInfo& info);

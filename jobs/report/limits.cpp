@@ -5,6 +5,7 @@
 #include <cmath>
 #include <cstdio>
 #include <fstream>
+#include <optional>
 #include <sstream>
 
 #include <toml++/toml.h>
@@ -283,6 +284,30 @@ Limits read_limits(const std::filesystem::path& file) {
   return parse_limits(text.str(), file.string());
 }
 
+namespace {
+// A value outside what the quantity can physically be (issue 41 item 3): an
+// estimate that says tan δ < 0, k ≤ 0, C ≤ 0 measured nothing, whatever the
+// limit. By the path's last key, as the report's JSON names them.
+std::optional<std::string> impossible(const std::string& key, double x) {
+  auto has = [&](const char* s) { return key.find(s) != std::string::npos; };
+  auto ends = [&](const char* s) {
+    const std::string t(s);
+    return key.size() >= t.size() && key.compare(key.size() - t.size(), t.size(), t) == 0;
+  };
+  if ((has("tan_delta") || key == "loss_tangent") && !ends("_sigma") && x < 0) return "tan delta below 0 is not physical";
+  if ((key == "k_eff" || key == "k33" || key == "k31" || key == "kp" || key == "kt") && (x <= 0 || x >= 1))
+    return "a coupling factor outside (0, 1) is not physical";
+  if ((has("capacitance") || key == "c0_f" || key == "c1_f") && !ends("_sigma") && x <= 0)
+    return "a capacitance at or below 0 is not physical";
+  if ((key.rfind("qm", 0) == 0) && !ends("_sigma") && key != "qm_inverse" && x <= 0)
+    return "a mechanical Q at or below 0 is not physical";
+  if (ends("_hz") && x <= 0) return "a frequency at or below 0 is not physical";
+  if ((key == "YE11" || key == "epsT33_rel") && x <= 0) return key + " at or below 0 is not physical";
+  if (key == "nu12" && (x <= -1 || x >= 0.5)) return "nu12 outside (-1, 0.5) is not physical";
+  return std::nullopt;
+}
+}  // namespace
+
 LimitCheck check_limit(const Limits& L, std::size_t k, const nlohmann::json& result) {
   const Limit& lim = L.limits.at(k);
   LimitCheck c;
@@ -312,6 +337,16 @@ LimitCheck check_limit(const Limits& L, std::size_t k, const nlohmann::json& res
                                          (lim.numeric() ? "a number" : "a string or boolean") + ")"
                                    : "");
     return c;
+  }
+  if (v->is_number() && !lim.path.empty()) {
+    // The quantity's own name: the last key (parameters.YE11 → YE11, its "updated").
+    std::string key = lim.path.back().key;
+    if (const auto why = impossible(key, v->get<double>())) {
+      c.state = "not measured";
+      c.value = nullptr;
+      c.reason = lim.quantity + " not measured: " + shown(*v) + " (" + *why + ")";
+      return c;
+    }
   }
   c.value = *v;
   if (!lim.numeric()) {

@@ -40,7 +40,7 @@ TEST(BatchSummary, DistributionsOutliersAndFailures) {
   EXPECT_EQ(s.distributions[0].name, "YE11");
   EXPECT_EQ(s.distributions[0].unit, "Pa");
   EXPECT_EQ(s.distributions[1].name, "nu12");
-  EXPECT_EQ(s.distributions[2].name, "f_r1");
+  EXPECT_EQ(s.distributions[2].name, "f_r1 (estimate order)");  // no per-mode figures in these records
   EXPECT_EQ(s.distributions[0].stats.n, 6u);
   ASSERT_EQ(s.distributions[0].outliers.size(), 1u);
   EXPECT_EQ(s.entries[s.distributions[0].outliers[0]].path, "line/T-005.h5");
@@ -48,13 +48,41 @@ TEST(BatchSummary, DistributionsOutliersAndFailures) {
   const std::string md = batch_summary_markdown(s, "R.h5");
   EXPECT_NE(md.find("7 (6 replayed, 1 failed)"), std::string::npos) << md;
   EXPECT_NE(md.find("line/bad.h5: /: truncated"), std::string::npos);
-  EXPECT_NE(md.find("| [line/T-005.h5](captures/T-005-k5/summary.md) | YE11 |"), std::string::npos)
+  EXPECT_NE(md.find("| [line/T-005.h5](captures/line-T-005-k5/summary.md) | YE11 |"), std::string::npos)
       << md;
   EXPECT_EQ(distributions_figure(s).panels.size(), s.distributions.size());
 }
 
 TEST(BatchSummary, ReportFolderNamesAreSafeAndUnique) {
-  EXPECT_EQ(capture_report_folder("a b/T:1.h5", "0123456789abcdef"), "captures/T_1-01234567");
+  // The folder it sits in names the case or tube (refsim-v1/05/fit.h5 → 05-fit).
+  EXPECT_EQ(capture_report_folder("a b/T:1.h5", "0123456789abcdef"), "captures/a_b-T_1-01234567");
+  EXPECT_EQ(capture_report_folder("corpus/05/fit.h5", "d019240d11"), "captures/05-fit-d019240d");
+  EXPECT_EQ(capture_report_folder("T.h5", "0123456789"), "captures/T-01234567");
   EXPECT_NE(capture_report_folder("x/T.h5", "aaaaaaaa11"),
             capture_report_folder("y/T.h5", "bbbbbbbb11"));
+}
+
+// Issue 41 item 3: frequency columns per identified mode (the per-mode
+// figures' modes, the updated model's), never the estimate's raw feature
+// order: a capture whose estimate found a spurious low "resonance" first
+// still files its first radial mode under mode 1; an unreliable mode is left out.
+TEST(BatchSummary, FrequencyColumnsPerIdentifiedMode) {
+  auto rec = [](double spurious, const char* status2) {
+    nlohmann::json r = {{"parameters", nlohmann::json::array()},
+                        {"resonances_hz", {spurious, 50e3, 80e3}},
+                        {"antiresonances_hz", {52e3}},
+                        {"modes",
+                         {{{"fs_hz", 50e3}, {"fp_hz", 53e3}, {"status", "ok"}},
+                          {{"fs_hz", 80e3}, {"fp_hz", 81e3}, {"status", status2}}}},
+                        {"verdict", ""}};
+    return nlohmann::json{{"path", "p.h5"}, {"sha256", "00"}, {"status", "ok"}, {"result", r}};
+  };
+  const auto a = batch_entry("a", rec(16e3, "ok"));
+  const auto b = batch_entry("b", rec(84e3, "unreliable"));
+  ASSERT_NE(a.find("fs_mode1"), nullptr);
+  EXPECT_DOUBLE_EQ(a.find("fs_mode1")->value, 50e3);
+  EXPECT_DOUBLE_EQ(b.find("fs_mode1")->value, 50e3);
+  EXPECT_DOUBLE_EQ(a.find("fp_mode2")->value, 81e3);
+  EXPECT_EQ(b.find("fs_mode2"), nullptr);
+  EXPECT_EQ(a.find("f_r1 (estimate order)"), nullptr);
 }

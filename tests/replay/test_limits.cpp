@@ -223,6 +223,25 @@ TEST(LimitsEvaluation, AQuantityNotMeasuredFailsNeverPasses) {
   EXPECT_EQ(v.reasons[0], "parameters.YE11 not measured (found object, expected a number)");
 }
 
+// Issue 41 item 3: a value the quantity cannot physically take (tan δ < 0,
+// a Q at or below 0, a negative modulus) is not a measurement: it fails as
+// "not measured" even where it lies inside the limit (tan δ −0.13 ≤ max 0.02).
+TEST(LimitsEvaluation, AnImpossibleValueIsNotMeasuredEvenInsideTheLimit) {
+  const Limits L = parse_limits(kValid, "lot.toml");
+  const auto ok = evaluate_result(L, result(6.5e10, 30, 0.0, "none"));
+  EXPECT_EQ(ok.status, "pass");  // tan δ = 0 is possible (no loss)
+  auto r = result(6.5e10, -5, -0.13, "none");
+  const auto v = evaluate_result(L, r);
+  EXPECT_EQ(v.status, "fail");
+  EXPECT_EQ(v.checks[1].state, "not measured");
+  EXPECT_EQ(v.checks[2].state, "not measured");
+  EXPECT_TRUE(v.checks[2].value.is_null());
+  EXPECT_NE(v.checks[2].reason.find("tan delta below 0 is not physical"), std::string::npos) << v.checks[2].reason;
+  EXPECT_NE(v.checks[1].reason.find("mechanical Q"), std::string::npos) << v.checks[1].reason;
+  r = result(-6.5e10, 30, 0.01, "none");  // a limit with no lower bound would pass it
+  EXPECT_EQ(evaluate_result(L, r).checks[0].state, "not measured");
+}
+
 TEST(LimitsEvaluation, AFailedReplayIsAnErrorNotAFail) {
   const Limits L = parse_limits(kValid, "lot.toml");
   const auto v = evaluate_record(

@@ -129,10 +129,11 @@ void register_replay_commands(CLI::App& app, Context& ctx) {
   r->add_flag("--seed-chain", a->seed_chain,
               "Also run the seed's chain (Prony features -> extended CMCM, LM where it fails) beside the "
               "output-error fit; its constants go into parameters[].cmcm");
-  r->add_option("--holdout", a->holdout,
+  r->add_option("--holdout,--holdout-pattern", a->holdout,
                 "Held-out capture beside each capture, by name: {stem} is the capture's name without .h5 "
-                "(e.g. holdout.h5, or {stem}-heldout.h5 for piezobench's own pairs); the diagnosis "
-                "predicts it from its v1");
+                "(e.g. holdout.h5); the diagnosis predicts it from its v1, and it is not replayed as a tube "
+                "of its own. Default: {stem}-heldout.h5 (piezobench's own pairs), {stem}-holdout.h5, "
+                "holdout.h5 or heldout.h5 beside the capture");
   r->add_option("--limits", a->limits,
                 "Acceptance limits (TOML, see README 'Limits and the lot report'): pass/fail per "
                 "capture with the reasons, and the lot summary (counts, distributions, outliers, Cpk)");
@@ -193,6 +194,7 @@ void register_replay_commands(CLI::App& app, Context& ctx) {
       const auto& c = s.counts;
       nlohmann::json j = {{"results", opt.out.string()},
                           {"found", s.found},
+                          {"heldout_partners", s.heldout_partners},
                           {"shard", a->shard},
                           {"total", c.total},
                           {"replayed", c.ok},
@@ -212,6 +214,10 @@ void register_replay_commands(CLI::App& app, Context& ctx) {
       } else {
         std::printf("replay: %zu capture(s) found, %zu in shard %s\n", s.found, c.total,
                     a->shard.c_str());
+        if (s.heldout_partners)
+          std::printf("replay: %zu of them held-out partners of another capture (used by its diagnosis, "
+                      "not counted as tubes)\n",
+                      s.heldout_partners);
         std::printf(
             "replay: %zu replayed, %zu failed, %zu done before%s; %.1f s, %.2f captures/s "
             "with --jobs %zu\n",
