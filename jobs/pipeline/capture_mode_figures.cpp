@@ -1,5 +1,6 @@
 #include "jobs/pipeline/capture_mode_figures.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <numbers>
 #include <stdexcept>
@@ -82,6 +83,20 @@ CaptureModeFigures model_mode_figures(const acq::Capture& cap, const CaptureMode
     m.frequency_constant_hz_m = {c.fs_hz.value * out.mean_diameter_m, c.fs_hz.sigma * out.mean_diameter_m};
     m.window_lo_hz = c.window_lo_hz;
     m.window_hi_hz = c.window_hi_hz;
+    if (!(m.window_hi_hz > m.window_lo_hz) && c.fs_hz.value > 0) {
+      // The model's mode has no fit window: its resonance neighbourhood, the
+      // wider of fs-fp and the -3 dB bandwidth, 1.5 times on each side (the
+      // admittance-plane plot draws the estimate and the branch there).
+      const double fs = c.fs_hz.value, fp = std::isfinite(c.fp_hz.value) ? c.fp_hz.value : fs;
+      const double bw = c.qm_branch.value > 0 ? fs / c.qm_branch.value : 0.0;
+      const double w = 1.5 * std::max(fp - fs, bw);
+      if (w > 0) {
+        m.window_lo_hz = std::max(0.5 * fs, fs - w);
+        m.window_hi_hz = fp + w;
+      }
+    }
+    // The branch itself (the admittance-plane plot, jobs/mode_nyquist.hpp).
+    m.fit.p = {c.r1_ohm.value, c.l1_h.value, c.c1_f.value, mf.c0_f.value};
     m.fit.converged = r.ok();
     m.fit.weighted = true;
     m.fit.chi2_per_dof = r.chi2_per_dof;  // the output-error fit's, of the samples

@@ -92,7 +92,10 @@ MergeSummary merge_results(const MergeOptions& opt) {
                          [&](const acq::ResultRecord& r) { f << jobs::json_text(record_json(r)) << "\n"; });
     if (!f.flush()) throw std::runtime_error("--jsonl: cannot write " + opt.jsonl->string());
   }
-  if (opt.report_dir) write_batch_summary(opt.out, *opt.report_dir);
+  if (opt.report_dir) {
+    write_batch_summary(opt.out, *opt.report_dir);
+    write_index(opt.out, *opt.report_dir);
+  }
   return sum;
 }
 

@@ -1,5 +1,6 @@
 #include "jobs/replay/replay_batch.hpp"
 
+#include <algorithm>
 #include <chrono>
 #include <fstream>
 #include <map>
@@ -25,6 +26,7 @@
 #include "jobs/replay/sha256.hpp"
 #include "jobs/report/batch_summary.hpp"
 #include "jobs/report/capture_report.hpp"
+#include "jobs/report/index_html.hpp"
 #include "jobs/report/lot_report.hpp"
 #include "jobs/export/report_export.hpp"
 #include "jobs/json/json_text.hpp"
@@ -647,6 +649,7 @@ ReplaySummary run_replay(const ReplayOptions& opt, const ReplayCallbacks& cb,
     sum.lot = summarize_lot_file(opt.out, *opt.limits);
     if (opt.report_dir) report::write_lot_report(*opt.limits, *sum.lot, opt.out.string(), *opt.report_dir);
   }
+  if (opt.report_dir) write_index(opt.out, *opt.report_dir);
   return sum;
 }
 
@@ -656,6 +659,15 @@ report::LotSummary summarize_lot_file(const fs::path& results, const report::Lim
     records.push_back({r.input_path, r.key, record_json(r)});
   });
   return report::summarize_lot(limits, std::move(records));
+}
+
+void write_index(const fs::path& results, const fs::path& report_dir) {
+  std::vector<std::pair<std::string, nlohmann::json>> records;
+  acq::for_each_result(results, [&](const acq::ResultRecord& r) { records.emplace_back(r.key, record_json(r)); });
+  std::sort(records.begin(), records.end(), [](const auto& a, const auto& b) {
+    return a.second.value("path", std::string()) < b.second.value("path", std::string());
+  });
+  report::write_index_html(records, results.string(), report_dir);
 }
 
 void write_batch_summary(const fs::path& results, const fs::path& report_dir) {

@@ -120,6 +120,9 @@ std::vector<std::filesystem::path> without_heldout_partners(const std::vector<st
 ReplaySummary run_replay(const ReplayOptions& opt, const ReplayCallbacks& cb,
                          const std::atomic<bool>& cancel);
 
+// report_dir/index.html of everything in a results file (report/index_html.hpp).
+void write_index(const std::filesystem::path& results, const std::filesystem::path& report_dir);
+
 // The batch summary of everything in a results file (report/batch_summary.hpp).
 void write_batch_summary(const std::filesystem::path& results,
                          const std::filesystem::path& report_dir);

@@ -129,6 +129,19 @@ TEST(CliReplay, BatchReportsAndSkipsACorruptedCaptureWritesReportsAndResumes) {
   EXPECT_NE(ss.str().find("5 (4 replayed, 1 failed)"), std::string::npos) << ss.str();
   EXPECT_NE(ss.str().find("| YE11 | Pa | 4 |"), std::string::npos) << ss.str();
   EXPECT_TRUE(fs::exists(rep / "distributions.svg"));
+  // One self-contained page (issue 41 item 3): a row per capture linking its
+  // folder, the batch plot inline, and no limits loaded said as such.
+  std::ifstream html_in(rep / "index.html");
+  std::stringstream hs;
+  hs << html_in.rdbuf();
+  const std::string html = hs.str();
+  EXPECT_NE(html.find("<svg"), std::string::npos);
+  EXPECT_NE(html.find("No limits loaded"), std::string::npos);
+  EXPECT_NE(html.find("/summary.md\">" + bad + "</a>"), std::string::npos) << html.substr(0, 2000);
+  EXPECT_NE(html.find("failed: "), std::string::npos);
+  std::size_t rows = 0;
+  for (auto p = html.find("<tr><td>"); p != std::string::npos; p = html.find("<tr><td>", p + 1)) ++rows;
+  EXPECT_EQ(rows, 5u);
 
   // Run again: the finished captures are recognised by path + SHA-256 and
   // skipped, the refused one is tried (and refused) again.
