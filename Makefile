@@ -9,7 +9,7 @@ ifeq ($(CI),true)
   CMAKEFLAGS += -DPIEZO_WERROR=ON
 endif
 
-.PHONY: all deps configure build demo test test-asan bench validate clean fixtures
+.PHONY: all deps configure build demo test test-asan bench validate clean fixtures screenshots
 
 all: build
 
@@ -42,6 +42,10 @@ bench: build
 
 validate: build
 	cd $(BUILD) && ctest --output-on-failure -L validate
+
+# The GUI's screenshots in docs/ (headless, xvfb-run): scripts/gui-screenshots.sh.
+screenshots: build
+	bash scripts/gui-screenshots.sh $(BUILD)
 
 fixtures: deps
 	/usr/bin/python3 fixtures/make_fixtures.py fixtures

@@ -5,6 +5,10 @@
 // diagnosis window.
 #include "ui/gui/windows.hpp"
 
+#include <cmath>
+
+#include "jobs/text/uncertain_text.hpp"
+
 namespace piezo::gui {
 
 namespace {
@@ -19,18 +23,27 @@ void parameter_table(const jobs::PipelineResult& r) {
                                                          : "least squares on the seed's features (sigma from them)";
   const bool corr = r.corrected.has_value();
   if (corr) {  // the result is the model refitted with the effect the diagnosis named
-    ImGui::TextColored(ImVec4(0.4f, 0.8f, 1.0f, 1.0f), "Result %s", r.corrected->label.c_str());
-    ImGui::TextDisabled("(\"without effect\": the update's constants before the diagnosis)");
+    ImGui::PushStyleColor(ImGuiCol_Text, ImVec4(0.4f, 0.8f, 1.0f, 1.0f));
+    ImGui::TextWrapped("Result %s; \"without effect\": the update's constants before the diagnosis",
+                       r.corrected->label.c_str());
+    ImGui::PopStyleColor();
   }
-  const int cols = 6 + (seed ? 1 : 0) + (sim ? 1 : 0) + (corr ? 1 : 0);
-  if (!ImGui::BeginTable("params", cols, ImGuiTableFlags_Borders | ImGuiTableFlags_RowBg))
+  // Columns sized to their content (value and sigma in one cell, σ to two
+  // significant digits), a horizontal scroll bar where the panel is narrower.
+  const int cols = 5 + (seed ? 1 : 0) + (sim ? 1 : 0) + (corr ? 1 : 0);
+  const float rows_h = ImGui::GetTextLineHeightWithSpacing() * static_cast<float>(r.params.size() + 1) +
+                       ImGui::GetStyle().ScrollbarSize + 6.0f;
+  if (!ImGui::BeginTable("params", cols,
+                         ImGuiTableFlags_Borders | ImGuiTableFlags_RowBg | ImGuiTableFlags_SizingFixedFit |
+                             ImGuiTableFlags_ScrollX | ImGuiTableFlags_NoHostExtendX,
+                         ImVec2(0, rows_h)))
     return;
-  ImGui::TableSetupColumn("parameter");
-  ImGui::TableSetupColumn("original");
-  ImGui::TableSetupColumn("updated");
-  ImGui::TableSetupColumn("sigma");
-  ImGui::TableSetupColumn("change %");
+  ImGui::TableSetupScrollFreeze(1, 0);
+  ImGui::TableSetupColumn("parameter [unit]");
+  ImGui::TableSetupColumn("updated ± sigma");
   ImGui::TableSetupColumn("status");
+  ImGui::TableSetupColumn("change %");
+  ImGui::TableSetupColumn("original");
   if (corr) ImGui::TableSetupColumn("without effect");
   if (seed) ImGui::TableSetupColumn("CMCM (seed)");
   if (sim) ImGui::TableSetupColumn("true (sim)");
@@ -40,9 +53,9 @@ void parameter_table(const jobs::PipelineResult& r) {
     ImGui::TableNextColumn();
     ImGui::Text("%s [%s]", p.name.c_str(), p.unit.c_str());
     ImGui::TableNextColumn();
-    ImGui::Text("%.5g", p.original);
-    ImGui::TableNextColumn();
-    ImGui::Text("%.5g", p.updated);
+    const double rel = p.sigma ? 100.0 * *p.sigma / std::abs(p.updated) : NAN;
+    ImGui::Text("%s%s", jobs::format_uncertain(p.updated, p.sigma.value_or(NAN), {}, {true}).c_str(),
+                std::isfinite(rel) ? (" (" + jobs::format_value(rel, "%", 2) + ")").c_str() : "");
     if (ImGui::IsItemHovered()) {
       if (r.output_error && r.output_error->ok())
         ImGui::SetTooltip("%s\ncorr(nu12, d31) %+.2f, chi2/dof %.3g (limit %.3g), %s", method,
@@ -53,13 +66,6 @@ void parameter_table(const jobs::PipelineResult& r) {
         ImGui::SetTooltip("%s", method);
     }
     ImGui::TableNextColumn();
-    if (p.sigma)
-      ImGui::Text("%.2g (%.2f %%)", *p.sigma, 100.0 * *p.sigma / std::abs(p.updated));
-    else
-      ImGui::TextDisabled("-");
-    ImGui::TableNextColumn();
-    ImGui::Text("%+.2f", p.original != 0 ? 100.0 * (p.updated - p.original) / p.original : 0.0);
-    ImGui::TableNextColumn();
     if (p.status == "ok") {
       ImGui::TextUnformatted("ok");
     } else {
@@ -68,10 +74,16 @@ void parameter_table(const jobs::PipelineResult& r) {
         for (const auto& q : r.output_error->parameters)
           if (q.name == p.name && !q.note.empty()) ImGui::SetTooltip("%s", q.note.c_str());
     }
+    ImGui::TableNextColumn();
+    ImGui::Text("%+.2f", p.original != 0 ? 100.0 * (p.updated - p.original) / p.original : 0.0);
+    ImGui::TableNextColumn();
+    ImGui::Text("%.5g", p.original);
     if (corr) {
       ImGui::TableNextColumn();
       if (p.uncorrected)
-        ImGui::Text("%.5g (%s)", *p.uncorrected, p.uncorrected_status.c_str());
+        ImGui::Text("%s (%s)",
+                    jobs::format_uncertain(*p.uncorrected, p.uncorrected_sigma.value_or(NAN), {}, {true}).c_str(),
+                    p.uncorrected_status.c_str());
       else
         ImGui::TextDisabled("-");
     }
@@ -126,10 +138,16 @@ void disturbances_block(const update::OeResult& o) {
 // Pass / fail against the loaded limits, with one line per reason.
 void limits_line(const jobs::report::CaptureVerdict& v, const std::string& file) {
   const bool pass = v.status == "pass";
-  ImGui::TextColored(pass ? ImVec4(0.4f, 1.0f, 0.4f, 1) : ImVec4(1.0f, 0.4f, 0.4f, 1), "Limits: %s",
-                     pass ? "PASS" : "FAIL");
+  // A banner a technician reads across the bench: white on green or red, twice the text size.
+  ImGui::PushStyleColor(ImGuiCol_Button, pass ? ImVec4(0.15f, 0.55f, 0.2f, 1) : ImVec4(0.75f, 0.15f, 0.15f, 1));
+  ImGui::PushStyleColor(ImGuiCol_ButtonHovered, pass ? ImVec4(0.15f, 0.55f, 0.2f, 1) : ImVec4(0.75f, 0.15f, 0.15f, 1));
+  ImGui::PushStyleColor(ImGuiCol_ButtonActive, pass ? ImVec4(0.15f, 0.55f, 0.2f, 1) : ImVec4(0.75f, 0.15f, 0.15f, 1));
+  ImGui::SetWindowFontScale(2.0f);
+  ImGui::Button(pass ? "  PASS  " : "  FAIL  ");
+  ImGui::SetWindowFontScale(1.0f);
+  ImGui::PopStyleColor(3);
   ImGui::SameLine();
-  ImGui::TextDisabled("(%s)", file.c_str());
+  ImGui::TextDisabled("limits: %s", file.c_str());
   for (const auto& reason : v.reasons) ImGui::TextColored(ImVec4(1.0f, 0.6f, 0.5f, 1), "  %s", reason.c_str());
 }
 }  // namespace
@@ -154,7 +172,10 @@ void render_results_window(AppState& s) {
   } else if (s.result) {
     const auto& r = *s.result;
     ImGui::TextWrapped("Capture: %s (%d shots)", r.capture_path.c_str(), r.shots);
-    if (s.verdict) limits_line(*s.verdict, s.limits ? s.limits->source : std::string());
+    if (s.verdict)
+      limits_line(*s.verdict, s.limits ? s.limits->source : std::string());
+    else
+      ImGui::TextColored(ImVec4(1.0f, 0.8f, 0.3f, 1), "No limits loaded: no pass/fail (Limits...)");
     if (r.params.empty())
       ImGui::TextDisabled("No updated parameters (see the stages below).");
     else
