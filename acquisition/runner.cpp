@@ -114,13 +114,27 @@ RunResult run_measurement(Bench& bench, const MeasurementPlan& plan, const std::
             dc.range_v[1] = channel_range_for(probe.v2, dc.range_v[0]);
           }
         }
-        bench.daq->configure(dc);
-        report("acquire");
-        bench.daq->arm();
-        bench.awg->output(true);
-        bench.awg->trigger();
-        report("fetch");
-        drivers::DaqRecord r = bench.daq->fetch(opt.fetch_timeout_s);
+        drivers::DaqRecord r;
+        for (int attempt = 0;; ++attempt) {
+          bench.daq->configure(dc);
+          report("acquire");
+          bench.daq->arm();
+          bench.awg->output(true);
+          bench.awg->trigger();
+          report("fetch");
+          r = bench.daq->fetch(opt.fetch_timeout_s);
+          // An autoranged standard's channel 2 clipped: the probe saw this
+          // bench's offset and hum at one instant, the shot at another (the
+          // hum's phase, 1/f wander). The next range up, and the shot again
+          // (not stored), up to the drive's own range.
+          if (phase.role == Role::Dut || !opt.autorange_standards || attempt >= 4 || dc.range_v[1] >= dc.range_v[0])
+            break;
+          dsp::ClipDetection c2;
+          c2.range_v = r.range_v[1];
+          if (!dsp::compute_stats(r.v2, c2).clipped) break;
+          dc.range_v[1] = channel_range_for({1.4 * dc.range_v[1]}, dc.range_v[0]);
+          report("range " + std::string(to_string(phase.role)) + " raised");
+        }
 
         Shot s;
         s.sample_rate_hz = r.sample_rate_hz;
@@ -161,7 +175,7 @@ RunResult run_measurement(Bench& bench, const MeasurementPlan& plan, const std::
             bench.awg->output(false);
             writer.close();
             throw RunError(shot_label(k, res.shots_planned) + " clipped: a channel reached the DAQ range of ±" +
-                               std::to_string(dc.range_v[0]) +
+                               std::to_string(dsp::compute_stats(s.v1, clip1).clipped ? dc.range_v[0] : dc.range_v[1]) +
                                " V. The shot is stored (flagged); raise the range or lower the amplitude. " +
                                std::to_string(res.shots_written) + " shot(s) are in " + out.string(),
                            res);
