@@ -8,12 +8,20 @@ updated (output-error fit) and the disturbed one diagnosed. Prints per tube
 the constants' errors, the sigma ratio disturbed/clean and the verdict, then
 the acceptance counts.
 
-usage: scripts/disturbance-study.py BUILD/ui/piezobench WORKDIR [N]
+Widened (issue 40 item 4), with a shot count: K shots per capture, and what
+another bench does differently besides: each shot's own offset per channel
+(offset_shot, 0.5-3 mV), hum at its own phase per shot and channel, 1/f
+noise independent per shot, 50 or 60 Hz, and every other tube recorded
+longer than a mains cycle (25 ms at 2 MS/s) instead of 2 ms at 10 MS/s.
+
+usage: scripts/disturbance-study.py BUILD/ui/piezobench WORKDIR [N] [SHOTS]
 """
 import json, math, os, random, subprocess, sys
 
 exe, work = sys.argv[1], sys.argv[2]
 n = int(sys.argv[3]) if len(sys.argv) > 3 else 20
+shots = int(sys.argv[4]) if len(sys.argv) > 4 else 1
+wide = len(sys.argv) > 4  # the widened study (issue 40): see the docstring
 os.makedirs(work, exist_ok=True)
 rng = random.Random(33)
 NOM = {"YE11": 6.66e10, "nu12": 0.3333, "d31": -2.1e-10, "epsT33_rel": 2294.0}  # apc850 isotropic class (sim truth names)
@@ -66,11 +74,16 @@ while len(rows) < n:
     seed = 1000 + k
     sset = ",".join("%s=%.6g" % (key, v) for key, v in truth.items())
     dist = "offset=%.4f,hum=%.4f,mains=%d,pink=1" % (off, hum, mains)
+    record = []
+    if wide:
+        dist += ",offset_shot=%.4f" % rng.uniform(0.0005, 0.003)
+        if k % 2:
+            record = ["--rate", "2e6", "--samples", "50000"]  # 25 ms: longer than a mains cycle
     res = {}
     for tag, extra in (("clean", []), ("dist", ["--disturbance", dist])):
         cap = os.path.join(work, "t%02d-%s.h5" % (k, tag))
-        p = run(["measure", "--shots", "1", "--noise", "%.4f" % noise, "--seed", str(seed), "--sim-isotropic", "--sim-set", sset,
-                 "--out", cap, "--overwrite"] + extra)
+        p = run(["measure", "--shots", str(shots), "--noise", "%.4f" % noise, "--seed", str(seed), "--sim-isotropic",
+                 "--sim-set", sset, "--out", cap, "--overwrite"] + record + extra)
         if p.returncode != 0:
             break
         u = run(["update", cap, "--json"])
@@ -103,8 +116,8 @@ while len(rows) < n:
     row["chi2_clean"] = res["clean"]["fit"]["chi2_per_dof"]
     row["baseline"] = res["dist"]["fit"].get("baseline", {})
     rows.append(row)
-    print("%2d noise %.1f%% hum %.1f mV %d Hz | err %s (clean %s) %s | sigma ratio %s | chi2 %.2f (clean %.2f) | %s" % (
-        k, noise * 100, hum * 1e3, mains,
+    print("%2d %s noise %.1f%% hum %.1f mV %d Hz | err %s (clean %s) %s | sigma ratio %s | chi2 %.2f (clean %.2f) | %s" % (
+        k, "%d shot(s)%s" % (shots, " 25 ms" if record else ""), noise * 100, hum * 1e3, mains,
         " ".join("%s %+.2f" % (a, b) for a, b in row["err"].items()),
         " ".join("%+.2f" % b for b in row["err_clean"].values()), ",".join(s[:2] for s in row["status"]),
         " ".join("%.2f" % v for v in row["ratio"].values()), row["chi2"], row["chi2_clean"], vname), flush=True)

@@ -39,7 +39,7 @@ std::string fmt(double v) {
 }  // namespace
 
 bool Disturbances::any() const {
-  return offset_v != 0.0 || hum_v != 0.0 || pink_rel != 0.0 || changes_dut() ||
+  return offset_v != 0.0 || offset_shot_v != 0.0 || hum_v != 0.0 || pink_rel != 0.0 || changes_dut() ||
          jitter_samples != 0.0;
 }
 
@@ -48,6 +48,7 @@ void Disturbances::validate() const {
     if (!ok) throw std::invalid_argument(std::string("Disturbances: ") + what);
   };
   need(std::isfinite(offset_v) && offset_v >= 0, "offset_v must be finite and >= 0");
+  need(std::isfinite(offset_shot_v) && offset_shot_v >= 0, "offset_shot_v must be finite and >= 0");
   need(std::isfinite(hum_v) && hum_v >= 0, "hum_v must be finite and >= 0");
   need(mains_hz == 50.0 || mains_hz == 60.0, "mains_hz must be 50 or 60");
   need(std::isfinite(pink_rel) && pink_rel >= 0, "pink_rel must be finite and >= 0");
@@ -73,11 +74,13 @@ Disturbances parse_disturbances(const std::string& text) {
     if (eq == std::string::npos) bad("'" + item + "': expected KEY=VALUE");
     const std::string key = trim(item.substr(0, eq)), value = trim(item.substr(eq + 1));
     if (!seen.insert(key).second) bad("'" + key + "' is given twice");
-    if (key == "offset" || key == "hum" || key == "pink" || key == "jitter") {
+    if (key == "offset" || key == "offset_shot" || key == "hum" || key == "pink" || key == "jitter") {
       const double v = number(key, value);
       if (v < 0) bad("'" + key + "': '" + value + "' must be >= 0");
       if (key == "offset")
         d.offset_v = v;
+      else if (key == "offset_shot")
+        d.offset_shot_v = v;
       else if (key == "hum")
         d.hum_v = v;
       else if (key == "pink")
@@ -105,7 +108,7 @@ Disturbances parse_disturbances(const std::string& text) {
       d.step_rel = v / 100.0;
       d.step_after_shot = static_cast<int>(s);
     } else {
-      bad("unknown key '" + key + "' (offset, hum, mains, pink, drift, step, jitter)");
+      bad("unknown key '" + key + "' (offset, offset_shot, hum, mains, pink, drift, step, jitter)");
     }
   }
   d.validate();
@@ -116,6 +119,7 @@ std::string to_string(const Disturbances& d) {
   std::string s;
   auto add = [&](const std::string& item) { s += (s.empty() ? "" : ",") + item; };
   if (d.offset_v != 0) add("offset=" + fmt(d.offset_v));
+  if (d.offset_shot_v != 0) add("offset_shot=" + fmt(d.offset_shot_v));
   if (d.hum_v != 0) add("hum=" + fmt(d.hum_v) + ",mains=" + fmt(d.mains_hz));
   if (d.pink_rel != 0) add("pink=" + fmt(100.0 * d.pink_rel));
   if (d.drift_rel != 0) add("drift=" + fmt(100.0 * d.drift_rel));

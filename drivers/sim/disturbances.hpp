@@ -24,6 +24,10 @@ struct Disturbances {
   // ±[0.5, 1]·offset_v (random sign); the same for every shot of the bench,
   // as a real scope's offset is until it is recalibrated. Volts, >= 0.
   double offset_v = 0.0;
+  // Another bench's offsets (issue 40): each shot's, per channel, moved by a
+  // further uniform ±offset_shot_v drawn per shot (AC-coupled front ends,
+  // auto-zero between shots). Volts, >= 0; key "offset_shot".
+  double offset_shot_v = 0.0;
   // Mains pickup, amplitude (peak) of the fundamental on each channel, volts:
   // hum_v·[sin θ + 0.30·sin 2θ + 0.15·sin 3θ], θ = 2π·mains_hz·t + φ, with φ
   // uniform in [0, 2π) drawn per channel and per shot (shots are not

@@ -122,7 +122,12 @@ ShotDisturbances SimBench::draw_disturbances() {
 
 std::vector<double> SimBench::additive_disturbance(int ch, const ShotDisturbances& sd,
                                                    const std::vector<double>& t, double clean_std) {
-  std::vector<double> a(t.size(), offset_v_[ch]);
+  double off = offset_v_[ch];
+  if (dist_.offset_shot_v > 0) {  // this shot's own, per channel
+    std::uniform_real_distribution<double> u(-dist_.offset_shot_v, dist_.offset_shot_v);
+    off += u(dist_rng_);
+  }
+  std::vector<double> a(t.size(), off);
   if (dist_.hum_v > 0)
     for (std::size_t k = 0; k < t.size(); ++k)
       a[k] += dist_.hum_v * mains_waveform(t[k], dist_.mains_hz, sd.hum_phase_rad[ch]);

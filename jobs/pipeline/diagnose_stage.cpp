@@ -171,7 +171,15 @@ void diagnose_stage(const PipelineRequest& req, const acq::Capture& cap, const C
     ho_shots = odd;
     ho_what = "held-out odd-numbered shots";
   }
-  if (fit_shots.size() < 3 || (heldout_cap && ho_shots.size() < 3)) {
+  // Shots that differ by a real bench's slow disturbances (each its own
+  // offset, hum phase, 1/f wander; issue 40 item 3): Z(f) of the repeats
+  // carries them into its "noise" and its residual, which the output-error
+  // model takes as nuisance (baseline projected out, 1/f weighted): the
+  // diagnosis runs there, as for one or two shots.
+  const bool disturbed = out.output_error && out.output_error->ok() &&
+                         (out.output_error->baseline.modelled || out.output_error->baseline.pink ||
+                          out.output_error->noise_source.find("slow disturbances") != std::string::npos);
+  if (fit_shots.size() < 3 || (heldout_cap && ho_shots.size() < 3) || disturbed) {
     // One or two shots: the noise of Z(f) cannot be measured from repeats
     // (nor is it Gaussian per bin at a few percent): the diagnosis runs in the
     // output-error model instead, each effect a sixth parameter of the fit —

@@ -27,7 +27,7 @@ void register_demo_command(CLI::App& app, Context& ctx) {
   demo->add_option("--effect", a->effects, "Bench effect the simulated bench adds and the model lacks, NAME=VALUE (repeatable)");
   demo->add_option(
       "--disturbance", a->disturbances,
-      "A real bench's slow disturbances on the simulated bench: offset=V,hum=V[,mains=50|60],"
+      "A real bench's slow disturbances on the simulated bench: offset=V,offset_shot=V,hum=V[,mains=50|60],"
       "pink=PCT,drift=PCT,step=PCT@SHOT,jitter=SAMPLES (any subset; acquisition/README.md)");
   demo->add_flag("--no-diagnose", a->no_diagnose, "Stop after the update");
   demo->add_option("--calibrate", a->calibrate,

@@ -45,7 +45,7 @@ void add_sim_options(CLI::App* cmd, SimOptions& o) {
   cmd->add_option("--effect", o.effects, "Simulated bench effect NAME=VALUE (repeatable)");
   cmd->add_option(
       "--disturbance", o.disturbance,
-      "Simulated bench's slow disturbances: offset=V,hum=V[,mains=50|60],pink=PCT,drift=PCT,"
+      "Simulated bench's slow disturbances: offset=V,offset_shot=V,hum=V[,mains=50|60],pink=PCT,drift=PCT,"
       "step=PCT@SHOT,jitter=SAMPLES (any subset; acquisition/README.md)");
   cmd->add_option("--sim-material", o.material, "Simulated transducer's material preset")->capture_default_str();
   cmd->add_flag("--sim-isotropic", o.isotropic, "Simulated transducer in the seed's isotropic class");
