@@ -1,3 +1,4 @@
+#include "dsp/probability_text.hpp"
 #include "dsp/divider_baseline.hpp"
 
 #include <Eigen/Dense>
@@ -308,10 +309,10 @@ DividerBaseline estimate_divider_baseline(const DividerRecord& rec, const Divide
   char buf[240];
   std::snprintf(buf, sizeof buf,
                 "channel 1 - channel 2 baseline %s: rms %.3g V (mean %.3g V, slope %.3g V/s%s), delta chi2 %.1f on "
-                "%d dof (chance 1e%.1f) in the bins up to %.0f Hz",
+                "%d dof (chance %s) in the bins up to %.0f Hz",
                 out.found ? "found" : "not significant", out.rms_v, out.offset_v, out.slope_v_per_s,
                 out.mains_hz > 0 ? (", " + std::to_string(static_cast<int>(out.mains_hz)) + " Hz hum").c_str() : "",
-                out.delta_chi2, out.dof, out.log10_p, out.band_hz);
+                out.delta_chi2, out.dof, probability_text(out.log10_p).c_str(), out.band_hz);
   out.note = buf;
   if (!out.found) out.samples.clear();
   return out;

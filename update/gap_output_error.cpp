@@ -1,3 +1,4 @@
+#include "dsp/probability_text.hpp"
 #include "update/gap_output_error.hpp"
 
 #include <algorithm>
@@ -59,9 +60,9 @@ std::vector<std::string> disturbance_findings(const OeBaseline& b) {
     }
     std::snprintf(buf, sizeof buf,
                   "Baseline wander between the channels (offset, slope to degree %d%s): projected out of the residual "
-                  "(it took chi2 %.0f for %d parameters, chance %s1e%.0f under white noise); slope %.3g +/- %.2g V/s.",
-                  b.poly_degree, b.harmonics > 0 ? ", hum" : "", b.delta_chi2, b.dof, b.log10_p < -300 ? "below " : "",
-                  std::max(b.log10_p, -300.0), b.slope_v_per_s, b.slope_sigma_v_per_s);
+                  "(it took chi2 %.0f for %d parameters, chance %s under white noise); slope %.3g +/- %.2g V/s.",
+                  b.poly_degree, b.harmonics > 0 ? ", hum" : "", b.delta_chi2, b.dof,
+                  dsp::probability_text(b.log10_p).c_str(), b.slope_v_per_s, b.slope_sigma_v_per_s);
     out.push_back(std::string(buf) + hum);
   }
   if (b.pink) {
@@ -222,8 +223,8 @@ GapDiagnosis build(const OeResult& r, const std::string& fit_description, const 
     d.verdict_effect = "none";
     std::snprintf(buf, sizeof buf,
                   "No gap: the updated model explains the capture within its noise (output-error chi2/dof %.2f, "
-                  "band test 1e%.1f).",
-                  r.chi2_per_dof, r.band_log10_p);
+                  "band test chance %s).",
+                  r.chi2_per_dof, dsp::probability_text(r.band_log10_p).c_str());
     d.verdict = buf + heldout_note;
   } else if (top) {
     d.verdict_effect = top->name;
@@ -272,9 +273,9 @@ GapDiagnosis build(const OeResult& r, const std::string& fit_description, const 
                     "the held-out data.", r.chi2_per_dof);
     else
       std::snprintf(buf, sizeof buf,
-                    "Unexplained gap in %.3g-%.3g kHz (residual %.3g times the noise there, chance 1e%.1f): no effect "
+                    "Unexplained gap in %.3g-%.3g kHz (residual %.3g times the noise there, chance %s): no effect "
                     "of the catalogue explains it.",
-                    r.band_lo_hz / 1e3, r.band_hi_hz / 1e3, r.band_excess, r.band_log10_p);
+                    r.band_lo_hz / 1e3, r.band_hi_hz / 1e3, r.band_excess, dsp::probability_text(r.band_log10_p).c_str());
     const std::string where = located_sentence(d.regions, regions_heldout ? "held-out prediction" : "residual");
     d.verdict = buf + where + near + heldout_note;
   }

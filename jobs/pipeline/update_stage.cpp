@@ -6,6 +6,7 @@
 #include <cstdio>
 #include <map>
 
+#include "dsp/probability_text.hpp"
 #include "acquisition/contained_read.hpp"
 #include "acquisition/capture_file.hpp"
 #include "jobs/pipeline/stages.hpp"
@@ -218,8 +219,9 @@ std::optional<update::OeResult> output_error_stage(const PipelineRequest& req, c
       else
         std::snprintf(w, sizeof w,
                       "the output-error fit does not explain the capture in %.3g-%.3g kHz (residual %.3g times "
-                      "the noise there, chance 1e%.1f)",
-                      r.band_lo_hz / 1e3, r.band_hi_hz / 1e3, r.band_excess, r.band_log10_p);
+                      "the noise there, chance %s)",
+                      r.band_lo_hz / 1e3, r.band_hi_hz / 1e3, r.band_excess,
+                      dsp::probability_text(r.band_log10_p).c_str());
       out.warnings.push_back(std::string(w) +
                              ": its constants are marked not identifiable; the gap diagnosis looks for the cause");
     }

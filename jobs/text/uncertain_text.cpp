@@ -1,5 +1,7 @@
 #include "jobs/text/uncertain_text.hpp"
 
+#include "dsp/probability_text.hpp"
+
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -90,11 +92,6 @@ std::string format_si(double value, double sigma, std::string_view base_unit, co
   return format_uncertain(value / scale, std::isfinite(sigma) ? sigma / scale : sigma, unit, style);
 }
 
-std::string format_probability_log10(double log10_p) {
-  if (std::isnan(log10_p)) return kDash;
-  if (log10_p >= 0) return "1";
-  if (log10_p < -300) return "< 1e-300";
-  return general(std::pow(10.0, log10_p), 2);
-}
+std::string format_probability_log10(double log10_p) { return dsp::probability_text(log10_p); }
 
 }  // namespace piezo::jobs

@@ -9,6 +9,7 @@
 // freedom; per constant, a line over the shot index (drift) and the best
 // split into two means (step) are each compared with a constant by the χ²
 // they remove.
+#include "dsp/probability_text.hpp"
 #include "update/output_error/shot_consistency.hpp"
 
 #include <Eigen/Dense>
@@ -194,8 +195,8 @@ OeShotConsistency shot_consistency(const FitAnswer& answer, Problem& prob, const
   std::sort(out.changes.begin(), out.changes.end(),
             [](const OeShotChange& a, const OeShotChange& b) { return a.z > b.z; });
   char buf[300];
-  std::snprintf(buf, sizeof buf, "The %d shots disagree (homogeneity chi2 %.0f for %d dof, chance 1e%.0f)", K,
-                out.chi2, out.dof, out.log10_p);
+  std::snprintf(buf, sizeof buf, "The %d shots disagree (homogeneity chi2 %.0f for %d dof, chance %s)", K,
+                out.chi2, out.dof, dsp::probability_text(out.log10_p).c_str());
   out.summary = buf;
   if (out.changes.empty()) {
     out.summary += ": no single constant's drift or step stands out.";

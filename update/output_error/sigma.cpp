@@ -1,4 +1,5 @@
 // Covariance, sigmas and identifiability of the output-error fit (sigma.hpp).
+#include "dsp/probability_text.hpp"
 #include "update/output_error/sigma.hpp"
 
 #include <Eigen/Dense>
@@ -128,11 +129,11 @@ void identify(const FitAnswer& answer, const Covariance& c, const TubeParams& no
       else
         std::snprintf(buf, sizeof buf,
                       "the model class does not explain this capture in %.3g-%.3g kHz (residual power "
-                      "%.3g times the noise's there, a chance of 1e%.1f under noise alone; chi2/dof "
+                      "%.3g times the noise's there, a chance of %s under noise alone; chi2/dof "
                       "%.3g overall): an effect outside the model (an end mass, a skew) biases every "
                       "constant; find it (gap diagnosis) or measure the fixture (calibration shots)",
-                      out.band_lo_hz / 1e3, out.band_hi_hz / 1e3, out.band_excess, out.band_log10_p,
-                      out.chi2_per_dof);
+                      out.band_lo_hz / 1e3, out.band_hi_hz / 1e3, out.band_excess,
+                      dsp::probability_text(out.band_log10_p).c_str(), out.chi2_per_dof);
       p.note = buf;
     } else if (rel > rows[i].limit) {
       p.status = "not identifiable";
