@@ -176,9 +176,11 @@ void diagnose_stage(const PipelineRequest& req, const acq::Capture& cap, const C
   // carries them into its "noise" and its residual, which the output-error
   // model takes as nuisance (baseline projected out, 1/f weighted): the
   // diagnosis runs there, as for one or two shots.
+  // (Decided by the shots' own spread, update/output_error/noise.cpp — not by
+  // a baseline or 1/f found in their average, which an unmodelled effect's
+  // misfit also shows: a series resistance's looks like 1/f noise.)
   const bool disturbed = out.output_error && out.output_error->ok() &&
-                         (out.output_error->baseline.modelled || out.output_error->baseline.pink ||
-                          out.output_error->noise_source.find("slow disturbances") != std::string::npos);
+                         out.output_error->noise_source.find("slow disturbances") != std::string::npos;
   if (fit_shots.size() < 3 || (heldout_cap && ho_shots.size() < 3) || disturbed) {
     // One or two shots: the noise of Z(f) cannot be measured from repeats
     // (nor is it Gaussian per bin at a few percent): the diagnosis runs in the
