@@ -1,5 +1,6 @@
 // The jobs' room (jobs/): `piezobench impedance` (see impedance_job.hpp).
 // Capture → dsp only; no estimator code here.
+#include <cmath>
 #include "jobs/impedance_job.hpp"
 
 #include <algorithm>
@@ -68,6 +69,17 @@ nlohmann::json features_json(const dsp::ImpedanceFeatures& f) {
   j["resonances_sigma_hz"] = list(f.resonances, true);
   j["antiresonances_hz"] = list(f.antiresonances, false);
   j["antiresonances_sigma_hz"] = list(f.antiresonances, true);
+  // Significant (issue 41 item 4): a σ that is finite and below a third of
+  // the frequency (the feature stands 3σ clear of zero). The text output
+  // lists these only; the arrays above keep every candidate, in order.
+  auto significant = [](const std::vector<dsp::Feature>& v) {
+    nlohmann::json a = nlohmann::json::array();
+    for (const auto& x : v) a.push_back(std::isfinite(x.sigma_hz) && x.sigma_hz > 0 && 3.0 * x.sigma_hz < x.f_hz);
+    return a;
+  };
+  j["resonances_significant"] = significant(f.resonances);
+  j["antiresonances_significant"] = significant(f.antiresonances);
+  j["significance_rule"] = "sigma finite and below a third of the frequency";
   j["capacitance_f"] = f.capacitance_f;
   j["capacitance_sigma_f"] = f.capacitance_sigma_f;
   return j;

@@ -4,6 +4,7 @@
 // Kramers–Kronig verdict, the band and the shot flags; bad requests exit 2.
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <filesystem>
 #include <nlohmann/json.hpp>
 
@@ -118,3 +119,28 @@ TEST_F(CliCalibrate, BadRequestsExitTwo) {
 }
 
 }  // namespace
+
+// Issue 41 item 4: a feature without significance (σ not below a third of
+// its frequency) is flagged in the JSON and left out of the text, which says
+// how many it left out; every listed one stands 3σ clear.
+TEST_F(CliCalibrate, ImpedanceListsOnlySignificantFeatures) {
+  const auto r = run_cli("impedance " + cal().string() + " --json");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const auto j = nlohmann::json::parse(r.out);
+  const auto& f = j["features"];
+  for (const char* kind : {"resonances", "antiresonances"}) {
+    const std::string k(kind);
+    ASSERT_EQ(f[k + "_significant"].size(), f[k + "_hz"].size()) << k;
+    for (std::size_t i = 0; i < f[k + "_hz"].size(); ++i) {
+      const double v = f[k + "_hz"][i], s = f[k + "_sigma_hz"][i].is_number() ? f[k + "_sigma_hz"][i].get<double>() : NAN;
+      EXPECT_EQ(f[k + "_significant"][i].get<bool>(), std::isfinite(s) && s > 0 && 3 * s < v) << k << " " << i;
+    }
+  }
+  const auto t = run_cli("impedance " + cal().string());
+  ASSERT_EQ(t.exit_code, 0) << t.err;
+  std::size_t left = 0;
+  for (const char* kind : {"resonances", "antiresonances"})
+    for (const auto& b : f[std::string(kind) + "_significant"]) left += !b.get<bool>();
+  if (left) EXPECT_NE(t.out.find("without significance not listed"), std::string::npos) << t.out;
+  else EXPECT_EQ(t.out.find("without significance not listed"), std::string::npos) << t.out;
+}

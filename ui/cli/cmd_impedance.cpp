@@ -62,9 +62,17 @@ void print_text(const nlohmann::json& j) {
     std::printf("  model order     %zu (%s)\n", j["order"].get<std::size_t>(),
                 j["order_automatic"].get<bool>() ? "automatic" : "manual");
   const auto& f = j["features"];
-  auto row = [&](const char* name, const char* key, const char* skey) {
+  // Only the features that stand clear of their σ (features.*_significant);
+  // how many candidates were left out is said.
+  auto row = [&](const char* name, const char* key, const char* skey, const char* sigkey) {
     std::printf("  %-15s", name);
+    std::size_t shown = 0, left = 0;
     for (std::size_t k = 0; k < f[key].size(); ++k) {
+      if (f.contains(sigkey) && k < f[sigkey].size() && f[sigkey][k].is_boolean() && !f[sigkey][k].get<bool>()) {
+        ++left;
+        continue;
+      }
+      ++shown;
       // σ to two significant digits, the value to match (jobs/text/uncertain_text.hpp).
       const double v = json_number(f[key][k]);
       if (f[skey].is_array() && k < f[skey].size() && f[skey][k].is_number())
@@ -72,10 +80,12 @@ void print_text(const nlohmann::json& j) {
       else
         std::printf(" %s;", jobs::format_value(v, "Hz", 7).c_str());
     }
+    if (!shown) std::printf(" none significant");
+    if (left) std::printf(" (%zu candidate(s) without significance not listed: sigma not below a third of the frequency)", left);
     std::printf("\n");
   };
-  row("resonances", "resonances_hz", "resonances_sigma_hz");
-  row("antiresonances", "antiresonances_hz", "antiresonances_sigma_hz");
+  row("resonances", "resonances_hz", "resonances_sigma_hz", "resonances_significant");
+  row("antiresonances", "antiresonances_hz", "antiresonances_sigma_hz", "antiresonances_significant");
   if (f["capacitance_f"].is_number())
     std::printf("  capacitance     %s\n", jobs::format_value(f["capacitance_f"].get<double>() * 1e12, "pF", 5).c_str());
 }
