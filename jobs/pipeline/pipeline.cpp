@@ -20,6 +20,26 @@ PipelineResult run_pipeline(const PipelineRequest& req, const std::function<void
   std::shared_ptr<drivers::sim::SimBench> sim;
   acq::Capture cap = acquire(req, out, progress, cancel, sim);
   if (cancel) return out;
+  {  // the capture's own set-up (GUI: the Plan panel after a replay)
+    acq::MeasurementPlan p;
+    p.setup = cap.setup;
+    p.shots = 0;
+    for (const auto& s : cap.shots) {
+      if (s.role != acq::Role::Dut) continue;
+      if (p.shots++ == 0) {
+        p.excitation.kind = s.excitation;
+        if (s.amplitude_v) p.excitation.amplitude_v = *s.amplitude_v;
+        if (s.decay_per_s) p.excitation.decay_per_s = *s.decay_per_s;
+        if (s.frequency_hz) p.excitation.frequency_hz = *s.frequency_hz;
+        if (s.f_start_hz) p.excitation.f_start_hz = *s.f_start_hz;
+        if (s.f_stop_hz) p.excitation.f_stop_hz = *s.f_stop_hz;
+        p.sample_rate_hz = s.sample_rate_hz;
+        p.samples = s.v1.size();
+        p.pretrigger_samples = static_cast<std::size_t>(std::max<std::int64_t>(0, s.pretrigger_samples));
+      }
+    }
+    out.capture_plan = p;
+  }
   if (req.use_calibration) calibrate_stage(cap, out);
   progress(0.45, "estimate: Prony-SS");
   // The estimate (Prony-SS features, FFT and cross-spectra overlays) feeds the

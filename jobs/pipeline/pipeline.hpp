@@ -116,6 +116,10 @@ struct StageReport {
 
 struct PipelineResult {
   std::string capture_path;
+  // The capture's own set-up as a plan (its /setup, its first transient dut
+  // shot's drive, rate and length, its dut shot count): what a replay shows
+  // in the GUI's Plan panel instead of the plan that was not used.
+  std::optional<acq::MeasurementPlan> capture_plan;
   int shots = 0;
   int shots_averaged = 0;         // transient dut shots averaged before the Prony fit
   std::string awg_idn, daq_idn;  // *IDN? of the instruments used (empty for a replay)

@@ -1,6 +1,7 @@
 // What the buttons do: start or replay a job, connect to the instruments,
 // export. Each hands its work to the Job or TaskQueue thread and returns at
 // once; outcomes come back into the AppState on the UI thread.
+#include <cstdio>
 #include "drivers/instrument_uri.hpp"
 #include "drivers/sim/disturbances.hpp"
 #include "jobs/bench_probe.hpp"
@@ -54,6 +55,7 @@ void start_job(AppState& s, bool replay) {
   }
   if (!replay) attach_calibration(s.calibration, s.calibration_prompt, req);  // fixture standards first
   if (!s.job.start(req)) return;
+  s.last_job_replay = replay;
   ++s.jobs_started;
   s.frame_ms_jobs.emplace_back();
   s.instrument.before_job = s.instrument.state;
@@ -92,6 +94,14 @@ bool collect_job(AppState& s) {
   }
   const auto& r = *s.result;
   s.log.push_back(cancelled ? "job cancelled" : "job finished");
+  if (s.last_job_replay && r.capture_plan) {  // the Plan panel shows what was replayed, not the unused plan
+    const double range = s.request.plan.range_v;
+    s.request.plan = *r.capture_plan;
+    s.request.plan.range_v = range;
+    const std::string id = r.capture_plan->setup.transducer_id.value_or("");
+    std::snprintf(s.transducer_id, sizeof s.transducer_id, "%s", id.c_str());
+    s.log.push_back("  the Plan panel shows the replayed capture's set-up");
+  }
   for (const auto& st : r.stages)
     s.log.push_back((st.ran ? "  ran " : "  skipped ") + st.name + ": " + st.note);
   for (const auto& w : r.warnings) s.log.push_back("  warning: " + w);

@@ -94,6 +94,7 @@ struct AppState {
   ~AppState() { calibration_prompt.close(); }
   Job job;
   int jobs_started = 0;
+  bool last_job_replay = false;  // the running/last job replays a capture (its set-up goes to the Plan panel)
   // Acceptance limits (jobs/report/limits.hpp, as `replay --limits`): loaded on
   // the task thread; each finished result is judged against them.
   char limits_path[256] = "";
