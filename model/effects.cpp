@@ -10,23 +10,23 @@ namespace {
 constexpr double kInf = std::numeric_limits<double>::infinity();
 const EffectInfo kCatalogue[] = {
     {"series_resistance", "ohm", 0.0, 200.0, &EffectSet::series_resistance_ohm,
-     "resistance of leads and contacts in series with the transducer"},
+     "resistance of leads and contacts in series with the transducer", 10.0},
     {"parallel_capacitance", "F", 0.0, 2e-9, &EffectSet::parallel_capacitance_f,
-     "fixture and cable capacitance across the transducer terminals"},
+     "fixture and cable capacitance across the transducer terminals", 100e-12},
     {"daq_input_resistance", "ohm", 1e3, kInf, &EffectSet::daq_input_resistance_ohm,
-     "input resistance of the DAQ channel on the transducer node"},
+     "input resistance of the DAQ channel on the transducer node", 1e6},
     {"dielectric_loss", "tan_delta", 0.0, 0.1, &EffectSet::dielectric_loss,
-     "dielectric loss tangent of the ceramic"},
+     "dielectric loss tangent of the ceramic", 0.01},
     {"channel_skew", "s", -1e-6, 1e-6, &EffectSet::channel_skew_s,
-     "sampling delay of channel 2 (v2) relative to channel 1 (v1)"},
+     "sampling delay of channel 2 (v2) relative to channel 1 (v1)", 100e-9},
     {"channel_gain", "fraction", -0.2, 0.2, &EffectSet::channel_gain,
-     "relative gain error of channel 2"},
+     "relative gain error of channel 2", 0.01},
     {"r1_tolerance", "fraction", -0.2, 0.2, &EffectSet::r1_tolerance,
-     "deviation of the true series resistor from its nominal value"},
+     "deviation of the true series resistor from its nominal value", 0.01},
     {"mass_loading", "fraction", 0.0, 0.5, &EffectSet::mass_loading,
-     "mass added at the tube's end faces, as a fraction of the tube's mass"},
+     "mass added at the tube's end faces, as a fraction of the tube's mass", 0.01},
     {"mechanical_damping", "damping_ratio", 0.0, 0.05, &EffectSet::mechanical_damping,
-     "modal damping ratio added to every mode (mounting/structural loss, not of Rayleigh form)"},
+     "modal damping ratio added to every mode (mounting/structural loss, not of Rayleigh form)", 1e-3},
 };
 }  // namespace
 
@@ -38,6 +38,10 @@ bool EffectSet::any() const {
 }
 
 std::span<const EffectInfo> effect_catalogue() { return kCatalogue; }
+
+double effect_coordinate_unit(const EffectInfo& e) {
+  return e.name == "daq_input_resistance" ? 1.0 / e.typical : e.typical;
+}
 
 const EffectInfo* find_effect(std::string_view name) {
   for (const auto& e : kCatalogue)

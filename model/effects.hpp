@@ -41,7 +41,17 @@ struct EffectInfo {
   double lower, upper;  // physical bounds used by the diagnosis and the CLI check
   double EffectSet::*field;
   std::string_view meaning;
+  // A typical bench magnitude, in `unit` (issue 42: one value for both
+  // diagnosis paths): the unit of the effect's fit coordinate and the size
+  // the alias sentence ("a typical … would read as …") and the
+  // detectability refer to. daq_input_resistance: 1 MΩ, fitted as its
+  // conductance (effect_coordinate_unit).
+  double typical;
 };
+
+// The unit of the effect's fit coordinate (x = value / unit): `typical`, or
+// for daq_input_resistance the conductance 1/typical (siemens).
+double effect_coordinate_unit(const EffectInfo& e);
 
 std::span<const EffectInfo> effect_catalogue();
 const EffectInfo* find_effect(std::string_view name);

@@ -213,7 +213,8 @@ GapDiagnosis diagnose_gap(model::ModalSolver& solver, const MaterialClass& cls, 
       const auto* info = model::find_effect(pool[c]);
       if (!info) throw std::invalid_argument("gap diagnosis: unknown effect '" + pool[c] + "'");
       rep.unit = std::string(info->unit);
-      rep.typical = typical_effect_magnitude(*info);
+      rep.typical = info->typical;  // in the effect's unit (the catalogue's; x = 1 is this size)
+      const double x_unit = typical_effect_magnitude(*info);  // the coordinate's unit (S for the DAQ's input)
       std::vector<std::string> fx = model_effects;
       fx.push_back(pool[c]);
       m.set_effects(fx);
@@ -267,7 +268,7 @@ GapDiagnosis diagnose_gap(model::ModalSolver& solver, const MaterialClass& cls, 
       }
       rep.fitted = true;
       rep.value = m.effect_value(f.x, je);
-      rep.sigma = f.sigma_x[static_cast<std::size_t>(je)] * rep.typical;
+      rep.sigma = f.sigma_x[static_cast<std::size_t>(je)] * x_unit;
       if (info->name == "daq_input_resistance") {  // fitted as a conductance G; σ_R = σ_G·R²
         rep.sigma = std::isfinite(rep.value) ? rep.sigma * rep.value * rep.value : std::numeric_limits<double>::infinity();
       }

@@ -19,17 +19,9 @@ bool is_conductance(const model::EffectInfo& e) { return e.name == "daq_input_re
 }  // namespace
 
 double typical_effect_magnitude(const model::EffectInfo& e) {
-  const std::string n(e.name);
-  if (n == "series_resistance") return 10.0;        // Ω: leads, contacts
-  if (n == "parallel_capacitance") return 100e-12;  // F: fixture, a metre of coax
-  if (n == "daq_input_resistance") return 1e-6;     // S (1 MΩ input)
-  if (n == "dielectric_loss") return 0.01;          // tan δ of a hard PZT
-  if (n == "channel_skew") return 50e-9;            // s
-  if (n == "channel_gain") return 0.01;
-  if (n == "r1_tolerance") return 0.01;             // a 1 % resistor
-  if (n == "mass_loading") return 0.02;
-  if (n == "mechanical_damping") return 2e-3;
-  throw std::invalid_argument("typical_effect_magnitude: unknown effect '" + n + "'");
+  // The catalogue's one typical size (model/effects.hpp), as the coordinate's
+  // unit: daq_input_resistance as a conductance (1 µS for 1 MΩ).
+  return model::effect_coordinate_unit(e);
 }
 
 struct GapModel::Linear {

@@ -102,8 +102,7 @@ GapDiagnosis build(const OeResult& r, const std::string& fit_description, const 
     rep.alias = e.alias;
     rep.alias_residual = e.alias_residual;
     rep.detectability = e.detectability;
-    // The DAQ input's typical size as a conductance (S), as the impedance-domain diagnosis gives it.
-    rep.typical = e.name == "daq_input_resistance" && e.typical > 0 ? 1.0 / e.typical : e.typical;
+    rep.typical = e.typical;  // in the effect's unit (ohm for the DAQ input), as the impedance path
     rep.bias_y_e11_pct = e.bias_pct[0];
     rep.bias_nu12_pct = e.bias_pct[1];
     rep.bias_d31_pct = e.bias_pct[2];

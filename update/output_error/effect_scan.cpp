@@ -221,9 +221,9 @@ Scanned scan_one(const ScanInputs& in, Problem& p, Fitter& f, const std::string&
     // The later starts stop once inside the best one's optimum or stalled
     // far above it (levenberg_marquardt's lead test, on the six).
     f.finish(run);
-    for (double start : {2.0, 4.0}) {
+    for (double start : {0.02, 0.04}) {  // 2 % and 4 % of the tube's mass
       Eigen::VectorXd xs = x0;
-      xs[kParams] = start;
+      xs[kParams] = start / typical;
       LmOutcome other = f.levenberg_marquardt(xs, &run);
       if (other.cost < run.cost) {
         run = std::move(other);

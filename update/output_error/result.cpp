@@ -33,39 +33,26 @@ std::optional<OeDamping> parse_damping(const std::string& s) {
 }
 
 std::optional<EffectCoordinate> effect_coordinate(const std::string& name) {
+  const model::EffectInfo* info = model::find_effect(name);
+  if (!info) return std::nullopt;
   EffectCoordinate c;
+  // The unit of the coordinate: the catalogue's typical size (model/effects.hpp,
+  // one table for both diagnosis paths).
+  const double typ = model::effect_coordinate_unit(*info);
+  c.typical = typ;
   if (name == "daq_input_resistance") {  // 1/R: x·1 µS
-    c.typical = 1e-6;
-    c.apply = [](model::EffectSet& fx, double x) {
+    c.apply = [typ](model::EffectSet& fx, double x) {
       const double g =
-          (std::isfinite(fx.daq_input_resistance_ohm) ? 1.0 / fx.daq_input_resistance_ohm : 0.0) + 1e-6 * x;
+          (std::isfinite(fx.daq_input_resistance_ohm) ? 1.0 / fx.daq_input_resistance_ohm : 0.0) + typ * x;
       fx.daq_input_resistance_ohm = g != 0 ? 1.0 / g : INFINITY;
     };
-    c.value = [](double x) { return 1e-6 * x; };
-    return c;
-  }
-  // Typical sizes: the unit of the coordinate (a lead of 10 Ω, a cable of
-  // 100 pF, a hard PZT's loss, a 100 ns skew, 1 % gain or R1, 1 % end mass,
-  // a damping ratio of 1e-3).
-  static const std::pair<const char*, std::pair<double model::EffectSet::*, double>> table[] = {
-      {"series_resistance", {&model::EffectSet::series_resistance_ohm, 10.0}},
-      {"parallel_capacitance", {&model::EffectSet::parallel_capacitance_f, 100e-12}},
-      {"dielectric_loss", {&model::EffectSet::dielectric_loss, 0.01}},
-      {"channel_skew", {&model::EffectSet::channel_skew_s, 1e-7}},
-      {"channel_gain", {&model::EffectSet::channel_gain, 0.01}},
-      {"r1_tolerance", {&model::EffectSet::r1_tolerance, 0.01}},
-      {"mass_loading", {&model::EffectSet::mass_loading, 0.01}},
-      {"mechanical_damping", {&model::EffectSet::mechanical_damping, 1e-3}},
-  };
-  for (const auto& [n, fe] : table) {
-    if (name != n) continue;
-    const auto [field, typ] = fe;
-    c.typical = typ;
-    c.apply = [field, typ](model::EffectSet& fx, double x) { fx.*field += typ * x; };
     c.value = [typ](double x) { return typ * x; };
     return c;
   }
-  return std::nullopt;
+  const auto field = info->field;
+  c.apply = [field, typ](model::EffectSet& fx, double x) { fx.*field += typ * x; };
+  c.value = [typ](double x) { return typ * x; };
+  return c;
 }
 
 }  // namespace piezo::update
