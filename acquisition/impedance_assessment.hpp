@@ -33,7 +33,7 @@ enum class UncertaintySource { Auto, Shots, Noise, None };
 // first sample (the AWG), and the samples before the first decimated one enter
 // the transforms as recorded (the fast transient of the tube's modes above the
 // band, which an order set by the noise leaves out: 4.9 % / 3.2° next to the
-// 82 kHz resonance without it, see dsp/README.md "Measured").
+// 82 kHz resonance without it, see docs/dsp-methods.md "Measured").
 inline dsp::PronyImpedanceOptions bench_prony_options() {
   dsp::PronyImpedanceOptions o;
   o.ramp_onset = true;
@@ -56,7 +56,7 @@ struct AssessmentOptions {
   // channel-2 baseline (slow wander, mains hum) tested (dsp/divider_baseline.hpp)
   // and reported; removed from channel 1 before the estimate only with
   // `baseline_remove` (on our bench the removal's own noise in the lowest bins
-  // cost as much as the baseline did: dsp/README.md).
+  // cost as much as the baseline did: docs/dsp-methods.md).
   bool baseline = true;
   bool baseline_remove = false;
   dsp::DividerBaselineOptions baseline_options;

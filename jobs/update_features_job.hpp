@@ -1,7 +1,7 @@
 #pragma once
 // The jobs' room (jobs/): `piezobench update Z.csv|Z.s1p [--resonances …]` —
 // multi-physics FE model updating of the tube from impedance features (seed
-// §6.3-6.4, update/README.md): extended CMCM, least squares (LM) or both, the
+// §6.3-6.4, docs/update-methods.md): extended CMCM, least squares (LM) or both, the
 // Rayleigh damping from two modes and the |Z| overlay CSV. Explicit features
 // override the ones found in the file. ui/cli/cmd_update.cpp parses the
 // options and prints.

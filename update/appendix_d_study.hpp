@@ -32,7 +32,7 @@ struct AppendixDOptions {
   double f_low_hz = 400.0;  // f_L of the capacitance (εT33 for (a), |Z| for (b))
   ModeShapeCmcmOptions shapes;
   // (c) starts from (b)'s answer when (b) converged (the original of Table D.1
-  // is too far from the target for the fit's own starts: see update/README.md),
+  // is too far from the target for the fit's own starts: see docs/update-methods.md),
   // else from the original.
   bool output_error_from_cmcm = true;
 };
@@ -61,7 +61,7 @@ AppendixDStudy appendix_d_study(const model::TubeModel& tube, model::ModalSolver
                                 const model::PiezoMaterialE& target,
                                 const AppendixDOptions& options = {});
 
-// The table as Markdown (what update/README.md carries).
+// The table as Markdown (what docs/update-methods.md carries).
 std::string to_markdown(const AppendixDStudy& s);
 
 }  // namespace piezo::update

@@ -84,7 +84,7 @@ struct CmcmOptions {
   // Include the i ≠ j equations. Exact at the fixed point, but with lagged shapes
   // they restate the previous iterate to first order (Φ_iᵀMΦ*_j ≈
   // Σ α_n Φ_iᵀK_nΦ_j/(λ_j − λ_i)), so they pin α and the iteration creeps, as in
-  // the seed's Fig. 37 (300 iterations). Off by default; see update/README.md.
+  // the seed's Fig. 37 (300 iterations). Off by default; see docs/update-methods.md.
   bool cross_modes = false;
   double mac_min = 0.9;     // tracked mode must keep MAC ≥ mac_min …
   double mac_margin = 0.2;  // … and beat the runner-up by this much

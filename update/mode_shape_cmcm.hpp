@@ -69,7 +69,7 @@ struct ModeShapeCmcmOptions {
   // Include the i ≠ j pairs (the seed: N_i × N_j equations). Their rows carry
   // the shape change (Φ_iᵀMΦ*_j is of the order of α) and so amplify any error
   // in the target shapes by 1/Φ_iᵀMΦ*_j; with i = j only, the 2 × 12 rows are
-  // the eigenvalue equations evaluated with the target shapes (update/README.md).
+  // the eigenvalue equations evaluated with the target shapes (docs/update-methods.md).
   bool cross_modes = true;
   // The seed's D.10 read as eq. 173 by linearising √((1+α_k)(1+α_l)) ≈
   // 1 + (α_k + α_l)/2: eight unknowns, biased for large changes (kept to show

@@ -99,7 +99,7 @@ struct OeOptions {
   }();
   double beta0_s = 1e-7;  // Rayleigh β to start from (the seed's value)
   // The damping model fitted (OeDamping; the default was chosen by the
-  // comparison study, update/README.md) and, for complex constants, the
+  // comparison study, docs/update-methods.md) and, for complex constants, the
   // 1/Qm to start from (Qm = 100, soft PZT; β = 1e-7 s gives the 50 kHz hoop
   // mode Qm ≈ 32).
   OeDamping damping = OeDamping::rayleigh;

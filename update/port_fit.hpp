@@ -16,7 +16,7 @@
 // features (the zeros/poles of a low-order rational fit) carry a truncation
 // bias where the model order is set by the noise — on the seed's tube the third
 // resonance (the zero of Z between 54 and 95 kHz) sits +0.2…0.3 % high at 3 %
-// noise, which alone moves nu12 by +1 % (update/README.md).
+// noise, which alone moves nu12 by +1 % (docs/update-methods.md).
 // Uncertainties: Gauss–Newton covariance σ̂²(JᵀJ)⁻¹ propagated to the features.
 #include <span>
 #include <string>

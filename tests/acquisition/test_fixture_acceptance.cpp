@@ -9,7 +9,7 @@
 //    noise; at 0.5 % noise (8 shots) noise-limited next to the 82 kHz resonance;
 //  * the Kramers–Kronig/passivity check passes on the result and fails when
 //    channel 2 is deskewed with the wrong sign.
-// The numbers are printed (dsp/README.md quotes them).
+// The numbers are printed (docs/dsp-methods.md quotes them).
 #include <gtest/gtest.h>
 
 #include <cstdio>

@@ -8,7 +8,7 @@
 // since the calibration standards' FFT ratio takes the record's last sample
 // from a fit (FftRatioOptions::end_fit_samples): its noise, common to every
 // bin, made a compensation error of up to 0.2 % / 0.1° at 1–20 kHz that the
-// standards' σ did not hold. The test holds the target; dsp/README.md quotes
+// standards' σ did not hold. The test holds the target; docs/dsp-methods.md quotes
 // the numbers.
 #include <gtest/gtest.h>
 

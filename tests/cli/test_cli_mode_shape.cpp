@@ -34,7 +34,7 @@ TEST(CliModeShape, JsonFieldsAndTheExactAnswer) {
 TEST(CliModeShape, ExitCodes) {
   EXPECT_EQ(run_cli("model mode-shape-cmcm --staging sideways").exit_code, 2);
   EXPECT_EQ(run_cli("model mode-shape-cmcm --capture-noise -1").exit_code, 2);
-  // The seed's staging fails on our model (update/README.md, Appendix D): exit 1.
+  // The seed's staging fails on our model (docs/update-methods.md, Appendix D): exit 1.
   EXPECT_EQ(run_cli("model mode-shape-cmcm --staging seed").exit_code, 1);
 }
 

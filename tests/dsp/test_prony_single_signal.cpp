@@ -129,7 +129,7 @@ TEST(PronySingleSignal, NoiseFreePolesAndResiduesExact) {
 // White noise σ = 2 % of the signal's rms, order 5 given (the model the CRB is
 // for), 600 samples, Hankel 200 × 400, 40 seeds. Subspace (Kung/HSVD)
 // estimates at this SNR are near-efficient but not efficient; the test allows
-// an efficiency loss of 1.5 in σ (the divider fits of dsp/README.md run at
+// an efficiency loss of 1.5 in σ (the divider fits of docs/dsp-methods.md run at
 // 1.13–1.31): every error within 4.5 × 1.5 CRB (Gaussian 4.5σ: 7e-6 per
 // estimate, 1e-3 over the 200), and the rms over seeds within [0.7, 1.8] CRB
 // (40 seeds: the rms itself scatters by ±11 %, 1σ).

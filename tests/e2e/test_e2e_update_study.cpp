@@ -93,7 +93,7 @@ TEST(E2eStudy, SeedChainOnTheSameTubes) {
     EXPECT_GE(best.lm, other.lm);
   }
   // The seed's drive with 4× the shots and the port fit: the lever that does not
-  // depend on the noise being relative to the record's std (update/README.md).
+  // depend on the noise being relative to the record's std (docs/update-methods.md).
   auto seed64 = test::seed_chain();
   seed64.plan.shots = 64;
   seed64.port_fit = true;

@@ -1,5 +1,5 @@
 // update/appendix_d_study: Table D.1 on our tube, the three updating paths
-// side by side (issue 22 item 4); prints the table update/README.md carries.
+// side by side (issue 22 item 4); prints the table docs/update-methods.md carries.
 #include <gtest/gtest.h>
 
 #include <cmath>

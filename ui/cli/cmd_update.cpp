@@ -1,7 +1,7 @@
 // `piezobench update [Z.csv | Z.s1p] [--resonances F,… --antiresonances F,… --low-z OHM@HZ]
 //      [--material M] [--isotropic] [--set YE11=…,nu12=…,d31=…,epsT33_rel=…]
 //      [--method cmcm|lm|both] [--overlay FILE.csv] [--damping F:ZETA,F:ZETA] [--json]`
-// Multi-physics FE model updating of the tube (seed §6.3-6.4, update/README.md).
+// Multi-physics FE model updating of the tube (seed §6.3-6.4, docs/update-methods.md).
 // Explicit features override the ones found in the file. The CLI's room
 // (ui/cli): the work is jobs/update_features_job.hpp and, for a capture,
 // jobs/update_capture_job.hpp.

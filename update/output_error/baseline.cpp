@@ -191,7 +191,7 @@ DisturbanceModel decide_disturbances(Problem& prob, const Averaged& rec, const s
   // part (refsim cases 13 and 14, dielectric loss: baseline Δχ² 0.3-0.4 % of
   // the transfer errors' χ²), a baseline's Δχ² was 8-99 % of it on our
   // disturbed study's captures. The cut between the two, 2 %, is a measured
-  // heuristic (update/README.md), not a test of chance.
+  // heuristic (docs/update-methods.md), not a test of chance.
   d.baseline = best_logp < kLn1e3 && best_delta > kBaselineShare * d.transfer_error_chi2;
   d.mains_distinguishable =
       d.mains_known || (deltas.size() == 2 && d.harmonics > 0 && std::abs(deltas[0] - deltas[1]) > kPinkLr);
