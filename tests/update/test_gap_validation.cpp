@@ -130,8 +130,9 @@ void score(const Case& c, const jobs::PipelineResult& r, Tally& t) {
   for (const auto& e : d.effects)
     if (e.name == c.effect) {
       alias = e.alias;
-      // (daq_input_resistance: typical is a conductance, S)
-      const double x = c.effect == "daq_input_resistance" ? 1.0 / (c.value * e.typical) : c.value / e.typical;
+      // (daq_input_resistance: typical is 1 MΩ in the catalogue's unit, fitted
+      // as the conductance 1/typical: x = (1/value) / (1/typical))
+      const double x = c.effect == "daq_input_resistance" ? e.typical / c.value : c.value / e.typical;
       detect_sigma = e.detectability * std::abs(x);
     }
   const bool undetectable = !c.effect.empty() && !alias && detect_sigma < 5.0;
