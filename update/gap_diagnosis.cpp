@@ -1,3 +1,4 @@
+#include "dsp/uncertain_text.hpp"
 #include "update/gap_diagnosis.hpp"
 
 #include <Eigen/Dense>
@@ -408,13 +409,13 @@ GapDiagnosis diagnose_gap(model::ModalSolver& solver, const MaterialClass& cls, 
     for (std::size_t i = 1; i < out.added.size(); ++i) more += (i == 1 ? "; then " : ", ") + out.added[i];
     if (out.heldout_without_gap)
       std::snprintf(buf, sizeof buf,
-                    "Gap explained by %s = %.4g +/- %.2g %s (fit gap shrinks by %.0f %%; the held-out data show no gap "
+                    "Gap explained by %s = %s (fit gap shrinks by %.0f %%; the held-out data show no gap "
                     "to shrink, chi2/dof %.2f, and stay within their noise with it)%s.",
-                    s.name.c_str(), s.value, s.sigma, s.unit.c_str(), 100 * s.shrink_fit,
+                    s.name.c_str(), dsp::format_uncertain(s.value, s.sigma, s.unit).c_str(), 100 * s.shrink_fit,
                     out.gap_heldout.value_or(0.0), more.c_str());
     else
-      std::snprintf(buf, sizeof buf, "Gap explained by %s = %.4g +/- %.2g %s (held-out gap shrinks by %.0f %%)%s.",
-                    s.name.c_str(), s.value, s.sigma, s.unit.c_str(),
+      std::snprintf(buf, sizeof buf, "Gap explained by %s = %s (held-out gap shrinks by %.0f %%)%s.",
+                    s.name.c_str(), dsp::format_uncertain(s.value, s.sigma, s.unit).c_str(),
                     100 * (out.heldout_shrink ? *out.heldout_shrink : s.shrink_fit), more.c_str());
     std::string twins;
     for (const auto& e : out.effects)

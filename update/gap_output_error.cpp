@@ -1,3 +1,4 @@
+#include "dsp/uncertain_text.hpp"
 #include "dsp/probability_text.hpp"
 #include "update/gap_output_error.hpp"
 
@@ -52,17 +53,18 @@ std::vector<std::string> disturbance_findings(const OeBaseline& b) {
     std::string hum;
     if (b.harmonics > 0 && std::isfinite(b.hum_v)) {
       char h[160];
-      std::snprintf(h, sizeof h, "; mains hum %s%.0f Hz %.3g +/- %.2g mV", b.mains_distinguishable ? "" : "(50 or 60 Hz, not told apart) ",
-                    b.mains_hz, 1e3 * b.hum_v, 1e3 * b.hum_sigma_v);
+      std::snprintf(h, sizeof h, "; mains hum %s%.0f Hz %s", b.mains_distinguishable ? "" : "(50 or 60 Hz, not told apart) ",
+                    b.mains_hz, dsp::format_uncertain(1e3 * b.hum_v, 1e3 * b.hum_sigma_v, "mV").c_str());
       hum = h;
     } else {
       hum = "; any mains hum is inside it (the record spans less than half a mains cycle: 50 and 60 Hz look alike)";
     }
     std::snprintf(buf, sizeof buf,
                   "Baseline wander between the channels (offset, slope to degree %d%s): projected out of the residual "
-                  "(it took chi2 %.0f for %d parameters, chance %s under white noise); slope %.3g +/- %.2g V/s.",
+                  "(it took chi2 %.0f for %d parameters, chance %s under white noise); slope %s.",
                   b.poly_degree, b.harmonics > 0 ? ", hum" : "", b.delta_chi2, b.dof,
-                  dsp::probability_text(b.log10_p).c_str(), b.slope_v_per_s, b.slope_sigma_v_per_s);
+                  dsp::probability_text(b.log10_p).c_str(),
+                  dsp::format_uncertain(b.slope_v_per_s, b.slope_sigma_v_per_s, "V/s").c_str());
     out.push_back(std::string(buf) + hum);
   }
   if (b.pink) {
@@ -240,8 +242,9 @@ GapDiagnosis build(const OeResult& r, const std::string& fit_description, const 
           if (rep.name == top->name) rep.indistinguishable_from.push_back(e.name);
       }
     if (!d.steps.empty()) d.steps.front().indistinguishable_from = d.verdict_alternatives;
-    std::snprintf(buf, sizeof buf, "Gap explained by %s = %.4g +/- %.2g %s (chi2 drops by %.0f; chi2/dof %.2f -> %.2f%s).",
-                  top->name.c_str(), top->value, top->sigma, top->unit.c_str(), top->delta_chi2, r.chi2_per_dof,
+    std::snprintf(buf, sizeof buf, "Gap explained by %s = %s (chi2 drops by %.0f; chi2/dof %.2f -> %.2f%s).",
+                  top->name.c_str(), dsp::format_uncertain(top->value, top->sigma, top->unit).c_str(), top->delta_chi2,
+                  r.chi2_per_dof,
                   top->chi2_per_dof,
                   top->explains ? ", no lack of fit left"
                                 : partial ? ", some misfit left: not alone, or not exactly in the catalogue's form"

@@ -15,35 +15,15 @@
 //
 // Plain notation while the printed magnitudes stay between 1e-3 and 1e6 and σ
 // needs at most 6 decimals; otherwise one common power of ten, "(m ± s)eE".
-#include <string>
-#include <string_view>
+#include "dsp/uncertain_text.hpp"
 
 namespace piezo::jobs {
 
-struct UncertainStyle {
-  // Compact (table cells): a σ that is not finite prints as "± —" instead of
-  // "(σ not identifiable)".
-  bool compact = false;
-  // Significant digits of a value printed without a usable σ.
-  int bare_digits = 6;
-  // What a σ that is not finite says (prose style).
-  const char* no_sigma = "σ not identifiable";
-};
-
-std::string format_uncertain(double value, double sigma, std::string_view unit = {},
-                             const UncertainStyle& style = {});
-
-// The same with the SI prefix (f p n µ m – k M G) chosen from the larger of
-// |value| and σ when `base_unit` is an unprefixed SI unit (F, H, Hz, s, V, A, W,
-// m, ohm, Ω); any other unit is printed as format_uncertain does.
-std::string format_si(double value, double sigma, std::string_view base_unit,
-                      const UncertainStyle& style = {});
-
-// A value without σ, `digits` significant digits, with its unit; "—" when not finite.
-std::string format_value(double value, std::string_view unit = {}, int digits = 6);
-
-// A probability given by its log10 (it may lie far below what a double holds):
-// "1e-12", "3.2e-5", "0.27"; below 1e-300 "< 1e-300".
-std::string format_probability_log10(double log10_p);
+// The implementation lives in dsp/uncertain_text (every layer prints alike).
+using dsp::format_probability_log10;
+using dsp::format_si;
+using dsp::format_uncertain;
+using dsp::format_value;
+using dsp::UncertainStyle;
 
 }  // namespace piezo::jobs

@@ -9,6 +9,7 @@
 // freedom; per constant, a line over the shot index (drift) and the best
 // split into two means (step) are each compared with a constant by the χ²
 // they remove.
+#include "dsp/uncertain_text.hpp"
 #include "dsp/probability_text.hpp"
 #include "update/output_error/shot_consistency.hpp"
 
@@ -205,11 +206,11 @@ OeShotConsistency shot_consistency(const FitAnswer& answer, Problem& prob, const
     for (std::size_t i = 0; i < out.changes.size(); ++i) {
       const auto& ch = out.changes[i];
       if (ch.kind == "step")
-        std::snprintf(buf, sizeof buf, " %s step %+.2f %% +/- %.2g %% between shots %d and %d", ch.parameter.c_str(),
-                      ch.size_pct, ch.sigma_pct, ch.after_shot, ch.after_shot + 1);
+        std::snprintf(buf, sizeof buf, " %s step %s between shots %d and %d", ch.parameter.c_str(),
+                      dsp::format_uncertain(ch.size_pct, ch.sigma_pct, "%").c_str(), ch.after_shot, ch.after_shot + 1);
       else
-        std::snprintf(buf, sizeof buf, " %s drift %+.2f %% +/- %.2g %% over the %d shots", ch.parameter.c_str(),
-                      ch.size_pct, ch.sigma_pct, K);
+        std::snprintf(buf, sizeof buf, " %s drift %s over the %d shots", ch.parameter.c_str(),
+                      dsp::format_uncertain(ch.size_pct, ch.sigma_pct, "%").c_str(), K);
       out.summary += std::string(i ? ";" : "") + buf;
     }
     out.summary += ".";

@@ -1,4 +1,4 @@
-#include "jobs/text/uncertain_text.hpp"
+#include "dsp/uncertain_text.hpp"
 
 #include "dsp/probability_text.hpp"
 
@@ -8,7 +8,7 @@
 #include <iterator>
 #include <utility>
 
-namespace piezo::jobs {
+namespace piezo::dsp {
 
 namespace {
 
@@ -92,6 +92,6 @@ std::string format_si(double value, double sigma, std::string_view base_unit, co
   return format_uncertain(value / scale, std::isfinite(sigma) ? sigma / scale : sigma, unit, style);
 }
 
-std::string format_probability_log10(double log10_p) { return dsp::probability_text(log10_p); }
+std::string format_probability_log10(double log10_p) { return probability_text(log10_p); }
 
-}  // namespace piezo::jobs
+}  // namespace piezo::dsp
