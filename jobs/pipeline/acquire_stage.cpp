@@ -39,8 +39,18 @@ acq::Capture acquire(const PipelineRequest& req, PipelineResult& out, const Stag
     ro.calibration = req.calibration;
     ro.connect_standard = acq::make_standard_connector(bench, req.prompt);
   }
+  std::string path = req.capture_out;
+  if (!req.overwrite_capture) {  // the first free NAME-k.h5 (nothing recorded is lost)
+    namespace fs = std::filesystem;
+    const fs::path want(req.capture_out);
+    std::error_code ec;
+    for (int k = 2; fs::exists(fs::path(path), ec) && k < 100000; ++k)
+      path = (want.parent_path() / (want.stem().string() + "-" + std::to_string(k) + want.extension().string())).string();
+    if (path != req.capture_out)
+      out.warnings.push_back(req.capture_out + " exists: this capture is written to " + path + " (nothing overwritten)");
+  }
   auto res = acq::run_measurement(
-      bench, req.plan, req.capture_out, ro,
+      bench, req.plan, path, ro,
       [&](const acq::Progress& p) {
         progress(0.4 * p.shot / std::max(1, p.total), "acquire: shot " + std::to_string(p.shot + 1) + "/" +
                                                            std::to_string(p.total) + " " + p.stage);
@@ -62,7 +72,7 @@ acq::Capture acquire_heldout(const PipelineRequest& req, const acq::MeasurementP
                              std::shared_ptr<drivers::sim::SimBench>& sim, PipelineResult& out,
                              const std::atomic<bool>& cancel) {
   namespace fs = std::filesystem;
-  fs::path main(req.capture_out);
+  fs::path main(out.capture_path.empty() ? req.capture_out : out.capture_path);  // where the main capture went
   const fs::path path = main.parent_path() / (main.stem().string() + "-heldout" + main.extension().string());
   acq::Bench bench = acq::open_bench({req.instrument, req.daq.empty() ? std::nullopt : std::optional(req.daq)}, sim);
   acq::RunnerOptions ro;

@@ -27,6 +27,10 @@ struct PipelineRequest {
   acq::MeasurementPlan plan;
   acq::SimSpec sim;  // used when instrument == "sim"
   std::string capture_out = "capture.h5";
+  // false: an existing capture_out is never overwritten — the capture goes to
+  // NAME-2.h5, NAME-3.h5 … and a warning says where (the GUI's default; the
+  // demo rewrites its own demo-out/ files).
+  bool overwrite_capture = true;
   std::string replay_capture;  // non-empty: skip acquisition
   // Read replayed and held-out captures in a child process first
   // (acquisition/contained_read.hpp: a crash of libhdf5 on a damaged file

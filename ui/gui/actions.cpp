@@ -31,6 +31,7 @@ void start_job(AppState& s, bool replay) {
   req.instrument = s.instrument.awg;
   req.daq = s.instrument.daq;
   req.capture_out = s.capture_out;
+  req.overwrite_capture = false;  // a technician's earlier capture is never overwritten silently
   const auto& presets = jobs::material_presets();
   req.material = presets.at(static_cast<std::size_t>(s.material_index) % presets.size()).name;
   req.plan.setup.material = req.material;
