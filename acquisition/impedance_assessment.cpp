@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <stdexcept>
 
 #include "acquisition/divider_record.hpp"
@@ -9,6 +10,25 @@
 #include "dsp/features.hpp"
 
 namespace piezo::acq {
+
+EstimateDefaults default_estimate(const Shot& first) {
+  EstimateDefaults d;
+  const double fs = first.sample_rate_hz;
+  const std::size_t post =
+      first.samples() - static_cast<std::size_t>(std::clamp<std::int64_t>(first.pretrigger_samples, 0,
+                                                                         static_cast<std::int64_t>(first.samples())));
+  d.fmax_hz = std::min(kDefaultEstimateBandHz, fs / 4);
+  // Prony decimates by D = fs/(5 fmax) (dsp::decimation_factor); a record
+  // shorter than 64 D keeps too few decimated samples for its Hankel matrix:
+  // the band widens (D shrinks) to what the record carries, fs/4 at most.
+  if (post > 0 && static_cast<double>(post) < 64.0 * fs / (5.0 * d.fmax_hz))
+    d.fmax_hz = std::min(fs / 4, 64.0 * fs / (5.0 * static_cast<double>(post)));
+  d.step_hz = std::max(std::min(kDefaultEstimateStepHz, d.fmax_hz / 100), d.fmax_hz / 2000);
+  d.fmin_hz = d.step_hz;
+  d.max_samples = std::min(kDefaultEstimateSamples, post);
+  return d;
+}
+
 
 namespace {
 

@@ -41,6 +41,24 @@ inline dsp::PronyImpedanceOptions bench_prony_options() {
   return o;
 }
 
+// The one estimate (issue 41 item 4): the band, grid and record length the
+// pipeline's estimate stage uses (jobs/pipeline/estimate_stage.cpp), and
+// `piezobench impedance` / `figures` by default, so that the three report the
+// same features of the same capture. The band reaches the tube's third
+// short/open-circuit pair with room (the model's mode range,
+// jobs/seed_features.hpp) and never past fs/4; Prony fits at most
+// kDefaultEstimateSamples samples after t = 0 (its Hankel SVD grows as the
+// square; the transient has decayed into the noise long before on the bench).
+inline constexpr double kDefaultEstimateBandHz = 120e3;
+inline constexpr double kDefaultEstimateStepHz = 100.0;
+inline constexpr std::size_t kDefaultEstimateSamples = 6000;
+struct EstimateDefaults {
+  double fmin_hz = 0, fmax_hz = 0, step_hz = 0;
+  std::size_t max_samples = 0;  // samples after t = 0 Prony fits
+};
+// Of the first transient dut shot (sample rate and record length).
+EstimateDefaults default_estimate(const Shot& first);
+
 struct AssessmentOptions {
   std::string method = "prony";     // prony | fft | xspec
   std::optional<std::size_t> shot;  // one shot (capture index); empty: every transient dut shot

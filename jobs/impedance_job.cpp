@@ -24,6 +24,7 @@
 #include "jobs/json/assessment_json.hpp"
 #include "jobs/json/mode_figures_json.hpp"
 #include "jobs/pipeline/capture_mode_figures.hpp"
+#include "jobs/seed_features.hpp"
 
 namespace piezo::jobs {
 
@@ -216,16 +217,18 @@ ImpedanceJobResult run_impedance(const ImpedanceRequest& a) {
   } else {
     const acq::Shot& shot = pick_shot(cap, a);
     const double fs = shot.sample_rate_hz;
-    const double fmax = a.fmax > 0 ? a.fmax : fs / 4;
+    // Unset: the one estimate the pipeline makes (acq::default_estimate); a
+    // wider --fmax keeps the default step's 2000 points at most.
+    const acq::EstimateDefaults est = acq::default_estimate(shot);
+    const double fmax = a.fmax > 0 ? a.fmax : est.fmax_hz;
     band_hz = fmax;
     if (!(fmax <= fs / 2)) throw InputError("--fmax above the Nyquist frequency");
-    const double step = a.step > 0 ? a.step : fmax / 2000;
+    const double step = a.step > 0 ? a.step : std::max(est.step_hz, fmax / 2000);
     trust.method = a.method;
     trust.fmin_hz = a.fmin > 0 ? a.fmin : step;
     trust.fmax_hz = fmax;
     trust.step_hz = step;
-    const std::size_t post = shot.samples() - static_cast<std::size_t>(std::max<std::int64_t>(0, shot.pretrigger_samples));
-    trust.prony.prep.max_samples = a.samples.value_or(std::min<std::size_t>(3000, post));
+    trust.prony.prep.max_samples = a.samples.value_or(est.max_samples);
     trust.prony.prony.order = a.order;
     trust.prony.bootstrap = a.bootstrap;
     trust.fft.prep.max_samples = a.samples.value_or(0);
@@ -235,11 +238,16 @@ ImpedanceJobResult run_impedance(const ImpedanceRequest& a) {
     trust.xspec.window = {*win, 0.5};
     trust.xspec.prep.max_samples = a.samples.value_or(0);
     // prony and fft: one shot unless --average; xspec: every shot of the drive as a segment
-    if (a.method != "xspec" && !a.average) trust.shot = static_cast<std::size_t>(&shot - cap.shots.data());
+    if (a.method != "xspec" && (!a.average || a.one_shot || a.shot)) trust.shot = static_cast<std::size_t>(&shot - cap.shots.data());
     assessed = acq::assess_impedance(cap, trust);
     r = assessed->result;
     names = assessed->shots;
     band = assessed->band;
+    try {
+      out.drive = capture_drive_band(cap, names);
+    } catch (const std::invalid_argument&) {
+      // too short a record to tell its band: every feature stands on its σ alone
+    }
   }
   return out;
 }
@@ -253,6 +261,23 @@ nlohmann::json impedance_json(const ImpedanceRequest& a, const ImpedanceJobResul
   const auto& sine_cal = res.sine_cal;
   const double band_hz = res.band_hz;
   auto j = result_json(r, a.file, res.shots, band_hz > 0 ? band_hz : 1e300);
+  if (res.drive) {  // features outside the drive's band are not significant (issue 41 item 4)
+    const auto& d = *res.drive;
+    j["drive_band"] = {{"found", d.found}, {"lo_hz", d.lo_hz}, {"hi_hz", d.hi_hz}, {"note", d.note}};
+    auto& fj = j["features"];
+    for (const std::string kind : {"resonances", "antiresonances"}) {
+      nlohmann::json in = nlohmann::json::array();
+      const auto& fs = fj[kind + "_hz"];
+      for (std::size_t k = 0; k < fs.size(); ++k) {
+        const double f = fs[k].is_number() ? fs[k].get<double>() : 0.0;
+        const bool inside = !d.found || (f >= d.lo_hz && f <= d.hi_hz);
+        in.push_back(inside);
+        if (!inside) fj[kind + "_significant"][k] = false;
+      }
+      fj[kind + "_in_drive_band"] = in;
+    }
+    fj["significance_rule"] = "sigma finite and below a third of the frequency, inside the drive's band";
+  }
   if (assessed) {
     j.update(jobs::assessment_json(*assessed));  // fields added, none renamed
   } else {  // stepped sine

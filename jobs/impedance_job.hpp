@@ -15,6 +15,7 @@
 
 #include "acquisition/capture.hpp"
 #include "acquisition/impedance_assessment.hpp"
+#include "dsp/drive_band.hpp"
 #include "dsp/impedance_types.hpp"
 
 namespace piezo::jobs {
@@ -22,12 +23,16 @@ namespace piezo::jobs {
 struct ImpedanceRequest {
   std::string file, method = "prony", window = "rect";
   std::optional<std::size_t> shot, samples, order, segment;
+  // 0 / unset: the one estimate's (acq::default_estimate: the pipeline's band,
+  // grid and Prony record length).
   double fmin = 0, fmax = 0, step = 0, overlap = 0.5;
   std::size_t bootstrap = 20;
   // Trust (issue 10): compensation, deskew, uncertainty, validity, KK, stabilization.
   std::string compensation = "auto", uncertainty = "auto", stabilization = "2:30:2";
   std::optional<double> skew_ns;
-  bool no_deskew = false, average = false, no_kk = false, no_validity = false, no_stabilization = false;
+  // prony/fft: every transient dut shot of the drive averaged (the pipeline's
+  // estimate, issue 41 item 4) unless one_shot or a shot is named.
+  bool no_deskew = false, average = true, one_shot = false, no_kk = false, no_validity = false, no_stabilization = false;
   bool no_baseline = false;      // do not test for a bench's slow disturbances (issue 33)
   bool remove_baseline = false;  // remove a significant one from channel 1 before the estimate
   std::size_t bootstrap_shots = 30;
@@ -42,6 +47,9 @@ struct ImpedanceJobResult {
   std::optional<dsp::ImpedanceBand> band;
   std::optional<acq::CaptureCalibration> sine_cal;  // stepped sine: compensated here, not by assess_impedance
   double band_hz = 0;                               // upper edge of the estimate's band (0: not stated)
+  // The band the recorded drive covers (transient methods; dsp/drive_band.hpp):
+  // a feature outside it was estimated from noise and is not significant.
+  std::optional<dsp::DriveBand> drive;
 };
 
 // Throws InputError (jobs/job_error.hpp) for a request the capture cannot

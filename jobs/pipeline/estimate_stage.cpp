@@ -6,6 +6,7 @@
 #include <cstdio>
 
 #include "acquisition/divider_record.hpp"
+#include "acquisition/impedance_assessment.hpp"
 #include "dsp/divider_baseline.hpp"
 #include "dsp/cross_spectra.hpp"
 #include "dsp/fft_ratio.hpp"
@@ -40,7 +41,10 @@ dsp::ImpedanceResult estimate(const acq::Capture& cap, bool refine_features, Pip
   if (shots.empty())
     throw std::invalid_argument("the capture holds no transient \"dut\" shot to estimate Z from");
   const acq::Shot& first = *shots.front();
-  const double fmax = std::min(120e3, first.sample_rate_hz / 4), step = 100.0;
+  // The one estimate's band, grid and record length (acq::default_estimate:
+  // `impedance` and `figures` use the same by default).
+  const acq::EstimateDefaults est = acq::default_estimate(first);
+  const double fmax = est.fmax_hz, step = est.step_hz;
   // Repeated shots of one drive are averaged sample by sample before the fit
   // (white noise drops by √N; the transient is identical from shot to shot).
   std::vector<double> v1(first.v1), v2(first.v2);
@@ -82,7 +86,7 @@ dsp::ImpedanceResult estimate(const acq::Capture& cap, bool refine_features, Pip
   // acq::bench_prony_options).
   po.direct_samples = dsp::PronyImpedanceOptions::kDirectFilterLength;
   const std::size_t post = first.samples() - static_cast<std::size_t>(first.pretrigger_samples);
-  po.prep.max_samples = std::min<std::size_t>(6000, post);
+  po.prep.max_samples = est.max_samples;
   po.prony.band_hz = fmax;
   po.features.fmin_hz = step;
   auto prony = dsp::impedance_prony(avg, dsp::make_grid(step, fmax, step), po);

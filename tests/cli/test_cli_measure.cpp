@@ -16,6 +16,7 @@
 #include <array>
 #include <chrono>
 #include <filesystem>
+#include <fstream>
 #include <nlohmann/json.hpp>
 #include <thread>
 
@@ -301,4 +302,48 @@ TEST(CliMeasure, TektronixWithComediBoardAndItsRefusals) {
                     (dir / "c.h5").string());
   EXPECT_EQ(r.exit_code, 2);
   EXPECT_NE(r.err.find("awg=keysight or awg=tektronix"), std::string::npos) << r.err;
+}
+
+// Issue 41 item 4: one estimate everywhere. `impedance CAP.h5` with no option
+// makes the pipeline's estimate (acq::default_estimate: its band, grid, record
+// length, every dut shot averaged): a replay of the same capture (the seed's
+// chain off, so no port-model refinement) reports the same resonances and
+// anti-resonances to rounding, and the impedance command lists no feature
+// outside the drive's band.
+TEST(CliMeasure, ImpedanceAndReplayMakeTheSameEstimate) {
+  const auto dir = tmp_dir() / "one-estimate";
+  std::filesystem::create_directories(dir);
+  const auto cap = (dir / "cap.h5").string();
+  auto r = test::run_cli("measure --instrument sim --shots 3 --noise 0.01 --seed 41 --overwrite --out " +
+                         cap);
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  r = test::run_cli("impedance " + cap + " --json");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const auto imp = nlohmann::json::parse(r.out);
+  const auto results = (dir / "r.h5").string(), jsonl = (dir / "r.jsonl").string();
+  std::filesystem::remove(results);
+  std::filesystem::remove(jsonl);
+  r = test::run_cli("replay " + cap + " --out " + results + " --jsonl " + jsonl);
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  std::ifstream in(jsonl);
+  std::string line;
+  ASSERT_TRUE(std::getline(in, line));
+  const auto rep = nlohmann::json::parse(line)["result"];
+  EXPECT_EQ(imp["samples_used"], 6000);
+  ASSERT_GE(rep["resonances_hz"].size(), 2u);
+  for (const char* key : {"resonances_hz", "antiresonances_hz"}) {
+    ASSERT_EQ(imp["features"][key].size(), rep[key].size()) << key;
+    for (std::size_t k = 0; k < rep[key].size(); ++k)
+      EXPECT_NEAR(imp["features"][key][k].get<double>() / rep[key][k].get<double>(), 1.0, 1e-9) << key << " " << k;
+  }
+  ASSERT_TRUE(imp.contains("drive_band"));
+  const double lo = imp["drive_band"]["lo_hz"], hi = imp["drive_band"]["hi_hz"];
+  for (const char* kind : {"resonances", "antiresonances"}) {
+    for (std::size_t k = 0; k < imp["features"][std::string(kind) + "_hz"].size(); ++k) {
+      const double f = imp["features"][std::string(kind) + "_hz"][k];
+      if (f < lo || f > hi) {
+        EXPECT_FALSE(imp["features"][std::string(kind) + "_significant"][k].get<bool>());
+      }
+    }
+  }
 }

@@ -66,7 +66,8 @@ TEST_F(CmdImpedance, PronyJsonCarriesFeaturesOrderAndSingularValues) {
   ASSERT_EQ(r.code, 0) << r.out;
   const auto j = nlohmann::json::parse(r.out);
   EXPECT_EQ(j["method"], "prony");
-  EXPECT_EQ(j["samples_used"], 3000);
+  // The one estimate's record length (acq::kDefaultEstimateSamples), as the pipeline's.
+  EXPECT_EQ(j["samples_used"], 6000);
   EXPECT_NEAR(j["order"].get<double>(), 8.0, 2.0);
   EXPECT_DOUBLE_EQ(j["singular_values_normalized"][0].get<double>(), 1.0);
   ASSERT_EQ(j["resonances_hz"].size(), 3u);

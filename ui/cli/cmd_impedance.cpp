@@ -66,8 +66,13 @@ void print_text(const nlohmann::json& j) {
   // how many candidates were left out is said.
   auto row = [&](const char* name, const char* key, const char* skey, const char* sigkey) {
     std::printf("  %-15s", name);
-    std::size_t shown = 0, left = 0;
+    std::size_t shown = 0, left = 0, outside = 0;
+    const std::string inkey = std::string(key).substr(0, std::string(key).size() - 3) + "_in_drive_band";
     for (std::size_t k = 0; k < f[key].size(); ++k) {
+      if (f.contains(inkey) && k < f[inkey].size() && f[inkey][k].is_boolean() && !f[inkey][k].get<bool>()) {
+        ++outside;
+        continue;
+      }
       if (f.contains(sigkey) && k < f[sigkey].size() && f[sigkey][k].is_boolean() && !f[sigkey][k].get<bool>()) {
         ++left;
         continue;
@@ -82,12 +87,17 @@ void print_text(const nlohmann::json& j) {
     }
     if (!shown) std::printf(" none significant");
     if (left) std::printf(" (%zu candidate(s) without significance not listed: sigma not below a third of the frequency)", left);
+    if (outside) std::printf(" (%zu candidate(s) outside the drive's band not listed)", outside);
     std::printf("\n");
   };
   row("resonances", "resonances_hz", "resonances_sigma_hz", "resonances_significant");
   row("antiresonances", "antiresonances_hz", "antiresonances_sigma_hz", "antiresonances_significant");
   if (f["capacitance_f"].is_number())
     std::printf("  capacitance     %s\n", jobs::format_value(f["capacitance_f"].get<double>() * 1e12, "pF", 5).c_str());
+  if (j.contains("drive_band") && j["drive_band"]["found"].get<bool>())
+    std::printf("  drive band      %s to %s (channel 1 above its noise floor)\n",
+                jobs::format_value(j["drive_band"]["lo_hz"].get<double>(), "Hz", 3).c_str(),
+                jobs::format_value(j["drive_band"]["hi_hz"].get<double>(), "Hz", 3).c_str());
 }
 
 void run(const ImpedanceArgs& a, Context& ctx) {
@@ -126,12 +136,12 @@ void register_impedance_command(CLI::App& app, Context& ctx) {
   cmd->add_option("CAPTURE", a->req.file, "Capture file (.h5)")->required();
   cmd->add_option("--method", a->req.method, "prony | fft | xspec | sine")
       ->check(CLI::IsMember({"prony", "fft", "xspec", "sine"}));
-  cmd->add_option("--shot", a->req.shot, "Shot index (prony, fft); default: first dut exp_decay shot");
-  cmd->add_option("--samples", a->req.samples, "Samples after t = 0 (prony: default 3000; fft/xspec: all)");
+  cmd->add_option("--shot", a->req.shot, "One shot by index (prony, fft); default: every dut shot of the drive, averaged");
+  cmd->add_option("--samples", a->req.samples, "Samples after t = 0 (prony: default 6000, as the pipeline; fft/xspec: all)");
   cmd->add_option("--order", a->req.order, "Prony model order (default: automatic)")->check(CLI::PositiveNumber);
   cmd->add_option("--fmin", a->req.fmin, "Lowest frequency [Hz] (default: one step)");
-  cmd->add_option("--fmax", a->req.fmax, "Highest frequency [Hz] (default: fs/4)");
-  cmd->add_option("--step", a->req.step, "Prony grid step [Hz] (default: fmax/2000)");
+  cmd->add_option("--fmax", a->req.fmax, "Highest frequency [Hz] (default: the pipeline's, 120 kHz or fs/4 when lower)");
+  cmd->add_option("--step", a->req.step, "Grid step [Hz] (default: 100 Hz, or fmax/2000 when that is wider)");
   cmd->add_option("--window", a->req.window, "fft/xspec window: rect, hann, hamming, blackman-harris, flattop, tukey");
   cmd->add_option("--segment", a->req.segment, "xspec segment length (default: the shortest shot)");
   cmd->add_option("--overlap", a->req.overlap, "xspec segment overlap fraction")->check(CLI::Range(0.0, 0.95));
@@ -147,7 +157,9 @@ void register_impedance_command(CLI::App& app, Context& ctx) {
   cmd->add_flag("--remove-baseline", a->req.remove_baseline,
                 "Remove a significant slow baseline of channel 1 - channel 2 from channel 1 before the estimate");
   cmd->add_option("--skew-ns", a->req.skew_ns, "A stored channel-2 skew (ns, > 0: v2 late) for a capture without calibration shots");
-  cmd->add_flag("--average", a->req.average, "prony/fft: average every dut shot of the drive (default: one shot)");
+  cmd->add_flag("--average", a->req.average,
+                "prony/fft: average every dut shot of the drive (the default, as the pipeline's estimate)");
+  cmd->add_flag("--one-shot", a->req.one_shot, "prony/fft: estimate from one shot (the first exp-decay dut shot, or --shot)");
   cmd->add_option("--uncertainty", a->req.uncertainty, "Uncertainty band: auto | shots | noise | none")->capture_default_str();
   cmd->add_option("--bootstrap-shots", a->req.bootstrap_shots, "Replicates of the bootstrap over shots")->capture_default_str();
   cmd->add_flag("--no-kk", a->req.no_kk, "Skip the Kramers-Kronig / passivity check");
