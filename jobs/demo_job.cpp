@@ -9,8 +9,7 @@
 
 namespace piezo::jobs {
 
-PipelineRequest demo_pipeline_request(const DemoRequest& d) {
-  namespace fs = std::filesystem;
+PipelineRequest demo_bench_request(const DemoRequest& d) {
   const DemoRequest* a = &d;
   PipelineRequest req;
   req.instrument = "sim";
@@ -39,11 +38,17 @@ PipelineRequest demo_pipeline_request(const DemoRequest& d) {
   ho.excitation.f_stop_hz = 150e3;
   ho.excitation.burst_fraction = 0.6;
   req.heldout_plan = ho;
-  req.capture_out = (fs::path(a->out_dir) / "demo-capture.h5").string();
   req.material = "apc850";
   req.isotropic = true;
   req.compare_lm = true;  // the table shows oe, cmcm and lm
-  fs::create_directories(a->out_dir);  // last: bad input leaves nothing behind
+  return req;
+}
+
+PipelineRequest demo_pipeline_request(const DemoRequest& d) {
+  namespace fs = std::filesystem;
+  PipelineRequest req = demo_bench_request(d);
+  req.capture_out = (fs::path(d.out_dir) / "demo-capture.h5").string();
+  fs::create_directories(d.out_dir);  // last: bad input leaves nothing behind
   return req;
 }
 

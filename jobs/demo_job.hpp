@@ -29,6 +29,12 @@ struct DemoRequest {
   int shots = 16;
 };
 
+// The demo's bench and plan without its files: the simulated tube, the
+// record, the fixture standards, the held-out chirp, the nominal material.
+// The GUI opens on it (its defaults are the CLI's, issue 41 item 5). Throws
+// std::invalid_argument for a bad effect, disturbance string or calibration list.
+PipelineRequest demo_bench_request(const DemoRequest& req);
+
 // The pipeline's request of the demo (creates `out_dir`). Throws
 // std::invalid_argument for a bad effect, disturbance string or calibration list.
 PipelineRequest demo_pipeline_request(const DemoRequest& req);

@@ -13,7 +13,7 @@ gui="$root/$build/ui/piezobench-gui"
 work=$(mktemp -d)
 trap 'rm -rf "$work"' EXIT
 cd "$work"
-xvfb-run -a -s "-screen 0 1700x1100x24" "$gui" --sim-effects series_resistance=15 \
+xvfb-run -a -s "-screen 0 1700x1100x24" "$gui" --sim-effects series_resistance=15 --no-calibrate \
   --click 'Measure and update' --wait-job --width 1280 --height 800 --timeout 300 \
   --screenshot "$root/docs/gui-1280x800.png"
 xvfb-run -a -s "-screen 0 1700x1100x24" "$gui" --limits "$root/docs/limits-example.toml" \

@@ -21,6 +21,7 @@
 #include <nlohmann/json.hpp>
 
 #include "acquisition/capture_file.hpp"
+#include "jobs/demo_job.hpp"
 #include "ui/gui/palette.hpp"
 
 namespace fs = std::filesystem;
@@ -147,7 +148,7 @@ TEST(Gui, MeasureAndUpdateUnderXvfb) {
   ScratchCleanup cleanup;
   auto run =
       run_gui("measure",
-              "--sim-effects series_resistance=15 --click 'Measure and update' --click JSON "
+              "--sim-effects series_resistance=15 --no-calibrate --shots 8 --click 'Measure and update' --click JSON "
               "--click 'Measure and update' --hover 700,90 --wait-job --screenshot screenshot.png");
   ASSERT_EQ(run.exit_code, 0) << "GUI run failed; see " << (run.dir / "gui.log");
   const auto& j = run.stats;
@@ -291,6 +292,13 @@ TEST(Gui, ErrorsAreShownWithWhatToDo) {
     EXPECT_EQ(run.stats["error_kind"], "file error");
     EXPECT_NE(run.stats["error"].get<std::string>().find("not-a-capture.h5"), std::string::npos);
     EXPECT_FALSE(run.stats["error_advice"].get<std::string>().empty());
+    // The GUI opens on the CLI's defaults (issue 41 item 5): `demo`'s shots,
+    // fixture standards, held-out chirp and noise.
+    const piezo::jobs::DemoRequest demo;
+    EXPECT_EQ(run.stats["plan"]["shots"], demo.shots);
+    EXPECT_EQ(run.stats["plan"]["calibration"], !demo.no_calibrate);
+    EXPECT_EQ(run.stats["plan"]["heldout"], true);
+    EXPECT_EQ(run.stats["plan"]["noise"], demo.noise);
   }
   {
     const int port = closed_port();

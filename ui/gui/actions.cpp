@@ -54,6 +54,12 @@ void start_job(AppState& s, bool replay) {
       return;
     }
   }
+  if (!replay && req.heldout_plan) {  // the held-out drive on the plan as edited: its excitation only differs
+    acq::MeasurementPlan ho = req.plan;
+    ho.excitation = req.heldout_plan->excitation;
+    req.heldout_plan = ho;
+  }
+  if (replay) req.heldout_plan.reset();
   if (!replay) attach_calibration(s.calibration, s.calibration_prompt, req);  // fixture standards first
   if (!s.job.start(req)) return;
   s.last_job_replay = replay;

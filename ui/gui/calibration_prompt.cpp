@@ -8,19 +8,23 @@ namespace piezo::gui {
 
 void render_calibration_controls(CalibrationForm& f, bool busy) {
   ImGui::BeginDisabled(busy);
-  ImGui::Checkbox("Fixture calibration before the shots", &f.enabled);
-  if (f.enabled) {
-    ImGui::Indent();
+  ImGui::Checkbox("Fixture standards", &f.enabled);
+  if (ImGui::IsItemHovered())
+    ImGui::SetTooltip("Measure the fixture (open, short, load) before the shots, as `demo` does by default");
+  if (f.enabled) {  // on one line: the panel keeps its actions in view
+    ImGui::SameLine();
     ImGui::Checkbox("open", &f.open);
     ImGui::SameLine();
     ImGui::Checkbox("short", &f.shrt);
     ImGui::SameLine();
     ImGui::Checkbox("load", &f.load);
     if (f.load) {
+      ImGui::Indent();
       ImGui::InputDouble("Load [ohm]", &f.load_ohm, 10, 100, "%.1f");
-      ImGui::InputDouble("Load parallel C [pF]", &f.load_parallel_pf, 10, 100, "%.1f");
+      ImGui::InputDouble("Load C [pF]", &f.load_parallel_pf, 10, 100, "%.1f");
+      if (ImGui::IsItemHovered()) ImGui::SetTooltip("Capacitance in parallel with the load standard");
+      ImGui::Unindent();
     }
-    ImGui::Unindent();
   }
   ImGui::EndDisabled();
 }

@@ -14,6 +14,16 @@ void render_plan_window(AppState& s) {
   ImGui::Begin("Plan");
   auto& p = s.request.plan;
   const bool busy = s.job.running();
+  // The form scrolls in its own region; the actions (Measure and update,
+  // Replay, progress and Cancel) stay below it in view at any window size
+  // (issue 41 item 5: at 1280 x 800 they were scrolled out of the panel).
+  const ImGuiStyle& st = ImGui::GetStyle();
+  const float footer = 48 + st.ItemSpacing.y + 2 * ImGui::GetTextLineHeightWithSpacing() +
+                       2 * ImGui::GetFrameHeightWithSpacing() + st.WindowPadding.y +
+                       (s.error || !s.warnings.empty() ? 2 * ImGui::GetTextLineHeightWithSpacing() : 0.0f);
+  ImGui::BeginChild("form", ImVec2(0, -footer), false);
+  // Fields leave room for their longest label.
+  ImGui::PushItemWidth(-(ImGui::CalcTextSize("Outer diameter [mm]").x + st.ItemInnerSpacing.x));
   ImGui::BeginDisabled(busy);
   ImGui::InputDouble("R1 [ohm]", &p.setup.divider_r1_ohm, 10, 100, "%.1f");
   int kind = static_cast<int>(p.excitation.kind);
@@ -59,6 +69,8 @@ void render_plan_window(AppState& s) {
   ImGui::InputText("Capture file", s.capture_out, sizeof s.capture_out);
   ImGui::EndDisabled();
   render_calibration_controls(s.calibration, busy);  // issue 10
+  ImGui::PopItemWidth();
+  ImGui::EndChild();
   ImGui::Separator();
 
   const bool connecting = s.instrument.state == InstrumentForm::State::Connecting;

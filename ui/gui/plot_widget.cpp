@@ -96,17 +96,32 @@ std::vector<std::pair<ImU32, std::string>> readout_at(const PlotSpec& spec, doub
   return lines;
 }
 
-void fit_view(const PlotSpec& spec, PlotView& view) {
+void fit_view(const PlotSpec& spec, PlotView& view, bool all) {
   double xmin = INFINITY, xmax = -INFINITY, ymin = INFINITY, ymax = -INFINITY;
+  const bool framed = !all && spec.fit_x1 > spec.fit_x0 && (!view.log_x || spec.fit_x0 > 0);
+  std::vector<double> ys;  // the samples the y range is taken from
   for (const auto& s : spec.series)
     for (std::size_t i = 0; i < s.x.size() && i < s.y.size(); ++i) {
       if ((view.log_x && s.x[i] <= 0) || (view.log_y && s.y[i] <= 0)) continue;
       if (!std::isfinite(s.x[i]) || !std::isfinite(s.y[i])) continue;
       xmin = std::min(xmin, s.x[i]);
       xmax = std::max(xmax, s.x[i]);
-      ymin = std::min(ymin, s.y[i]);
-      ymax = std::max(ymax, s.y[i]);
+      if (framed && (s.x[i] < spec.fit_x0 || s.x[i] > spec.fit_x1)) continue;
+      ys.push_back(s.y[i]);
     }
+  if (framed && xmax > xmin) {  // the frame, inside the data
+    xmin = std::max(xmin, spec.fit_x0);
+    xmax = std::min(xmax, spec.fit_x1);
+  }
+  if (!ys.empty()) {
+    const double q = all ? 0.0 : std::clamp(spec.fit_y_quantile, 0.0, 0.49);
+    const auto lo = static_cast<std::size_t>(q * static_cast<double>(ys.size() - 1));
+    const auto hi = ys.size() - 1 - lo;
+    std::nth_element(ys.begin(), ys.begin() + static_cast<std::ptrdiff_t>(lo), ys.end());
+    ymin = ys[lo];
+    std::nth_element(ys.begin(), ys.begin() + static_cast<std::ptrdiff_t>(hi), ys.end());
+    ymax = ys[hi];
+  }
   if (!(xmax > xmin)) {
     xmin = view.log_x ? 1 : 0;
     xmax = 10;
@@ -175,7 +190,7 @@ bool plot(const char* id, const PlotSpec& spec, PlotView& view, ImVec2 size) {
     Y1 += dy;
   }
   if (hovered && ImGui::IsMouseDoubleClicked(ImGuiMouseButton_Left)) {
-    fit_view(spec, view);
+    fit_view(spec, view, /*all=*/true);  // every sample ("Fit views" returns to the spec's frame)
     X0 = fwd(view.x0, view.log_x);
     X1 = fwd(view.x1, view.log_x);
     Y0 = fwd(view.y0, view.log_y);

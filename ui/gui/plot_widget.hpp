@@ -59,13 +59,22 @@ struct PlotSpec {
   std::vector<Series> series;
   std::vector<Marker> markers;
   std::vector<Band> bands;
+  // How fit_view frames the data (issue 41 item 5): an x range to open on
+  // (e.g. |Z| on the resonance band; double-click still fits), the y range
+  // then from the samples inside it; and a y range from the quantiles
+  // [q, 1 - q] of those samples, so a few points at the band's edges do not
+  // flatten the rest (0: the full range).
+  double fit_x0 = 0, fit_x1 = 0;  // fit_x1 > fit_x0: open on [fit_x0, fit_x1]
+  double fit_y_quantile = 0;
 };
 
 // Draws the plot in a child region of `size`; returns true while hovered.
 bool plot(const char* id, const PlotSpec& spec, PlotView& view, ImVec2 size);
 
-// Fit the view to the data (used by plot() when !view.fitted).
-void fit_view(const PlotSpec& spec, PlotView& view);
+// Fit the view to the data (used by plot() when !view.fitted), framed as
+// the spec's fit_x0/fit_x1 and fit_y_quantile ask; `all`: every sample (the
+// double-click).
+void fit_view(const PlotSpec& spec, PlotView& view, bool all = false);
 
 // The snapping marker nearest to the cursor at screen x `mouse_px` within
 // `radius_px`, `to_px` mapping data x to screen x; nullptr when none.

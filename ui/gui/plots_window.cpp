@@ -58,6 +58,16 @@ void impedance_specs(const AppState& s, PlotSpec& mag, PlotSpec& ph) {
     mag.markers.push_back({f, IM_COL32(255, 255, 255, 90), "resonance fr " + khz(f), true});
   for (double f : s.result->antiresonances_hz)
     mag.markers.push_back({f, IM_COL32(255, 160, 160, 90), "anti-resonance fa " + khz(f), true});
+  // Open on the resonance band (issue 41 item 5): from 0.8 x the lowest
+  // resonance to 1.25 x the highest anti-resonance, so the modes fill the
+  // plot instead of its right tenth; a double-click shows the whole estimate.
+  double lo = INFINITY, hi = 0;
+  for (double f : s.result->resonances_hz) lo = std::min(lo, f), hi = std::max(hi, f);
+  for (double f : s.result->antiresonances_hz) lo = std::min(lo, f), hi = std::max(hi, f);
+  if (hi > lo && lo > 0) {
+    mag.fit_x0 = ph.fit_x0 = 0.8 * lo;
+    mag.fit_x1 = ph.fit_x1 = 1.25 * hi;
+  }
 }
 std::string pm(const dsp::Uncertain& u, double scale, const char* f) {
   if (!std::isfinite(u.value)) return "-";
@@ -201,10 +211,9 @@ void render_plots_window(AppState& s) {
                         "kept by Prony-SS (order " + std::to_string(s.result->order) + ")"});
   }
 
-  // |Z| across the full width; below it the residual, the phase and the
-  // singular values side by side.
+  // |Z| across the full width; below it the residual and the phase (the
+  // singular values on a tab).
   const ImVec2 avail = ImGui::GetContentRegionAvail();
-  const float gap = ImGui::GetStyle().ItemSpacing.x;
   const float row2 = avail.y * 0.52f;
   plot("mag", mag, s.mag_view, ImVec2(avail.x, avail.y - row2 - ImGui::GetStyle().ItemSpacing.y));
   if (s.show_modes) {
@@ -212,11 +221,23 @@ void render_plots_window(AppState& s) {
     ImGui::End();
     return;
   }
-  plot("residual", res, s.residual_view, ImVec2(avail.x * 0.42f, row2));
-  ImGui::SameLine();
-  plot("phase", ph, s.phase_view, ImVec2(avail.x * 0.30f - gap, row2));
-  ImGui::SameLine();
-  plot("sv", sv, s.sv_view, ImVec2(0, row2));
+  // The residual and the phase side by side; Prony's Hankel singular values
+  // (how the order was chosen: for the engineer, not the technician) behind
+  // a tab of their own.
+  if (ImGui::BeginTabBar("lower")) {
+    if (ImGui::BeginTabItem("Residual and phase")) {
+      const float h = ImGui::GetContentRegionAvail().y;
+      plot("residual", res, s.residual_view, ImVec2(avail.x * 0.58f, h));
+      ImGui::SameLine();
+      plot("phase", ph, s.phase_view, ImVec2(0, h));
+      ImGui::EndTabItem();
+    }
+    if (ImGui::BeginTabItem("Hankel SVs")) {
+      plot("sv", sv, s.sv_view, ImVec2(0, ImGui::GetContentRegionAvail().y));
+      ImGui::EndTabItem();
+    }
+    ImGui::EndTabBar();
+  }
   ImGui::End();
 }
 

@@ -59,6 +59,10 @@ PlotSpec residual_plot_spec(const update::GapDiagnosis& d, bool phase) {
     spec.bands.push_back({g.f_lo_hz / 1e3, g.f_hi_hz / 1e3, region_colour(g.kind),
                           short_kind(g.kind), region_detail(g)});
   }
+  // Fitted to the bulk of the residual (issue 41 item 5): the 1st to 99th
+  // percentile of the samples, so the band's edges do not stretch the axis
+  // to +-40 dB over data within +-5 dB; a double-click shows every sample.
+  spec.fit_y_quantile = 0.01;
   // The noise first and thin, the residuals on top.
   const auto& sig = phase ? d.before.sigma_deg : d.before.sigma_db;
   Series hi{"+/-2 sigma (noise)", khz(d.before.f_hz), {}, kColNoiseBand, 1.0f, false}, lo = hi;
