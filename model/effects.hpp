@@ -8,6 +8,7 @@
 #include <span>
 #include <string>
 #include <string_view>
+#include <vector>
 
 namespace piezo::model {
 
@@ -47,7 +48,13 @@ struct EffectInfo {
   // detectability refer to. daq_input_resistance: 1 MΩ, fitted as its
   // conductance (effect_coordinate_unit).
   double typical;
+  // What measures it apart from the constants when the impedance alone cannot
+  // (an alias): the advice of the diagnosis' alias sentence.
+  std::string_view separated_by;
 };
+
+// The alias sentence's advice for these effects: "measure X with Y; Z with W".
+std::string separation_advice(const std::vector<std::string>& names);
 
 // The unit of the effect's fit coordinate (x = value / unit): `typical`, or
 // for daq_input_resistance the conductance 1/typical (siemens).

@@ -11,6 +11,7 @@
 #include <stdexcept>
 
 #include "model/bench_response.hpp"
+#include "model/effects.hpp"
 
 namespace piezo::update {
 
@@ -381,7 +382,7 @@ GapDiagnosis diagnose_gap(model::ModalSolver& solver, const MaterialClass& cls, 
   if (!aliases.empty()) {
     alias_note = " Not separable from the constants by the impedance alone (aliases): ";
     for (std::size_t i = 0; i < aliases.size(); ++i) alias_note += (i ? ", " : "") + aliases[i];
-    alias_note += " - calibrate the fixture to measure them.";
+    alias_note += " - " + model::separation_advice(aliases) + ".";
   }
   if (!out.measured.empty()) {
     alias_note += " Measured by the fixture calibration and held in the model: ";

@@ -287,7 +287,7 @@ GapDiagnosis build(const OeResult& r, const std::string& fit_description, const 
   if (!aliases.empty()) {
     d.verdict += " Not separable from the constants by this capture (aliases): ";
     for (std::size_t i = 0; i < aliases.size(); ++i) d.verdict += (i ? ", " : "") + aliases[i];
-    d.verdict += " - calibrate the fixture to measure them.";
+    d.verdict += " - " + model::separation_advice(aliases) + ".";
   }
   // Shots that disagree (a drift, a step): the pooled record mixes two or
   // more states of the tube, whose misfit an effect of the catalogue may

@@ -11,6 +11,7 @@
 #include "acquisition/divider_record.hpp"
 #include "dsp/shot_ensemble.hpp"
 #include "model/bench_response.hpp"
+#include "model/effects.hpp"
 #include "model/material_spec.hpp"
 #include "model/modal.hpp"
 #include "model/tube_model.hpp"
@@ -174,4 +175,22 @@ TEST(GapDiagnosisExact, EndMassIsNamedWithItsValue) {
   EXPECT_EQ(r.verdict_effect, "mass_loading") << r.verdict;
   ASSERT_FALSE(r.steps.empty());
   EXPECT_NEAR(r.steps.front().value, 0.03, 0.003);
+}
+
+// The alias sentence's advice comes from the effect table (issue 41: "calibrate
+// the fixture" was advised for any alias, also after the fixture was
+// calibrated and for effects no standard measures): every effect of the
+// catalogue says what measures it; effects with the same advice are named
+// together; an effect that is not in the list is not named.
+TEST(EffectTable, EveryEffectSaysWhatSeparatesItFromTheConstants) {
+  for (const auto& e : piezo::model::effect_catalogue()) EXPECT_FALSE(e.separated_by.empty()) << e.name;
+  const std::string a = piezo::model::separation_advice({"mechanical_damping"});
+  EXPECT_EQ(a.find("fixture"), std::string::npos) << a;
+  EXPECT_NE(a.find("mechanical_damping with"), std::string::npos) << a;
+  const std::string b = piezo::model::separation_advice({"r1_tolerance", "series_resistance", "channel_gain"});
+  EXPECT_NE(b.find("series_resistance with the short standard"), std::string::npos) << b;
+  EXPECT_NE(b.find("channel_gain with the load standard"), std::string::npos) << b;
+  EXPECT_NE(b.find("r1_tolerance with the load standard"), std::string::npos) << b;
+  EXPECT_EQ(b.find("mass_loading"), std::string::npos) << b;
+  EXPECT_EQ(piezo::model::separation_advice({}), "");
 }
