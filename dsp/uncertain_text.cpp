@@ -42,9 +42,9 @@ std::string format_value(double value, std::string_view unit, int digits) {
 }
 
 std::string format_uncertain(double value, double sigma, std::string_view unit, const UncertainStyle& style) {
-  if (!std::isfinite(value)) return kDash;
+  if (!std::isfinite(value)) return style.dash;
   if (!std::isfinite(sigma) || sigma < 0) {
-    if (style.compact) return with_unit(general(value, style.bare_digits) + " ± " + kDash, unit);
+    if (style.compact) return with_unit(general(value, style.bare_digits) + " ± " + style.dash, unit);
     return format_value(value, unit, style.bare_digits) + " (" + style.no_sigma + ")";
   }
   if (sigma == 0) return with_unit(general(value, 6) + " ± 0", unit) + (style.compact ? "" : " (exact)");
@@ -77,7 +77,7 @@ std::string format_uncertain(double value, double sigma, std::string_view unit, 
 }
 
 std::string format_si(double value, double sigma, std::string_view base_unit, const UncertainStyle& style) {
-  if (!std::isfinite(value)) return kDash;
+  if (!std::isfinite(value)) return style.dash;
   static const char* const kSi[] = {"F", "H", "Hz", "s", "V", "A", "W", "m", "ohm", "Ω"};
   if (std::find(std::begin(kSi), std::end(kSi), base_unit) == std::end(kSi))
     return format_uncertain(value, sigma, base_unit, style);

@@ -30,6 +30,9 @@ struct UncertainStyle {
   int bare_digits = 6;
   // What a σ that is not finite says (prose style).
   const char* no_sigma = "σ not identifiable";
+  // What a value or a compact σ that is not finite prints as ("—"; the GUI's
+  // font, Latin-1 only, takes "-").
+  const char* dash = "\xE2\x80\x94";
 };
 
 std::string format_uncertain(double value, double sigma, std::string_view unit = {},

@@ -19,10 +19,13 @@ xvfb-run -a -s "-screen 0 1700x1100x24" "$gui" --sim-effects series_resistance=1
 xvfb-run -a -s "-screen 0 1700x1100x24" "$gui" --limits "$root/docs/limits-example.toml" \
   --click 'Limits...' --click 'Measure and update' --wait-job --width 1600 --height 1000 --timeout 300 \
   --screenshot "$root/docs/gui-1600x1000.png"
+# The Modes view: per-mode figures and the selected mode's admittance plane.
+xvfb-run -a -s "-screen 0 1700x1100x24" "$gui" --click 'Measure and update' --click Modes --wait-job \
+  --width 1280 --height 800 --timeout 300 --screenshot "$root/docs/gui-modes.png"
 corpus="$root/../shared/corpus/refsim-v1/05"
 if [ -f "$corpus/fit.h5" ]; then
   xvfb-run -a -s "-screen 0 1700x1100x24" "$gui" --replay "$corpus/fit.h5" --replay-heldout "$corpus/holdout.h5" \
     --click 'Replay capture' --wait-job --width 1280 --height 800 --timeout 300 \
     --screenshot "$root/docs/gui-replay.png"
 fi
-echo "gui-screenshots: docs/gui-1280x800.png docs/gui-1600x1000.png${corpus:+ docs/gui-replay.png}"
+echo "gui-screenshots: docs/gui-1280x800.png docs/gui-1600x1000.png docs/gui-modes.png${corpus:+ docs/gui-replay.png}"

@@ -386,10 +386,11 @@ GapDiagnosis diagnose_gap(model::ModalSolver& solver, const MaterialClass& cls, 
   }
   if (!out.measured.empty()) {
     alias_note += " Measured by the fixture calibration and held in the model: ";
-    for (std::size_t i = 0; i < out.measured.size(); ++i) {
-      char v[96];
-      std::snprintf(v, sizeof v, "%s%s %.4g", i ? ", " : "", out.measured[i].name.c_str(), out.measured[i].value);
-      alias_note += v;
+    for (std::size_t i = 0; i < out.measured.size(); ++i) {  // with its unit (the effect table's, SI-prefixed)
+      const auto* info = model::find_effect(out.measured[i].name);
+      const std::string unit = info ? std::string(info->unit) : std::string();
+      alias_note += std::string(i ? ", " : "") + out.measured[i].name + " " +
+                    dsp::format_value(out.measured[i].value, unit, 4);
     }
     alias_note += ".";
   }

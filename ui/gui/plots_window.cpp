@@ -8,6 +8,7 @@
 #include <complex>
 #include <cstdio>
 
+#include "jobs/text/uncertain_text.hpp"
 #include "ui/gui/residual_plot.hpp"
 #include "ui/gui/windows.hpp"
 
@@ -126,11 +127,20 @@ void render_modes_row(AppState& s, float width, float height) {
   } else {
     const auto& r = s.result->mode_figures->figures;
     if (!s.result->mode_figures->source.empty()) ImGui::TextDisabled("%s", s.result->mode_figures->source.c_str());
-    ImGui::Text("C^T %s nF, tan d %s at %.0f Hz; N %s Hz m (hoop mode); hover a value for its sigma",
-                pm(r.free_capacitance_f, 1e9, "%.4g").c_str(), pm(r.tan_delta, 1.0, "%.2g").c_str(),
-                r.reference_used_hz, pm(r.frequency_constant_hz_m, 1.0, "%.5g").c_str());
+    // σ to two significant digits, the value to match (dsp/uncertain_text.hpp).
+    // (ImGui's font has no sigma: the words say it.)
+    const dsp::UncertainStyle ascii{false, 3, "sigma not identifiable", "-"};
+    const std::string head = "C^T " + jobs::format_si(r.free_capacitance_f.value, r.free_capacitance_f.sigma, "F", ascii) +
+                             ", tan d " + jobs::format_uncertain(r.tan_delta.value, r.tan_delta.sigma, {}, ascii) + " at " +
+                             jobs::format_value(r.reference_used_hz, "Hz", 4) + "; N " +
+                             jobs::format_uncertain(r.frequency_constant_hz_m.value, r.frequency_constant_hz_m.sigma,
+                                                    "Hz m", ascii) +
+                             " (hoop mode); hover a value for its sigma";
+    ImGui::TextWrapped("%s", head.c_str());
+    // Columns at their content's width; the table scrolls sideways rather
+    // than cutting L1 and C1 off at 1280 x 800 (issue 41 item 5).
     const ImGuiTableFlags flags = ImGuiTableFlags_Borders | ImGuiTableFlags_RowBg | ImGuiTableFlags_ScrollY |
-                                  ImGuiTableFlags_SizingFixedFit;
+                                  ImGuiTableFlags_ScrollX | ImGuiTableFlags_SizingFixedFit;
     if (ImGui::BeginTable("modes", 10, flags)) {
       for (const char* h : {"mode", "status", "fs kHz", "fp kHz", "k_eff", "Qm branch", "Qm 3 dB", "R1 ohm", "L1 mH", "C1 pF"})
         ImGui::TableSetupColumn(h);

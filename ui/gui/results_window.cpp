@@ -12,6 +12,12 @@
 namespace piezo::gui {
 
 namespace {
+// A table cell's value ± σ in the GUI's Latin-1 font ("-" for a σ that is not finite).
+const dsp::UncertainStyle kGuiCell{true, 6, "sigma not identifiable", "-"};
+}  // namespace
+
+
+namespace {
 void parameter_table(const jobs::PipelineResult& r) {
   const bool sim = std::any_of(r.params.begin(), r.params.end(),
                                [](const auto& p) { return p.truth.has_value(); });
@@ -54,7 +60,7 @@ void parameter_table(const jobs::PipelineResult& r) {
     ImGui::Text("%s [%s]", p.name.c_str(), p.unit.c_str());
     ImGui::TableNextColumn();
     const double rel = p.sigma ? 100.0 * *p.sigma / std::abs(p.updated) : NAN;
-    ImGui::Text("%s%s", jobs::format_uncertain(p.updated, p.sigma.value_or(NAN), {}, {true}).c_str(),
+    ImGui::Text("%s%s", jobs::format_uncertain(p.updated, p.sigma.value_or(NAN), {}, kGuiCell).c_str(),
                 std::isfinite(rel) ? (" (" + jobs::format_value(rel, "%", 2) + ")").c_str() : "");
     if (ImGui::IsItemHovered()) {
       if (r.output_error && r.output_error->ok())
@@ -82,7 +88,7 @@ void parameter_table(const jobs::PipelineResult& r) {
       ImGui::TableNextColumn();
       if (p.uncorrected)
         ImGui::Text("%s (%s)",
-                    jobs::format_uncertain(*p.uncorrected, p.uncorrected_sigma.value_or(NAN), {}, {true}).c_str(),
+                    jobs::format_uncertain(*p.uncorrected, p.uncorrected_sigma.value_or(NAN), {}, kGuiCell).c_str(),
                     p.uncorrected_status.c_str());
       else
         ImGui::TextDisabled("-");
