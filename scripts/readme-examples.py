@@ -1,5 +1,6 @@
 #!/usr/bin/env python3
-"""Runs the README's example invocations as a newcomer would (issue 41 item 7).
+"""Runs the README's example invocations as a newcomer would, and checks the
+numbers the docs quote against the program (issue 41 item 7).
 
 Usage: scripts/readme-examples.py PIEZOBENCH README.md WORKDIR
 
@@ -12,8 +13,20 @@ fixtures/ and docs/ beside it. Each must exit 0. Every `demo` line is then run
 again with --json and judged against the acceptance of issue 41: the four
 constants with finite sigma, status ok, and within 3 sigma of the simulated
 bench's true values (the demo's report carries them as "true"; no estimator
-reads them). Exit 0 when all hold, 1 with the failures listed.
+reads them).
+
+Quoted numbers: README.md and docs/*.md mark each number they quote from the
+program with a comment beside it,
+    <!-- doc-check: ARGS | PATH | QUOTED -->
+ARGS the command after `piezobench` (run with --json, in WORKDIR), PATH a
+dotted path into its JSON (an integer indexes an array, a word picks the
+array element whose "name" is that word), QUOTED the number as the text prints
+it. The program's value must round to it: within half a unit of its last digit.
+
+Exit 0 when all hold, 1 with the failures listed.
 """
+import decimal
+import glob
 import json
 import math
 import os
@@ -58,6 +71,53 @@ def runnable(line):
             break
         cmd = stripped
     return None if PLACEHOLDER.search(cmd) else cmd
+
+
+DOC_CHECK = re.compile(r"<!--\s*doc-check:\s*(.+?)\s*\|\s*(\S+)\s*\|\s*(\S+)\s*-->")
+
+
+def json_at(j, path):
+    for tok in path.split("."):
+        if isinstance(j, list):
+            if re.fullmatch(r"-?\d+", tok):
+                j = j[int(tok)]
+            else:
+                j = next(e for e in j if isinstance(e, dict) and e.get("name") == tok)
+        else:
+            j = j[tok]
+    return j
+
+
+def doc_checks(exe, root, work, failures):
+    """The <!-- doc-check --> markers of README.md and docs/*.md; returns how many ran."""
+    cache, n = {}, 0
+    files = [os.path.join(root, "README.md")] + sorted(glob.glob(os.path.join(root, "docs", "*.md")))
+    for path in files:
+        text = open(path, encoding="utf-8").read()
+        for m in DOC_CHECK.finditer(text):
+            args, jpath, quoted = m.group(1), m.group(2), m.group(3)
+            where = f"{os.path.relpath(path, root)}: {quoted} ({args} | {jpath})"
+            if args not in cache:
+                r = subprocess.run([exe, "--json"] + shlex.split(args), cwd=work, capture_output=True, text=True,
+                                   timeout=600)
+                cache[args] = json.loads(r.stdout) if r.returncode == 0 else f"exit {r.returncode}: {r.stderr[-300:]}"
+            j = cache[args]
+            n += 1
+            if isinstance(j, str):
+                failures.append(f"{where}: the command failed ({j})")
+                continue
+            try:
+                value = float(json_at(j, jpath))
+            except (KeyError, IndexError, StopIteration, TypeError, ValueError) as e:
+                failures.append(f"{where}: no number at {jpath} ({e!r})")
+                continue
+            q = decimal.Decimal(quoted)
+            tol = 0.5 * 10 ** q.as_tuple().exponent
+            ok = abs(value - float(q)) <= tol * (1 + 1e-9)
+            print(f"{'ok' if ok else 'STALE':>8}  {where}: the program gives {value:.6g}")
+            if not ok:
+                failures.append(f"{where}: the program gives {value:.6g} (quoted to +-{tol:g})")
+    return n
 
 
 def main():
@@ -115,7 +175,9 @@ def main():
                   f"(true {t}, {z:+.2f} sigma) {p.get('status')}")
             if not ok:
                 failures.append(f"demo {label}: {p['name']} = {v} +- {s}, status {p.get('status')}, true {t}")
-    print(f"readme-examples: {ran} invocation(s) run, {len(demos)} demo(s) judged, {len(failures)} failure(s)")
+    checks = doc_checks(exe, root, work, failures)
+    print(f"readme-examples: {ran} invocation(s) run, {len(demos)} demo(s) judged, {checks} quoted number(s) "
+          f"checked, {len(failures)} failure(s)")
     for f in failures:
         print("FAIL:", f)
     return 1 if failures else 0
