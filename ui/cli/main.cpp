@@ -2,11 +2,13 @@
 // Exit codes: 0 success, 2 bad input, 1 internal failure.
 #include <iostream>
 
+#include "ui/allocator_policy.hpp"
 #include "ui/cli/cli_common.hpp"
 #include "ui/cli/suggest.hpp"
 #include "ui/version.hpp"
 
 int main(int argc, char** argv) {
+  piezo::ui::set_allocator_policy();
   using namespace piezo::cli;
   CLI::App app{"piezobench — impedance measurement and FE model updating of piezoelectric tubes",
                "piezobench"};

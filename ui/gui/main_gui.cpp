@@ -20,6 +20,7 @@
 #include <nlohmann/json.hpp>
 
 #include "jobs/demo_job.hpp"
+#include "ui/allocator_policy.hpp"
 #include "ui/gui/screenshot.hpp"
 #include "ui/gui/test_script.hpp"
 #include "ui/gui/windows.hpp"
@@ -136,6 +137,7 @@ nlohmann::json frame_stats(const AppState& s, const TestScript& script) {
 }  // namespace
 
 int main(int argc, char** argv) {
+  piezo::ui::set_allocator_policy();
   CLI::App cli{"piezobench-gui — Measure and update", "piezobench-gui"};
   std::vector<std::string> clicks;
   std::string screenshot, stats_file, replay, replay_heldout, instrument = "sim", daq, sim_effects;
