@@ -8,6 +8,8 @@
 #include <new>
 #include <stdexcept>
 
+#include "dsp/work_counters.hpp"
+
 namespace piezo::dsp {
 
 namespace {
@@ -38,6 +40,7 @@ RealFft::~RealFft() {
 }
 
 void RealFft::forward(const double* in, std::size_t count, std::complex<double>* out) {
+  g_ffts.fetch_add(1, std::memory_order_relaxed);  // dsp/work_counters.hpp
   count = std::min(count, n_);
   std::memcpy(rbuf_, in, count * sizeof(double));
   std::fill(rbuf_ + count, rbuf_ + n_, 0.0);
@@ -46,6 +49,7 @@ void RealFft::forward(const double* in, std::size_t count, std::complex<double>*
 }
 
 void RealFft::inverse(const std::complex<double>* in, double* out, std::size_t count) {
+  g_ffts.fetch_add(1, std::memory_order_relaxed);
   std::memcpy(cbuf_, static_cast<const void*>(in), bins() * sizeof(fftw_complex));
   fftw_execute(static_cast<fftw_plan>(inv_));  // c2r destroys its input: cbuf_ is scratch
   std::memcpy(out, rbuf_, std::min(count, n_) * sizeof(double));

@@ -12,6 +12,7 @@
 #include <string>
 
 #include "dsp/hankel.hpp"
+#include "dsp/work_counters.hpp"
 
 namespace piezo::dsp {
 
@@ -156,6 +157,7 @@ struct Decomposition {
 Decomposition decompose(const Eigen::Ref<const Eigen::MatrixXd>& y, double sample_rate_hz,
                         const PronyOptions& opt, std::size_t highest_order, bool automatic,
                         bool highest_must_fit) {
+  g_prony_decompositions.fetch_add(1, std::memory_order_relaxed);  // dsp/work_counters.hpp
   if (!(sample_rate_hz > 0.0) || !std::isfinite(sample_rate_hz))
     fail("sample rate must be positive");
   const Eigen::Index m = y.cols();

@@ -127,6 +127,7 @@ DiagnoseResult run_diagnose(const DiagnoseRequest& a) {
   req.material = material;
   req.isotropic = !a.transverse;
   req.gap_candidates = a.candidates;
+  req.seed_chain = a.seed_chain;
   req.oe_options = a.oe;
   std::atomic<bool> cancel{false};
   DiagnoseResult out;
@@ -170,6 +171,7 @@ nlohmann::json diagnose_json(const DiagnoseRequest& a, const DiagnoseResult& r) 
     const nlohmann::json rep = report_json(res);
     c["parameters"] = rep["parameters"];
     c["corrected_for"] = rep["corrected_for"];
+    c["work"] = rep["work"];  // FE modal solves, Prony decompositions, FFTs (issue 43)
   }
   c["stages"] = nlohmann::json::array();
   for (const auto& s : res.stages)

@@ -19,6 +19,10 @@ struct DiagnoseRequest {
   std::string fit, holdout, material, plot, plot_size = "1200x800";
   std::vector<std::string> candidates;  // empty: every effect the diagnosis can fit
   bool transverse = false;              // transversely isotropic class instead of isotropic
+  // The seed's chain (extended CMCM on Prony's features) beside the output-error
+  // fit: off by default as in replay (run anyway when that fit fails); on, the
+  // parameters carry "cmcm" beside the update (`diagnose --seed-chain`).
+  bool seed_chain = false;
   update::OeOptions oe;
   // How the nominal material was chosen when it was a guess (said at once).
   std::function<void(const std::string&)> warn;

@@ -8,6 +8,7 @@
 #include <stdexcept>
 
 #include "model/outer_surface_damping.hpp"
+#include "model/work_counters.hpp"
 
 namespace piezo::model {
 
@@ -185,6 +186,7 @@ ModalResult ModalSolver::solve(const PiezoMaterialE& material, Electrodes electr
                                const ModalOptions& opt) {
   validate(material, "ModalSolver::solve");
   opt.validate();
+  g_modal_solves.fetch_add(1, std::memory_order_relaxed);  // model/work_counters.hpp
   const int nu = model_->n_u();
   if (opt.n_modes >= nu) throw std::invalid_argument("ModalSolver::solve: n_modes >= n_u");
   ModalResult res;

@@ -86,6 +86,21 @@ nlohmann::json report_json(const PipelineResult& r) {
   }
   j["stages"] = nlohmann::json::array();
   for (const auto& s : r.stages) j["stages"].push_back({{"name", s.name}, {"ran", s.ran}, {"note", s.note}});
+  {  // the work done (issue 43): totals, then per phase of the run
+    WorkCounts t;
+    nlohmann::json phases = nlohmann::json::array();
+    for (const auto& p : r.work) {
+      t += p.work;
+      phases.push_back({{"phase", p.phase},
+                        {"modal_solves", p.work.modal_solves},
+                        {"prony_decompositions", p.work.prony_decompositions},
+                        {"ffts", p.work.ffts}});
+    }
+    j["work"] = {{"modal_solves", t.modal_solves},
+                 {"prony_decompositions", t.prony_decompositions},
+                 {"ffts", t.ffts},
+                 {"phases", phases}};
+  }
   j["verdict"] = r.verdict;
   if (r.fixture) {  // measured from the capture's calibration shots
     const auto& f = *r.fixture;

@@ -14,7 +14,7 @@ namespace piezo::jobs::detail {
 acq::Capture acquire(const PipelineRequest& req, PipelineResult& out, const Stages& progress,
                      const std::atomic<bool>& cancel, std::shared_ptr<drivers::sim::SimBench>& sim) {
   if (!req.replay_capture.empty()) {
-    progress(0.05, "reading " + req.replay_capture);
+    progress(0.05, "acquire: reading " + req.replay_capture);
     // A recorded capture is replayed with what it holds: a shot the reader refuses
     // (clipped beyond its range, NaN, a wrong shape) is left out and flagged.
     acq::ContainedReadOptions ro;

@@ -13,10 +13,11 @@ namespace piezo::jobs {
 
 using namespace detail;
 
-PipelineResult run_pipeline(const PipelineRequest& req, const std::function<void(const PipelineProgress&)>& cb,
-                            const std::atomic<bool>& cancel) {
+namespace {
+PipelineResult run_stages(const PipelineRequest& req, const std::function<void(const PipelineProgress&)>& cb,
+                          const std::atomic<bool>& cancel, WorkLog& log) {
   PipelineResult out;
-  Stages progress{cb};
+  Stages progress{cb, &log};
   std::shared_ptr<drivers::sim::SimBench> sim;
   acq::Capture cap = acquire(req, out, progress, cancel, sim);
   if (cancel) return out;
@@ -68,12 +69,20 @@ PipelineResult run_pipeline(const PipelineRequest& req, const std::function<void
   if (!req.seed_chain) out.stages.push_back({"update (CMCM)", false, "not requested (the seed's chain is off)"});
   else if (z) seed = seed_update_stage(req, cap, cm, *z, out);
   else out.stages.push_back({"update (CMCM)", false, "needs the impedance estimate"});
-  const std::string seed_note = out.stages.back().note;
+  std::string seed_note = out.stages.back().note;
   if (cancel) return out;
   progress(0.62, "update: output-error fit");
   const auto oe = output_error_stage(req, cap, cm, out);
   const std::string oe_note = out.stages.back().note;
   if (cancel) return out;
+  if (!req.seed_chain && req.seed_chain_fallback && z && !(oe && oe->ok())) {
+    // The fallback: the seed's chain only where the output-error fit gave no update.
+    progress(0.64, "update: extended CMCM (the seed's chain)");
+    seed = seed_update_stage(req, cap, cm, *z, out);
+    out.stages.back().note += " (run because the output-error fit did not converge)";
+    seed_note = out.stages.back().note;
+    if (cancel) return out;
+  }
   // The per-mode figures on the estimator the capture supports best (issue
   // 34): the output-error fit's updated model, when it converged.
   if (oe && oe->ok()) {
@@ -165,6 +174,18 @@ PipelineResult run_pipeline(const PipelineRequest& req, const std::function<void
     }
   }
   progress(1.0, "done");
+  return out;
+}
+}  // namespace
+
+PipelineResult run_pipeline(const PipelineRequest& req, const std::function<void(const PipelineProgress&)>& cb,
+                            const std::atomic<bool>& cancel) {
+  WorkLog log;
+  log.open("acquire");
+  PipelineResult out = run_stages(req, cb, cancel, log);
+  log.close();
+  for (const auto& p : log.phases())
+    if (p.phase != "done") out.work.push_back(p);
   return out;
 }
 

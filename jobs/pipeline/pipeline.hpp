@@ -15,6 +15,7 @@
 #include "acquisition/sim_setup.hpp"
 #include "dsp/fixture_calibration.hpp"
 #include "jobs/pipeline/capture_mode_figures.hpp"
+#include "jobs/pipeline/work.hpp"
 #include "update/gap_diagnosis.hpp"
 #include "update/output_error.hpp"
 
@@ -65,6 +66,11 @@ struct PipelineRequest {
   // Off, the pipeline runs Prony-SS (plots, features) and the output-error
   // fit only: replay's default, for throughput (`replay --seed-chain` turns it on).
   bool seed_chain = true;
+  // With seed_chain off, run the seed's chain anyway when the output-error fit
+  // did not converge (on Prony's features as estimated): the update it can
+  // still give, without paying for it on every capture (issue 43: 500-700 FE
+  // modal solves of a `diagnose` went to a chain whose result was not used).
+  bool seed_chain_fallback = true;
   // Also run least squares (LM) on the seed's features beside extended CMCM
   // (the demo's comparison table); otherwise LM runs only where CMCM fails.
   bool compare_lm = false;
@@ -150,6 +156,9 @@ struct PipelineResult {
   std::string output_error_excitation;          // the drive of the shots it fitted
   std::string heldout_path;  // the held-out capture, when there is one
   std::vector<StageReport> stages;
+  // The work each phase of the run did (FE modal solves, Prony decompositions,
+  // FFTs; jobs/pipeline/work.hpp): deterministic, asserted by the tests.
+  std::vector<WorkPhase> work;
   std::vector<std::string> warnings;
   // The damping of the seed chain's model curves read from the first two
   // resonances (when the seed chain's constants are used): the model and

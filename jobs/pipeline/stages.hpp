@@ -16,6 +16,7 @@
 #include "dsp/impedance_types.hpp"
 #include "jobs/pipeline/capture_fit.hpp"
 #include "jobs/pipeline/pipeline.hpp"
+#include "jobs/pipeline/work.hpp"
 #include "model/modal.hpp"
 #include "update/feature_update.hpp"
 
@@ -23,7 +24,9 @@ namespace piezo::jobs::detail {
 
 struct Stages {
   const std::function<void(const PipelineProgress&)>& cb;
+  WorkLog* work = nullptr;  // each label opens a phase of the work log (work.hpp)
   void operator()(double f, const std::string& s) const {
+    if (work) work->open(s);
     if (cb) cb(PipelineProgress{f, s});
   }
 };

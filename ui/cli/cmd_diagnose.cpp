@@ -92,6 +92,9 @@ void register_diagnose_command(CLI::App& app, Context& ctx) {
   c->add_option("--candidates", a->req.candidates,
                 "Effects to try, comma-separated (default: all supported)")
       ->delimiter(',');
+  c->add_flag("--seed-chain", a->req.seed_chain,
+              "Also run the seed's chain (Prony features -> extended CMCM, LM where it fails) beside the "
+              "output-error fit; its constants go into parameters[].cmcm (default: only when that fit fails)");
   add_chain_tolerance_options(c, a->req.oe);
   add_json_flag(c, ctx);
   c->callback([&ctx, a] { ctx.exit_code = run_command(ctx, [&] { run_diagnose(ctx, *a); }); });

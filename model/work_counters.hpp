@@ -1,0 +1,18 @@
+#pragma once
+// Process-wide counters of the FE model's expensive work (issue 43): the
+// pipeline reads them before and after each stage (jobs/pipeline/work.hpp), a
+// replay worker per capture, and the tests assert the counts of a replayed
+// capture, so that a change that doubles the work fails CI without a timing
+// assertion. Relaxed atomics: helper threads (the output-error fit's second
+// FE solver) count into the same totals; forked replay workers have their own.
+#include <atomic>
+
+namespace piezo::model {
+
+// ModalSolver::solve calls: one shifted factorisation and one Lanczos
+// eigensolution each (a port model is one short- and one open-circuit solve).
+inline std::atomic<long> g_modal_solves{0};
+
+inline long modal_solves() { return g_modal_solves.load(std::memory_order_relaxed); }
+
+}  // namespace piezo::model

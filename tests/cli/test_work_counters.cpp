@@ -1,0 +1,75 @@
+// Issue 43 item 3: the work of a replayed capture and of a diagnosis,
+// counted and bounded. FE modal solves, Prony-SS decompositions and FFTs are
+// deterministic for a given capture on machines of our kind; the bounds are
+// the counts measured when the counters went in (2026-11-28) plus 20 %, so a
+// change that makes the pipeline do markedly more work fails here without any
+// timing assertion, and one that makes it do less lowers the bounds by hand.
+// The counts: replay of refsim-v1/12 132 modal solves, 1 decomposition, 1390
+// FFTs; diagnose of refsim-v1/07 with its hold-out (a lack-of-fit case, the
+// costliest of the corpus) 631, 1, 2942.
+#include <gtest/gtest.h>
+#include <unistd.h>
+
+#include <filesystem>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <string>
+
+#include "tests/support/run_cli.hpp"
+
+namespace {
+
+namespace fs = std::filesystem;
+const fs::path kCorpus = fs::path(PIEZO_SOURCE_DIR) / ".." / "shared" / "corpus" / "refsim-v1";
+
+void expect_work(const nlohmann::json& w, long modal, long prony, long ffts) {
+  ASSERT_TRUE(w.is_object()) << "no work counts in the report";
+  const long m = w["modal_solves"], p = w["prony_decompositions"], f = w["ffts"];
+  EXPECT_GT(m, 0) << "the counters count nothing";
+  EXPECT_LE(m, modal + modal / 5) << "FE modal solves up more than 20 % (" << m << " for " << modal << ")";
+  EXPECT_LE(p, prony) << "Prony decompositions up (" << p << " for " << prony << ")";
+  EXPECT_LE(f, ffts + ffts / 5) << "FFTs up more than 20 % (" << f << " for " << ffts << ")";
+  // The phases add up to the totals.
+  long sm = 0, sp = 0, sf = 0;
+  for (const auto& ph : w["phases"]) {
+    sm += ph["modal_solves"].get<long>();
+    sp += ph["prony_decompositions"].get<long>();
+    sf += ph["ffts"].get<long>();
+  }
+  EXPECT_EQ(sm, m);
+  EXPECT_EQ(sp, p);
+  EXPECT_EQ(sf, f);
+}
+
+TEST(WorkCounters, ReplayOfOneCorpusCapture) {
+  if (!fs::exists(kCorpus / "12" / "fit.h5")) GTEST_SKIP() << "no corpus at " << kCorpus;
+  const fs::path dir = fs::temp_directory_path() / ("piezo-work-" + std::to_string(::getpid()));
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  const auto r = piezo::test::run_cli("replay " + (kCorpus / "12" / "fit.h5").string() + " --out " +
+                                      (dir / "r.h5").string() + " --jsonl " + (dir / "r.jsonl").string());
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  std::ifstream in(dir / "r.jsonl");
+  std::string line;
+  ASSERT_TRUE(std::getline(in, line));
+  const auto j = nlohmann::json::parse(line);
+  expect_work(j["result"]["work"], 132, 1, 1390);
+  // The seed's chain is off in a replay and the output-error fit converged: no
+  // FE work in its phase.
+  for (const auto& ph : j["result"]["work"]["phases"]) {
+    if (ph["phase"].get<std::string>().find("CMCM") != std::string::npos) {
+      EXPECT_EQ(ph["modal_solves"], 0) << ph;
+    }
+  }
+  fs::remove_all(dir);
+}
+
+TEST(WorkCounters, DiagnosisWithItsHoldout) {
+  if (!fs::exists(kCorpus / "07" / "fit.h5")) GTEST_SKIP() << "no corpus at " << kCorpus;
+  const auto r = piezo::test::run_cli("diagnose " + (kCorpus / "07" / "fit.h5").string() + " --holdout " +
+                                      (kCorpus / "07" / "holdout.h5").string() + " --json");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  expect_work(nlohmann::json::parse(r.out)["work"], 631, 1, 2942);
+}
+
+}  // namespace
