@@ -94,7 +94,8 @@ nlohmann::json report_json(const PipelineResult& r) {
       phases.push_back({{"phase", p.phase},
                         {"modal_solves", p.work.modal_solves},
                         {"prony_decompositions", p.work.prony_decompositions},
-                        {"ffts", p.work.ffts}});
+                        {"ffts", p.work.ffts},
+                        {"seconds", p.seconds}});
     }
     j["work"] = {{"modal_solves", t.modal_solves},
                  {"prony_decompositions", t.prony_decompositions},

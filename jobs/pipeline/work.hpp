@@ -30,6 +30,7 @@ WorkCounts work_since(const WorkCounts& a, const WorkCounts& b);
 struct WorkPhase {
   std::string phase;  // "acquire", "estimate", "update: output-error fit", "diagnose", …
   WorkCounts work;
+  double seconds = 0;  // wall time (not deterministic: never compared by the tests)
 };
 
 // Records the work between progress labels: open() closes the phase running
@@ -45,6 +46,7 @@ class WorkLog {
  private:
   std::vector<WorkPhase> phases_;
   WorkCounts start_{};
+  double t0_ = 0;
   bool running_ = false;
 };
 
