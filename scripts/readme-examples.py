@@ -16,7 +16,7 @@ bench's true values (the demo's report carries them as "true"; no estimator
 reads them).
 
 Quoted numbers: README.md and docs/*.md mark each number they quote from the
-program with a comment beside it,
+program with a comment on a line of its own beside it,
     <!-- doc-check: ARGS | PATH | QUOTED -->
 ARGS the command after `piezobench` (run with --json, in WORKDIR), PATH a
 dotted path into its JSON (an integer indexes an array, a word picks the
@@ -73,7 +73,8 @@ def runnable(line):
     return None if PLACEHOLDER.search(cmd) else cmd
 
 
-DOC_CHECK = re.compile(r"<!--\s*doc-check:\s*(.+?)\s*\|\s*(\S+)\s*\|\s*(\S+)\s*-->")
+# A marker stands on a line of its own (a page may show the syntax in running text).
+DOC_CHECK = re.compile(r"^[ \t]*<!--\s*doc-check:\s*(.+?)\s*\|\s*(\S+)\s*\|\s*(\S+)\s*-->", re.M)
 
 
 def json_at(j, path):
