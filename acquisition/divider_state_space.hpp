@@ -26,11 +26,12 @@
 #include "drivers/sim/bench_physics.hpp"
 #include "model/effects.hpp"
 #include "model/port_model.hpp"
+#include "model/seed_circuit.hpp"
 
 namespace piezo::acq {
 
 struct BenchCircuit {
-  double r1_ohm = 3140.0;  // the TRUE series resistor (nominal·(1 + r1_tolerance))
+  double r1_ohm = model::kSeedR1Ohm;  // the TRUE series resistor (nominal·(1 + r1_tolerance))
   double series_resistance_ohm = 0.0;
   double parallel_capacitance_f = 0.0;
   double daq_input_resistance_ohm = std::numeric_limits<double>::infinity();

@@ -9,6 +9,8 @@
 #include <stdexcept>
 #include <toml++/toml.h>
 
+#include "model/seed_circuit.hpp"
+
 namespace piezo::acq {
 
 namespace {
@@ -218,7 +220,7 @@ MeasurementPlan parse_plan_toml(std::string_view toml_text, const std::string& s
       p.shots = static_cast<int>(*v);
     }
   }
-  p.setup.divider_r1_ohm = 3140.0;
+  p.setup.divider_r1_ohm = model::kSeedR1Ohm;
   if (auto su = t["setup"].as_table()) {
     for (auto& [k, v] : *su) {
       static const std::vector<std::string> known = {"r1_ohm", "transducer_id", "material", "notes",

@@ -6,6 +6,7 @@
 #include "acquisition/calibration_plan.hpp"
 #include "drivers/sim/disturbances.hpp"
 #include "model/effects.hpp"
+#include "model/seed_circuit.hpp"
 
 namespace piezo::jobs {
 
@@ -13,7 +14,7 @@ PipelineRequest demo_bench_request(const DemoRequest& d) {
   const DemoRequest* a = &d;
   PipelineRequest req;
   req.instrument = "sim";
-  req.plan.setup.divider_r1_ohm = 3140.0;
+  req.plan.setup.divider_r1_ohm = model::kSeedR1Ohm;
   req.plan.setup.transducer_id = "demo-tube";
   req.plan.setup.material = "apc850";
   req.plan.samples = 20000;

@@ -19,11 +19,12 @@
 #include <vector>
 
 #include "model/port_model.hpp"
+#include "model/seed_circuit.hpp"
 
 namespace piezo::model {
 
 struct DividerCircuit {
-  double r1_ohm = 3140.0;  // series resistor (seed ch. 5 lab circuit)
+  double r1_ohm = kSeedR1Ohm;  // series resistor (seed ch. 5 lab circuit)
   double c_parallel_f = 0.0;  // capacitance from node 2 to ground (cable, DAQ input)
   double r_lead_ohm = 0.0;    // series resistance between node 2 and the transducer
   double r_daq_ohm = std::numeric_limits<double>::infinity();  // DAQ input resistance at node 2

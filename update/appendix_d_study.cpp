@@ -6,6 +6,7 @@
 #include <sstream>
 
 #include "model/transient.hpp"
+#include "model/seed_circuit.hpp"
 
 namespace piezo::update {
 
@@ -56,7 +57,7 @@ OeData simulate_capture(model::ModalSolver& solver, const model::PiezoMaterialE&
   mo.n_modes = 40;  // more than the estimator's 16: its truncation is part of the comparison
   const auto port = solver.port_model(target, mo);
   model::DividerCircuit c;
-  c.r1_ohm = 3140.0;
+  c.r1_ohm = model::kSeedR1Ohm;
   v2 = model::simulate_divider(port, {0.0, o.beta_s}, c, v1, fs);
   if (o.noise_rel > 0) {
     std::mt19937_64 rng(o.seed);

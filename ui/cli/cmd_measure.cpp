@@ -24,6 +24,7 @@
 #include "drivers/sim/tcp_server.hpp"
 #include "drivers/transport.hpp"
 #include "ui/cli/cli_common.hpp"
+#include "model/seed_circuit.hpp"
 
 namespace piezo::cli {
 
@@ -126,7 +127,7 @@ void register_measure_commands(CLI::App& app, Context& ctx) {
     std::string excitation = "exp_decay";
     double amplitude = 1.0, decay = 3000.0, frequency = 50e3, f_start = 1e3, f_stop = 120e3, f_step = 0;
     std::size_t samples = 20000, pretrigger = 200;
-    double rate = 1e7, range = 0, r1 = 3140;
+    double rate = 1e7, range = 0, r1 = model::kSeedR1Ohm;
     int shots = 1;
     std::string out;
     bool overwrite = false, allow_clipping = false;
@@ -269,7 +270,7 @@ void register_measure_commands(CLI::App& app, Context& ctx) {
   struct SimArgs {
     std::string host = "127.0.0.1";
     int port = 5025;
-    double r1 = 3140;
+    double r1 = model::kSeedR1Ohm;
     double seconds = 0;  // 0 = until interrupted
     std::string dialect = "keysight";
     SimOptions sim;
