@@ -17,13 +17,13 @@ WorkCounts work_since(const WorkCounts& a, const WorkCounts& b) {
 }
 
 namespace {
-// The phase a progress label belongs to: the words before its colon ("acquire:
-// shot 3/64 fetch" → "acquire"; the gap diagnosis' steps → "diagnose"), the
-// update's two fits apart ("update: output-error fit").
 double now_s() {
   return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
 }
 
+// The phase a progress label belongs to: the words before its colon ("acquire:
+// shot 3/64 fetch" → "acquire"; the gap diagnosis' steps → "diagnose"), the
+// update's two fits apart ("update: output-error fit").
 std::string phase_of(const std::string& label) {
   const auto colon = label.find(':');
   std::string key = label.substr(0, colon);
@@ -48,12 +48,6 @@ void WorkLog::close() {
   phases_.back().work = work_since(work_now(), start_);
   phases_.back().seconds = now_s() - t0_;
   running_ = false;
-}
-
-WorkCounts WorkLog::total() const {
-  WorkCounts t;
-  for (const auto& p : phases_) t += p.work;
-  return t;
 }
 
 }  // namespace piezo::jobs

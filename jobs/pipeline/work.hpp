@@ -41,7 +41,6 @@ class WorkLog {
   void open(const std::string& label);
   void close();
   const std::vector<WorkPhase>& phases() const { return phases_; }
-  WorkCounts total() const;
 
  private:
   std::vector<WorkPhase> phases_;
