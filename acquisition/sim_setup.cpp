@@ -6,6 +6,7 @@
 #include <map>
 #include <stdexcept>
 
+#include "acquisition/channel2_response.hpp"
 #include "acquisition/divider_state_space.hpp"
 #include "model/material_spec.hpp"
 #include "model/modal.hpp"
@@ -35,15 +36,20 @@ class FePhysics : public drivers::sim::BenchPhysics {
   };
 
   FePhysics(Transducer transducer, const model::ModalPortModel& port, const BenchCircuit& circuit,
-            std::vector<std::pair<std::string, double>> truth, std::string description)
+            Channel2Response channel2, std::vector<std::pair<std::string, double>> truth,
+            std::string description)
       : transducer_(std::move(transducer)), port_(port), circuit_(circuit), ss_(port, circuit),
-        truth_(std::move(truth)), description_(std::move(description)) {
+        channel2_(std::move(channel2)), truth_(std::move(truth)), description_(std::move(description)) {
     ports_.emplace(key(factors_), port);
   }
 
   std::vector<double> respond(const drivers::sim::PiecewiseLinear& v1,
                               std::span<const double> times) override {
-    return ss_.simulate(v1, times);
+    std::vector<double> v2 = ss_.simulate(v1, times);
+    // The catalogue's channel-2 effects without an element of their own.
+    if (channel2_ && times.size() > 1)
+      apply_channel2_response(v2, (times.back() - times.front()) / double(times.size() - 1), channel2_);
+    return v2;
   }
   std::vector<std::pair<std::string, double>> truth() const override { return truth_; }
   std::string description() const override { return description_; }
@@ -100,6 +106,7 @@ class FePhysics : public drivers::sim::BenchPhysics {
   model::ModalPortModel port_;  // the current constants'
   BenchCircuit circuit_;
   DividerStateSpace ss_;
+  Channel2Response channel2_;
   std::vector<std::pair<std::string, double>> truth_;
   std::string description_;
   drivers::sim::ConstantFactors factors_;
@@ -194,7 +201,7 @@ std::shared_ptr<drivers::sim::SimBench> make_sim_bench(const SimSpec& spec, doub
   imp.noise_v[0] = imp.noise_v[1] = spec.noise_v;
   imp.adc_bits = spec.adc_bits;
   auto physics = std::make_unique<FePhysics>(
-      std::move(tr), port, c, std::move(truth),
+      std::move(tr), port, c, channel2_response(fx), std::move(truth),
       "FE tube " + mat.description + ", " + std::to_string(static_cast<int>(port.modes.size())) +
           " modes" + what);
   return std::make_shared<drivers::sim::SimBench>(std::move(physics), imp, spec.seed, spec.faults,

@@ -2,6 +2,7 @@
 
 #include <cmath>
 #include <stdexcept>
+#include <vector>
 
 namespace piezo::model {
 
@@ -35,14 +36,48 @@ cd tube_admittance(const ModalPortModel& port, const RayleighDamping& d, const E
   return cd(0.0, omega) * q;
 }
 
+namespace {
+// The catalogue's entries of each circuit/DAQ stage, found once (this is the
+// fits' inner loop: a few entries, no search).
+struct StageEntries {
+  std::vector<const EffectInfo*> at[5];
+  StageEntries() {
+    for (const auto& e : effect_catalogue()) at[static_cast<int>(e.stage)].push_back(&e);
+  }
+};
+const std::vector<const EffectInfo*>& entries(EffectStage s) {
+  static const StageEntries all;
+  return all.at[static_cast<int>(s)];
+}
+// The term of e at ω if e is present in fx (its value not the neutral one).
+bool present(const EffectInfo& e, const EffectSet& fx) {
+  static const EffectSet neutral;
+  return fx.*(e.field) != neutral.*(e.field);
+}
+}  // namespace
+
 cd recorded_transfer(cd y_tube, const EffectSet& fx, double r1_nominal_ohm, double omega) {
   if (!(r1_nominal_ohm > 0)) throw std::invalid_argument("recorded_transfer: R1 must be positive");
-  // Y_n = 1/Z_a + jωC_p + 1/R_daq with Z_a = 1/Y_t + R_s; H = 1/(1 + R1·Y_n).
-  cd y = fx.series_resistance_ohm > 0 ? y_tube / (1.0 + fx.series_resistance_ohm * y_tube) : y_tube;
-  y += cd(0.0, omega * fx.parallel_capacitance_f);
-  if (std::isfinite(fx.daq_input_resistance_ohm)) y += 1.0 / fx.daq_input_resistance_ohm;
-  const cd h = 1.0 / (1.0 + r1_nominal_ohm * (1.0 + fx.r1_tolerance) * y);
-  return h * (1.0 + fx.channel_gain) * std::exp(cd(0.0, -omega * fx.channel_skew_s));
+  // Each circuit and DAQ effect by its catalogue term (model/effects.hpp):
+  // Z_a = 1/Y_t + ΣZ_series, Y_n = 1/Z_a + ΣY_shunt, H = 1/(1 + R1·Πf_r1·Y_n),
+  // H' = H·Πf_channel2.
+  cd y = y_tube;
+  for (const EffectInfo* e : entries(EffectStage::series))
+    if (present(*e, fx))
+      if (const cd z = e->term(fx.*(e->field), omega); z != 0.0) y = y / (1.0 + z * y);
+  for (const EffectInfo* e : entries(EffectStage::shunt))
+    if (present(*e, fx)) y += e->term(fx.*(e->field), omega);
+  double r1 = r1_nominal_ohm;
+  for (const EffectInfo* e : entries(EffectStage::r1))
+    if (present(*e, fx)) r1 *= e->term(fx.*(e->field), omega).real();
+  cd h = 1.0 / (1.0 + r1 * y);
+  // The channel-2 factors from the catalogue's last to its first (the gain
+  // before the skew's phase, the order this product was first written in:
+  // only the rounding depends on it).
+  const auto& daq = entries(EffectStage::channel2);
+  for (auto it = daq.rbegin(); it != daq.rend(); ++it)
+    if (present(**it, fx)) h *= (*it)->term(fx.*((*it)->field), omega);
+  return h;
 }
 
 cd reported_impedance(cd y_tube, const EffectSet& fx, double r1_nominal_ohm, double omega) {

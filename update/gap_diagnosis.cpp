@@ -271,7 +271,7 @@ GapDiagnosis diagnose_gap(model::ModalSolver& solver, const MaterialClass& cls, 
       rep.fitted = true;
       rep.value = m.effect_value(f.x, je);
       rep.sigma = f.sigma_x[static_cast<std::size_t>(je)] * x_unit;
-      if (info->name == "daq_input_resistance") {  // fitted as a conductance G; σ_R = σ_G·R²
+      if (info->coordinate == model::EffectCoordinate::conductance) {  // fitted as G; σ_R = σ_G·R²
         rep.sigma = std::isfinite(rep.value) ? rep.sigma * rep.value * rep.value : std::numeric_limits<double>::infinity();
       }
       rep.chi2_after = f.chi2;
@@ -292,9 +292,8 @@ GapDiagnosis diagnose_gap(model::ModalSolver& solver, const MaterialClass& cls, 
         rep.material_rel_sigma[i] = f.converged && f.sigma_x[i] > 0 ? 0.01 * f.sigma_x[i] : NAN;
       if (!f.converged) rep.note = f.message;
       else if (!law.empty()) rep.note = "law in frequency: " + law + " (the better fit of the two)";
-      else if (rep.name == "mass_loading")  // tests/update/test_gap_validation, GAP_EFFECTS=mass_loading
-        rep.note = "its magnitude trades against the elastic constants (a lighter mass on a stiffer "
-                   "material): named in 13 of 14 simulated tubes, the fraction read low (0.2-1.0 x the true one)";
+      else if (!info->note.empty())
+        rep.note = info->note;
       if (heldout) {
         rep.heldout_chi2_after = predictive_chi2(m, *heldout, f);
         const double before = excess_gap(*ho_cur, out.n_heldout);

@@ -14,8 +14,6 @@ constexpr double kDampUnit = 1e-3;   // damping ratio per x unit
 constexpr double kLinStep = 0.1;     // x units (0.1 %) for the linearisation differences
 constexpr int kMat = 4;
 constexpr double kMassStep = 0.002;  // end-mass fraction step for its linearisation (0.1 x unit)
-
-bool is_conductance(const model::EffectInfo& e) { return e.name == "daq_input_resistance"; }
 }  // namespace
 
 double typical_effect_magnitude(const model::EffectInfo& e) {
@@ -61,15 +59,7 @@ void GapModel::set_effects(const std::vector<std::string>& effects) {
   for (const auto& name : effects) {
     const auto* e = model::find_effect(name);
     if (!e) throw std::invalid_argument("GapModel: unknown effect '" + name + "'");
-    const double u = typical_effect_magnitude(*e);
-    double lo, hi;
-    if (is_conductance(*e)) {
-      lo = 0.0;
-      hi = (1.0 / e->lower) / u;
-    } else {
-      lo = e->lower / u;
-      hi = e->upper / u;
-    }
+    const auto [lo, hi] = model::effect_coordinate_bounds(*e);
     params_.push_back({GapParam::effect, name, e, lo, hi});
   }
   // The end mass is a direction of the linearised port: (un)set it with the
@@ -88,9 +78,8 @@ std::vector<double> GapModel::reference_x() const {
   x[5] = damping0_.beta * w_ref_ / 2 / kDampUnit;
   for (std::size_t i = 6; i < params_.size(); ++i) {
     const auto& e = *params_[i].effect;
-    model::EffectSet neutral;
-    const double v = neutral.*(e.field);
-    x[i] = is_conductance(e) ? 0.0 : v / typical_effect_magnitude(e);
+    const model::EffectSet neutral;
+    x[i] = model::effect_coordinate(e, neutral.*(e.field));
   }
   return x;
 }
@@ -109,10 +98,7 @@ model::RayleighDamping GapModel::damping(const std::vector<double>& x) const {
 }
 
 double GapModel::effect_value(const std::vector<double>& x, int i) const {
-  const auto& e = *params_.at(static_cast<std::size_t>(i)).effect;
-  const double v = x[static_cast<std::size_t>(i)] * typical_effect_magnitude(e);
-  if (is_conductance(e)) return v > 0 ? 1.0 / v : std::numeric_limits<double>::infinity();
-  return v;
+  return model::effect_from_coordinate(*params_.at(static_cast<std::size_t>(i)).effect, x[static_cast<std::size_t>(i)]);
 }
 
 model::EffectSet GapModel::effects(const std::vector<double>& x) const {

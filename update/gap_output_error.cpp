@@ -41,8 +41,7 @@ bool weak_candidate(const OeEffect& e) {
     return false;
   const model::EffectInfo* info = model::find_effect(e.name);
   if (!info) return false;
-  if (e.name == "daq_input_resistance") return e.value > 0;
-  return e.value >= info->lower && e.value <= info->upper;
+  return model::effect_value_physical(*info, e.value);
 }
 
 // The slow disturbances as sentences (issue 33 item 3).

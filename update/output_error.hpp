@@ -340,13 +340,12 @@ OeResult fit_output_error(model::ModalSolver& solver, const MaterialClass& cls,
                           const TubeParams& nominal, const OeData& data,
                           const OeOptions& options = {});
 
-// A catalogue effect as a coordinate of the output-error model: x·typical
-// added to its EffectSet field (the DAQ input as a conductance, x·1 µS, so
-// that 0 is "none"). Empty for effects this model cannot fit.
+// A catalogue effect as a coordinate of the output-error model: x units of
+// model::effect_coordinate_unit added to its EffectSet field (a conductance
+// coordinate, the DAQ input, as x·1 µS, so that 0 is "none"). Empty for
+// effects this model cannot fit.
 struct EffectCoordinate {
-  double typical = 0;  // SI (the DAQ input: siemens)
   std::function<void(model::EffectSet&, double)> apply;
-  std::function<double(double)> value;  // SI from x (the DAQ input: siemens)
 };
 std::optional<EffectCoordinate> effect_coordinate(const std::string& name);
 

@@ -23,8 +23,9 @@
 #include "drivers/sim/sim_tektronix_awg.hpp"
 #include "drivers/sim/tcp_server.hpp"
 #include "drivers/transport.hpp"
-#include "ui/cli/cli_common.hpp"
+#include "model/effects.hpp"
 #include "model/seed_circuit.hpp"
+#include "ui/cli/cli_common.hpp"
 
 namespace piezo::cli {
 
@@ -43,7 +44,8 @@ struct SimOptions {
 };
 
 void add_sim_options(CLI::App* cmd, SimOptions& o) {
-  cmd->add_option("--effect", o.effects, "Simulated bench effect NAME=VALUE (repeatable)");
+  cmd->add_option("--effect", o.effects,
+                  "Simulated bench effect NAME=VALUE (SI, repeatable); NAME: " + model::effect_names());
   cmd->add_option(
       "--disturbance", o.disturbance,
       "Simulated bench's slow disturbances: offset=V,offset_shot=V,hum=V[,mains=50|60],pink=PCT,drift=PCT,"

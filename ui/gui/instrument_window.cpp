@@ -7,6 +7,7 @@
 #include <cstdio>
 
 #include "drivers/instrument_uri.hpp"
+#include "model/effects.hpp"
 #include "ui/gui/driver_choices.hpp"
 
 namespace piezo::gui {
@@ -94,11 +95,9 @@ void render_instrument_window(AppState& s) {
     ImGui::InputTextWithHint("Sim effects", "e.g. series_resistance=15", in.sim_effects,
                              sizeof in.sim_effects);
     if (ImGui::IsItemHovered())
-      ImGui::SetTooltip(
-          "Bench effects the simulated bench adds and the model lacks, NAME=VALUE (SI), "
-          "comma separated:\nseries_resistance, parallel_capacitance, daq_input_resistance, "
-          "dielectric_loss,\nchannel_skew, channel_gain, r1_tolerance, mechanical_damping, "
-          "mass_loading");
+      ImGui::SetTooltip("Bench effects the simulated bench adds and the model lacks, NAME=VALUE (SI), "
+                        "comma separated:\n%s",
+                        model::effect_names(4).c_str());
     ImGui::InputTextWithHint("Disturbances", "e.g. offset=0.005,hum=0.005,mains=50",
                              in.sim_disturbances, sizeof in.sim_disturbances);
     if (ImGui::IsItemHovered())

@@ -27,8 +27,6 @@ namespace {
 struct Refit {
   std::size_t index;  // in out.effects
   std::function<void(model::EffectSet&, double)> apply;
-  std::function<double(double)> value;
-  double typical;
   const model::EffectInfo* info;
   LmOutcome run;
 };
@@ -78,30 +76,24 @@ void fill(const ScanInputs& in, Problem& p, Fitter& f, OeEffect& e, Refit& rf) {
   const double dof_e = std::max(1.0, dof - 1.0);
   e.chi2_per_dof = 2.0 * run.cost / dof_e;
   e.delta_chi2 = 2.0 * (best.cost - run.cost);
-  const double v = rf.value(run.x[kParams]);
-  double sv = NAN;
+  double sx = NAN;  // the coordinate's σ
   if (run.jtj.rows() == kParams + 1) {
     Eigen::FullPivLU<Eigen::MatrixXd> lu(run.jtj);
     if (lu.isInvertible()) {
       const Eigen::MatrixXd ce = std::max(1.0, e.chi2_per_dof) * lu.inverse();
-      sv = rf.typical * std::sqrt(std::max(0.0, ce(kParams, kParams)));
+      sx = std::sqrt(std::max(0.0, ce(kParams, kParams)));
       e.covariance_rel = ce;
       const double k = nominal.nu12 / e.material.nu12;
       e.covariance_rel.row(1) *= k;
       e.covariance_rel.col(1) *= k;
     }
   }
-  const bool daq = e.name == "daq_input_resistance";
-  if (daq) {  // conductance → resistance, σ_R = σ_G/G²
-    e.value = v > 0 ? 1.0 / v : INFINITY;
-    e.sigma = v > 0 ? sv / (v * v) : NAN;
-  } else {
-    e.value = v;
-    e.sigma = sv;
-  }
+  // From the coordinate (a conductance's σ_R = σ_G/G²).
+  e.value = model::effect_from_coordinate(*rf.info, run.x[kParams]);
+  e.sigma = model::effect_sigma_from_coordinate(*rf.info, run.x[kParams], sx);
   const auto st = spectral_lack_of_fit(run.r, p.residual_psd(*t_best, ch1, ch2), p.residual_bin_hz());
   e.band_log10_p = st.log10_p;
-  const bool physical = daq ? v > 0 : (e.value >= rf.info->lower && e.value <= rf.info->upper);
+  const bool physical = model::effect_value_physical(*rf.info, e.value);
   e.significant = !e.alias && run.converged && physical &&
                   e.delta_chi2 > opt.effect_significance * std::max(1.0, e.chi2_per_dof);
   e.explains = e.significant && e.chi2_per_dof <= out.chi2_limit && st.log10_p >= std::log10(opt.lack_of_fit_p);
@@ -167,13 +159,11 @@ Scanned scan_one(const ScanInputs& in, Problem& p, Fitter& f, const std::string&
   Scanned s;
   const model::EffectInfo* info = model::find_effect(name);
   const auto coord = effect_coordinate(name);
-  const double typical = coord->typical;
   const auto& apply = coord->apply;
-  const auto& value = coord->value;
   OeEffect e;
   const int models_before = p.evaluations();
   e.name = name;
-  e.typical = name == "daq_input_resistance" ? 1.0 / typical : typical;
+  e.typical = info->typical;
   e.unit = info->unit;
   p.free_effect(apply);
   Eigen::VectorXd x0(kParams + 1);
@@ -183,9 +173,8 @@ Scanned scan_one(const ScanInputs& in, Problem& p, Fitter& f, const std::string&
   const Eigen::MatrixXd& j_start = fo.j_start;
   // Far below significance to first order (and not the end mass, whose
   // effect grows faster than linearly): the linear answer, no refit.
-  if (!e.alias && name != "mass_loading" && score < opt.effect_significance / 4 && jperp2 > 0) {
+  if (!e.alias && !info->moves_modes && score < opt.effect_significance / 4 && jperp2 > 0) {
     const double s2e = std::max(1.0, out.chi2_per_dof);
-    const double v = value(step_lin), sv = typical * std::sqrt(s2e / jperp2);
     e.converged = true;
     e.linearised = true;
     e.material = out.updated;
@@ -196,8 +185,8 @@ Scanned scan_one(const ScanInputs& in, Problem& p, Fitter& f, const std::string&
     apply(e.effect_set, step_lin);
     e.delta_chi2 = score;
     e.chi2_per_dof = (2.0 * best.cost - score) / std::max(1.0, dof - 1.0);
-    e.value = name == "daq_input_resistance" ? (v > 0 ? 1.0 / v : INFINITY) : v;
-    e.sigma = name == "daq_input_resistance" ? (v > 0 ? sv / (v * v) : NAN) : sv;
+    e.value = model::effect_from_coordinate(*info, step_lin);
+    e.sigma = model::effect_sigma_from_coordinate(*info, step_lin, std::sqrt(s2e / jperp2));
     e.band_log10_p = out.band_log10_p;
     e.covariance_rel = Eigen::MatrixXd::Zero(kParams + 1, kParams + 1);
     e.covariance_rel.topLeftCorner(kParams, kParams) = out.covariance_rel;
@@ -211,19 +200,19 @@ Scanned scan_one(const ScanInputs& in, Problem& p, Fitter& f, const std::string&
   // misfit it also starts at 2 % and 4 % (each evaluation an FE model).
   const Eigen::MatrixXd* j0 = j_start.size() ? &j_start : nullptr;
   // (The end mass moves the modes themselves: its runs keep the exact J.)
-  LmOutcome run = f.levenberg_marquardt(x0, nullptr, j0, name != "mass_loading");
-  if (!run.converged && name != "mass_loading" && std::isfinite(run.cost)) {
+  LmOutcome run = f.levenberg_marquardt(x0, nullptr, j0, !info->moves_modes);
+  if (!run.converged && !info->moves_modes && std::isfinite(run.cost)) {
     // The frozen columns did not get there: on from where it stopped, exactly.
     LmOutcome exact = f.levenberg_marquardt(run.x, nullptr);
     if (exact.converged || exact.cost < run.cost) run = std::move(exact);
   }
-  if (name == "mass_loading" && out.lack_of_fit) {
+  if (info->moves_modes && out.lack_of_fit) {
     // The later starts stop once inside the best one's optimum or stalled
     // far above it (levenberg_marquardt's lead test, on the six).
     f.finish(run);
-    for (double start : {0.02, 0.04}) {  // 2 % and 4 % of the tube's mass
+    for (double start : {2.0, 4.0}) {  // 2 and 4 typical sizes (2 % and 4 % of the tube's mass)
       Eigen::VectorXd xs = x0;
-      xs[kParams] = start / typical;
+      xs[kParams] = start;
       LmOutcome other = f.levenberg_marquardt(xs, &run);
       if (other.cost < run.cost) {
         run = std::move(other);
@@ -248,7 +237,7 @@ Scanned scan_one(const ScanInputs& in, Problem& p, Fitter& f, const std::string&
       p.free_effect(apply);
     }
   }
-  Refit rf{0, apply, value, typical, info, std::move(run)};
+  Refit rf{0, apply, info, std::move(run)};
   if (e.law == "constant-phase")
     rf.apply = [apply](model::EffectSet& fx, double x) {
       apply(fx, x);
@@ -343,7 +332,9 @@ int scan_effects(const FitAnswer& answer, Fitter& fitter, const Coordinates5& co
     std::vector<Scanned> scanned(scan_names.size());
     // The longest first: an end mass (up to three LM runs, an FE model per
     // evaluation), the dielectric loss (two laws).
-    auto rank = [](const std::string& n) { return n == "mass_loading" ? 0 : n == "dielectric_loss" ? 1 : 2; };
+    auto rank = [](const std::string& n) {
+      return model::find_effect(n)->moves_modes ? 0 : n == "dielectric_loss" ? 1 : 2;
+    };
     std::vector<std::size_t> order(scan_names.size());
     for (std::size_t i = 0; i < order.size(); ++i) order[i] = i;
     std::stable_sort(order.begin(), order.end(),

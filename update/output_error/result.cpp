@@ -38,20 +38,7 @@ std::optional<EffectCoordinate> effect_coordinate(const std::string& name) {
   EffectCoordinate c;
   // The unit of the coordinate: the catalogue's typical size (model/effects.hpp,
   // one table for both diagnosis paths).
-  const double typ = model::effect_coordinate_unit(*info);
-  c.typical = typ;
-  if (name == "daq_input_resistance") {  // 1/R: x·1 µS
-    c.apply = [typ](model::EffectSet& fx, double x) {
-      const double g =
-          (std::isfinite(fx.daq_input_resistance_ohm) ? 1.0 / fx.daq_input_resistance_ohm : 0.0) + typ * x;
-      fx.daq_input_resistance_ohm = g != 0 ? 1.0 / g : INFINITY;
-    };
-    c.value = [typ](double x) { return typ * x; };
-    return c;
-  }
-  const auto field = info->field;
-  c.apply = [field, typ](model::EffectSet& fx, double x) { fx.*field += typ * x; };
-  c.value = [typ](double x) { return typ * x; };
+  c.apply = [info](model::EffectSet& fx, double x) { model::add_effect_coordinate(*info, fx, x); };
   return c;
 }
 
