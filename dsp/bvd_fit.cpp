@@ -5,7 +5,7 @@
 #include <numbers>
 #include <stdexcept>
 
-#include "dsp/levenberg_marquardt.hpp"
+#include "numerics/levenberg_marquardt.hpp"
 
 namespace piezo::dsp {
 
@@ -151,19 +151,19 @@ BvdFit fit_bvd(const Eigen::VectorXd& f, const Eigen::VectorXcd& z, const Eigen:
   out.weighted = z_sigma.size() > 0;
   Eigen::VectorXd t(4);
   t << std::log(start.r1_ohm), std::log(start.l1_h), std::log(start.c1_f), std::log(start.c0_f);
-  LmProblem pb;
+  numerics::LmProblem pb;
   pb.residual = [&](const Eigen::VectorXd& x) -> std::optional<Eigen::VectorXd> {
     Eigen::VectorXd r;
     m.eval(x, r, nullptr);
     return r;
   };
   pb.jacobian = [&](const Eigen::VectorXd& x, const Eigen::VectorXd&, Eigen::MatrixXd& j,
-                    const LmJacobianCall&) {
+                    const numerics::LmJacobianCall&) {
     Eigen::VectorXd r;
     m.eval(x, r, &j);
     return j.allFinite();
   };
-  LmSettings ls;  // the damping of this fit before the shared engine (its figures were measured so)
+  numerics::LmSettings ls;  // the damping of this fit before the shared engine (its figures were measured so)
   ls.max_iterations = opt.max_iterations;
   ls.max_tries = 40;
   ls.mu_down = 10;
@@ -171,9 +171,9 @@ BvdFit fit_bvd(const Eigen::VectorXd& f, const Eigen::VectorXcd& z, const Eigen:
   ls.accept_equal = true;
   ls.step_tolerance = opt.step_tolerance;
   ls.tiny_rejected_step_converges = false;
-  ls.on_stall = LmSettings::Stall::converged;  // no step lowers the cost even at μ → ∞: a minimum to rounding
-  const LmRun run = levenberg_marquardt(pb, t, ls);
-  if (run.stop == LmRun::Stop::bad_start)
+  ls.on_stall = numerics::LmSettings::Stall::converged;  // no step lowers the cost even at μ → ∞: a minimum to rounding
+  const numerics::LmRun run = numerics::levenberg_marquardt(pb, t, ls);
+  if (run.stop == numerics::LmRun::Stop::bad_start)
     throw std::invalid_argument("fit_bvd: the start values give a non-finite impedance");
   out.iterations = run.iterations;
   out.converged = run.converged;
@@ -185,7 +185,7 @@ BvdFit fit_bvd(const Eigen::VectorXd& f, const Eigen::VectorXcd& z, const Eigen:
   // Covariance (Jacobian at the solution): (JᵀJ)⁻¹ for whitened residuals; with
   // relative weights the scale of the noise is unknown and the residual sets it.
   const Eigen::Index dof = 2 * n - 4;
-  Eigen::Matrix4d cov = lm_covariance(jac);
+  Eigen::Matrix4d cov = numerics::lm_covariance(jac);
   if (out.weighted) {
     out.chi2_per_dof = dof > 0 ? cost / double(dof) : kNaN;
   } else {

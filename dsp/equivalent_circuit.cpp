@@ -10,7 +10,7 @@
 
 #include "dsp/circuit_adequacy.hpp"
 #include "dsp/circuit_figures.hpp"
-#include "dsp/levenberg_marquardt.hpp"
+#include "numerics/levenberg_marquardt.hpp"
 #include "dsp/mode_figures.hpp"
 
 namespace piezo::dsp {
@@ -131,23 +131,23 @@ struct Trial {
 };
 
 Trial fit_layout(const Data& d, const Layout& lay, const Eigen::VectorXd& t0, int max_iterations) {
-  LmProblem pb;
+  numerics::LmProblem pb;
   pb.residual = [&](const Eigen::VectorXd& t) -> std::optional<Eigen::VectorXd> {
     for (Eigen::Index p = 0; p < t.size(); ++p)
       if (!(std::abs(t[p]) < 700)) return std::nullopt;
     return d.residual(lay, t, nullptr);
   };
   pb.jacobian = [&](const Eigen::VectorXd& t, const Eigen::VectorXd&, Eigen::MatrixXd& j,
-                    const LmJacobianCall&) {
+                    const numerics::LmJacobianCall&) {
     d.residual(lay, t, &j);
     return j.allFinite();
   };
-  LmSettings s;
+  numerics::LmSettings s;
   s.max_iterations = max_iterations;
   s.step_tolerance = 1e-10;
   s.relative_cost_tolerance = 1e-12;
   s.max_step = 2.0;  // no element moves by more than e² in one step
-  const LmRun run = levenberg_marquardt(pb, t0, s);
+  const numerics::LmRun run = numerics::levenberg_marquardt(pb, t0, s);
   Trial tr;
   tr.lay = lay;
   tr.t = run.x;
@@ -513,7 +513,7 @@ CircuitFit fit_equivalent_circuit(const Eigen::VectorXd& f, const Eigen::VectorX
   out.chi2_per_dof = dof > 0 ? out.chi2 / dof : kNaN;
   // Covariance of ln θ: (JᵀJ)⁺, scaled by the lack of fit (χ²/ν above 1) or, with
   // relative weights, by the residual's own scale.
-  Eigen::MatrixXd cov = lm_covariance(best.j);
+  Eigen::MatrixXd cov = numerics::lm_covariance(best.j);
   const double inflate = out.weighted ? std::max(1.0, out.chi2_per_dof) : out.chi2_per_dof;
   cov *= std::isfinite(inflate) ? inflate : kNaN;
 

@@ -9,7 +9,7 @@
 // loss conductance ωC0·tanδ, i.e. R0 = 1/(ωC0·tanδ) at each frequency), an
 // optional series resistance Rs (leads, electrodes), and one motional R-L-C
 // branch per mode. All branches are fitted jointly, by weighted least squares
-// on Re and Im of Z (the shared engine, dsp/levenberg_marquardt), in the logs
+// on Re and Im of Z (the shared engine, numerics/levenberg_marquardt), in the logs
 // of the elements. The number of branches is chosen by the Bayesian
 // information criterion: a branch is added where the residual stands out and
 // kept only if the criterion falls; a branch whose removal lowers it, or whose

@@ -6,7 +6,7 @@
 #include <numbers>
 #include <stdexcept>
 
-#include "dsp/levenberg_marquardt.hpp"
+#include "numerics/levenberg_marquardt.hpp"
 
 namespace piezo::dsp {
 
@@ -132,14 +132,14 @@ FixtureCalibration fit_fixture(const CalibrationStandards& s) {
       t[idx[static_cast<std::size_t>(c)]] += u[c] * scale[idx[static_cast<std::size_t>(c)]];
     return t;
   };
-  LmProblem pb;
+  numerics::LmProblem pb;
   pb.residual = [&](const Eigen::VectorXd& u) -> std::optional<Eigen::VectorXd> {
     const auto t = params(u);
     if (t[kRs] < 0 || t[kRho] <= 0 || t[kU] <= 0) return std::nullopt;  // not a physical fixture
     return residual(t);
   };
   pb.jacobian = [&](const Eigen::VectorXd& u, const Eigen::VectorXd&, Eigen::MatrixXd& j,
-                    const LmJacobianCall&) {
+                    const numerics::LmJacobianCall&) {
     const auto t = params(u);
     j.resize(nr, np);
     for (Eigen::Index c = 0; c < np; ++c) {
@@ -153,7 +153,7 @@ FixtureCalibration fit_fixture(const CalibrationStandards& s) {
     }
     return j.allFinite();
   };
-  LmSettings ls;  // this fit's damping before the shared engine
+  numerics::LmSettings ls;  // this fit's damping before the shared engine
   ls.max_iterations = 200;
   ls.max_tries = 20;
   ls.mu_down = 10;
@@ -161,9 +161,9 @@ FixtureCalibration fit_fixture(const CalibrationStandards& s) {
   ls.diag_floor = 1e-30;
   ls.relative_cost_tolerance = 1e-12;
   ls.tiny_rejected_step_converges = false;
-  ls.on_stall = LmSettings::Stall::converged;  // no step lowers the cost: a minimum (to rounding)
-  const LmRun run = levenberg_marquardt(pb, Eigen::VectorXd::Zero(np), ls);
-  if (run.stop == LmRun::Stop::bad_start)
+  ls.on_stall = numerics::LmSettings::Stall::converged;  // no step lowers the cost: a minimum (to rounding)
+  const numerics::LmRun run = numerics::levenberg_marquardt(pb, Eigen::VectorXd::Zero(np), ls);
+  if (run.stop == numerics::LmRun::Stop::bad_start)
     throw std::invalid_argument("fit_fixture: the starting fixture model gives a non-finite transfer");
   out.iterations = run.iterations;
   out.converged = run.converged;
@@ -173,7 +173,7 @@ FixtureCalibration fit_fixture(const CalibrationStandards& s) {
   const double dof = std::max<double>(1.0, double(nr - np));
   out.chi2_reduced = cost / dof;
   // Covariance of the scaled free parameters, inflated by χ²_red when the model misfits.
-  Eigen::MatrixXd cov = lm_covariance(jm) * std::max(1.0, out.chi2_reduced);
+  Eigen::MatrixXd cov = numerics::lm_covariance(jm) * std::max(1.0, out.chi2_reduced);
   std::array<double, kParams> sd{};
   for (Eigen::Index c = 0; c < np; ++c) {
     const int i = idx[static_cast<std::size_t>(c)];

@@ -7,7 +7,7 @@
 #include <limits>
 #include <stdexcept>
 
-#include "dsp/levenberg_marquardt.hpp"
+#include "numerics/levenberg_marquardt.hpp"
 
 namespace piezo::update {
 
@@ -100,7 +100,7 @@ GapFit fit_gap(GapModel& m, const GapData& d, const std::vector<double>& x0, con
   fit.dof = fit.n - p;
   Eigen::MatrixXd jtj;
   for (int outer = 0; outer <= opt.max_relinearisations; ++outer) {
-    // Levenberg–Marquardt (dsp/levenberg_marquardt) over the free columns.
+    // Levenberg–Marquardt (numerics/levenberg_marquardt) over the free columns.
     auto full = [&](const Eigen::VectorXd& u) {
       std::vector<double> x = fit.x;
       for (int c = 0; c < p; ++c) x[static_cast<std::size_t>(cols[static_cast<std::size_t>(c)])] = u[c];
@@ -108,7 +108,7 @@ GapFit fit_gap(GapModel& m, const GapData& d, const std::vector<double>& x0, con
     };
     Eigen::VectorXd u0(p);
     for (int c = 0; c < p; ++c) u0[c] = fit.x[static_cast<std::size_t>(cols[static_cast<std::size_t>(c)])];
-    dsp::LmProblem pb;
+    numerics::LmProblem pb;
     pb.residual = [&](const Eigen::VectorXd& u) -> std::optional<Eigen::VectorXd> {
       try {
         const auto r = gap_residuals(m, d, full(u));
@@ -118,7 +118,7 @@ GapFit fit_gap(GapModel& m, const GapData& d, const std::vector<double>& x0, con
       }
     };
     pb.jacobian = [&](const Eigen::VectorXd& u, const Eigen::VectorXd&, Eigen::MatrixXd& j,
-                      const dsp::LmJacobianCall&) {
+                      const numerics::LmJacobianCall&) {
       const auto jc = gap_jacobian(m, d, full(u), cols);  // throws where u itself is not physical
       j.resize(fit.n, p);
       for (int c = 0; c < p; ++c)
@@ -131,7 +131,7 @@ GapFit fit_gap(GapModel& m, const GapData& d, const std::vector<double>& x0, con
         u[c] = std::clamp(u[c], pi.lower, pi.upper);
       }
     };
-    dsp::LmSettings ls;  // this fit's damping before the shared engine
+    numerics::LmSettings ls;  // this fit's damping before the shared engine
     ls.max_iterations = opt.max_iterations;
     ls.max_tries = 12;
     ls.mu_min = 1e-9;
@@ -140,9 +140,9 @@ GapFit fit_gap(GapModel& m, const GapData& d, const std::vector<double>& x0, con
     ls.relative_cost_tolerance = opt.chi2_tolerance;
     ls.cost_tolerance = 0.5e-6 * std::max(1.0, static_cast<double>(fit.n));  // Δχ² < 1e-6 per residual
     ls.tiny_rejected_step_converges = false;
-    ls.on_stall = dsp::LmSettings::Stall::converged;  // no descent at any damping: a (local) minimum
-    const dsp::LmRun run = dsp::levenberg_marquardt(pb, u0, ls);
-    if (run.stop == dsp::LmRun::Stop::bad_start) (void)gap_residuals(m, d, fit.x);  // throws the reason
+    ls.on_stall = numerics::LmSettings::Stall::converged;  // no descent at any damping: a (local) minimum
+    const numerics::LmRun run = numerics::levenberg_marquardt(pb, u0, ls);
+    if (run.stop == numerics::LmRun::Stop::bad_start) (void)gap_residuals(m, d, fit.x);  // throws the reason
     fit.iterations += run.iterations;
     fit.x = full(run.x);
     if (run.j.rows() == fit.n) jtj = run.j.transpose() * run.j;

@@ -6,7 +6,7 @@
 #include <optional>
 #include <stdexcept>
 
-#include "dsp/levenberg_marquardt.hpp"
+#include "numerics/levenberg_marquardt.hpp"
 #include "update/condensed_stiffness.hpp"
 #include "update/updater.hpp"
 
@@ -190,7 +190,7 @@ LmResult update_lm(const model::TubeModel& tube, model::ModalSolver& solver,
     evaluated.emplace_back(x, std::move(*ev));
     return &evaluated.back().second;
   };
-  dsp::LmProblem pb;
+  numerics::LmProblem pb;
   bool first = true;
   pb.residual = [&](const Eigen::VectorXd& x) -> std::optional<Eigen::VectorXd> {
     std::string w;
@@ -200,22 +200,22 @@ LmResult update_lm(const model::TubeModel& tube, model::ModalSolver& solver,
     return ev->r;
   };
   pb.jacobian = [&](const Eigen::VectorXd& x, const Eigen::VectorXd&, Eigen::MatrixXd& j,
-                    const dsp::LmJacobianCall&) {
+                    const numerics::LmJacobianCall&) {
     std::string w;
     const Evaluation* ev = evaluation(x, w);
     if (!ev) return false;
     j = ev->j;
     return true;
   };
-  dsp::LmSettings ls;  // this updater's damping before the shared engine
+  numerics::LmSettings ls;  // this updater's damping before the shared engine
   ls.max_iterations = opt.max_iterations;
   ls.max_tries = 12;
   ls.mu0 = opt.lambda0;
   ls.diag_floor = 1e-30;
   ls.step_tolerance = opt.step_tolerance;
-  ls.on_stall = dsp::LmSettings::Stall::failed;
-  const dsp::LmRun run = dsp::levenberg_marquardt(pb, Eigen::VectorXd::Zero(kNp), ls);
-  if (run.stop == dsp::LmRun::Stop::bad_start)
+  ls.on_stall = numerics::LmSettings::Stall::failed;
+  const numerics::LmRun run = numerics::levenberg_marquardt(pb, Eigen::VectorXd::Zero(kNp), ls);
+  if (run.stop == numerics::LmRun::Stop::bad_start)
     return done(UpdateStatus::non_physical, "original model: " + why_start);
   res.iterations = run.iterations;
   std::string w;

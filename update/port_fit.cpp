@@ -7,7 +7,7 @@
 #include <optional>
 #include <stdexcept>
 
-#include "dsp/levenberg_marquardt.hpp"
+#include "numerics/levenberg_marquardt.hpp"
 #include "dsp/windows.hpp"
 #include "model/transient.hpp"
 
@@ -274,7 +274,7 @@ PortFitResult fit_port_model(std::span<const double> v1, std::span<const double>
   if (!r) throw std::invalid_argument(std::string(fn) + ": the starting model cannot be simulated");
   double cost = 0.5 * r->squaredNorm();
   Eigen::MatrixXd j;
-  // Levenberg–Marquardt (dsp/levenberg_marquardt) over the parameters in
+  // Levenberg–Marquardt (numerics/levenberg_marquardt) over the parameters in
   // `free`, the others held; true when converged.
   auto levenberg_marquardt = [&](const std::vector<int>& free, int max_iterations) {
     auto full = [&](const Eigen::VectorXd& u) {
@@ -284,28 +284,28 @@ PortFitResult fit_port_model(std::span<const double> v1, std::span<const double>
     };
     Eigen::VectorXd u0(static_cast<Eigen::Index>(free.size()));
     for (std::size_t c = 0; c < free.size(); ++c) u0[static_cast<Eigen::Index>(c)] = th[free[c]];
-    dsp::LmProblem pb;
+    numerics::LmProblem pb;
     pb.residual = [&](const Eigen::VectorXd& u) { return residual(full(u)); };
     pb.jacobian = [&](const Eigen::VectorXd& u, const Eigen::VectorXd&, Eigen::MatrixXd& jac,
-                      const dsp::LmJacobianCall&) { return jacobian(full(u), free, jac); };
+                      const numerics::LmJacobianCall&) { return jacobian(full(u), free, jac); };
     // Converged also when the features stop moving: C_e and the pseudo-mode's
     // static share trade off along a nearly flat valley that LM crawls through
     // without changing them.
     Eigen::VectorXd f_prev = features_of(th);
-    pb.converged_after_step = [&](const dsp::LmState& st) {
+    pb.converged_after_step = [&](const numerics::LmState& st) {
       const Eigen::VectorXd f_now = features_of(full(st.x));
       const double moved = ((f_now - f_prev).array() / f_prev.array()).abs().maxCoeff();
       f_prev = f_now;
       return moved < opt.feature_tolerance;
     };
-    dsp::LmSettings ls;  // this fit's damping before the shared engine
+    numerics::LmSettings ls;  // this fit's damping before the shared engine
     ls.max_iterations = max_iterations;
     ls.max_tries = 16;
     ls.step_tolerance = opt.step_tolerance;
     ls.jacobian_at_answer = false;  // the covariance below takes its own J at the answer
-    const dsp::LmRun run = dsp::levenberg_marquardt(pb, u0, ls);
+    const numerics::LmRun run = numerics::levenberg_marquardt(pb, u0, ls);
     res.iterations += run.iterations;
-    if (run.stop == dsp::LmRun::Stop::bad_start) {
+    if (run.stop == numerics::LmRun::Stop::bad_start) {
       res.message = "the model could not be simulated at the current estimate";
       return false;
     }
@@ -313,12 +313,12 @@ PortFitResult fit_port_model(std::span<const double> v1, std::span<const double>
     r = run.r;
     cost = run.cost;
     switch (run.stop) {
-      case dsp::LmRun::Stop::converged:
+      case numerics::LmRun::Stop::converged:
         return true;
-      case dsp::LmRun::Stop::jacobian_failed:
+      case numerics::LmRun::Stop::jacobian_failed:
         res.message = "the model could not be simulated near the current estimate";
         return false;
-      case dsp::LmRun::Stop::stalled:
+      case numerics::LmRun::Stop::stalled:
         // No step lowers the error any more, and the residual is not orthogonal
         // to the Jacobian's columns (cosine >= 1e-4): not a minimum.
         res.message =

@@ -7,7 +7,7 @@
 #include <cmath>
 #include <utility>
 
-#include "dsp/levenberg_marquardt.hpp"
+#include "numerics/levenberg_marquardt.hpp"
 
 namespace piezo::update::oe {
 
@@ -73,7 +73,7 @@ double Fitter::tangent_cost(const Eigen::VectorXd& anchor, const Eigen::VectorXd
 
 LmOutcome Fitter::levenberg_marquardt(Eigen::VectorXd x, const LmOutcome* lead,
                                       const Eigen::MatrixXd* j0, bool freeze_material) {
-  dsp::LmProblem pb;
+  numerics::LmProblem pb;
   pb.residual = [&](const Eigen::VectorXd& xt) { return weighted(xt); };
   // J by forward differences at every iterate: four FE port models (β's
   // column reuses the cached one), or none near the last exact J (the port
@@ -83,7 +83,7 @@ LmOutcome Fitter::levenberg_marquardt(Eigen::VectorXd x, const LmOutcome* lead,
   // A retry (the engine's retry_exact: an iteration that found no lower cost
   // through the tangent, j0's frozen columns or the screen) is exact.
   pb.jacobian = [&](const Eigen::VectorXd& xt, const Eigen::VectorXd& r, Eigen::MatrixXd& j,
-                    const dsp::LmJacobianCall& call) {
+                    const numerics::LmJacobianCall& call) {
     const bool have_j0 = j0 && j0->rows() == r.size() && j0->cols() == xt.size();
     if (call.exact) return jacobian(xt, r, j, 0, true);
     if (call.iteration == 1 && have_j0) {
@@ -101,18 +101,18 @@ LmOutcome Fitter::levenberg_marquardt(Eigen::VectorXd x, const LmOutcome* lead,
   // rejected without an FE model; one it says lowers it is computed.
   pb.screen = [&](const Eigen::VectorXd& anchor, const Eigen::VectorXd& xt) { return tangent_cost(anchor, xt); };
   // A later start stops early inside the lead's optimum, or stalled far above it.
-  pb.after_iteration = [&](const dsp::LmState& st) {
-    dsp::LmVerdict v;
+  pb.after_iteration = [&](const numerics::LmState& st) {
+    numerics::LmVerdict v;
     if (!lead || lead->jtj.rows() != st.x.size() || lead->x.size() != st.x.size()) return v;
     const Eigen::VectorXd dx = st.x - lead->x;
     const double gap = st.cost - lead->cost;
-    if (gap >= 0 && dx.dot(lead->jtj * dx) < 9.0) return dsp::LmVerdict{true, true, "joined the first start's optimum"};
+    if (gap >= 0 && dx.dot(lead->jtj * dx) < 9.0) return numerics::LmVerdict{true, true, "joined the first start's optimum"};
     const double s2 = std::max(1.0, 2.0 * lead->cost / dof_fit);
     if (st.iteration >= 2 && gap > std::max(50.0, 10.0 * s2) && st.last_drop < 0.1 * gap)
-      return dsp::LmVerdict{true, false, "stalled far above the first start's optimum"};
+      return numerics::LmVerdict{true, false, "stalled far above the first start's optimum"};
     return v;
   };
-  dsp::LmSettings ls;  // this fit's damping, as measured on the corpus before the shared engine
+  numerics::LmSettings ls;  // this fit's damping, as measured on the corpus before the shared engine
   ls.max_iterations = opt.max_iterations;
   ls.max_tries = 14;
   ls.max_step = 0.3;  // trust region: no constant moves by more than 30 % in one step
@@ -125,21 +125,21 @@ LmOutcome Fitter::levenberg_marquardt(Eigen::VectorXd x, const LmOutcome* lead,
   // step is far shorter than the way to the minimum: go on along it, doubling.
   ls.extend_steps = 4;
   ls.jacobian_at_answer = false;  // finish() computes the exact J of the run that is used
-  const dsp::LmRun run = dsp::levenberg_marquardt(pb, std::move(x), ls);
+  const numerics::LmRun run = numerics::levenberg_marquardt(pb, std::move(x), ls);
   LmOutcome o;
   o.x = run.x;
   o.iterations = run.iterations;
   o.converged = run.converged;
   o.message = run.message;
   switch (run.stop) {
-    case dsp::LmRun::Stop::bad_start:
+    case numerics::LmRun::Stop::bad_start:
       o.message = "the start cannot be simulated";
       o.cost = INFINITY;
       return o;
-    case dsp::LmRun::Stop::jacobian_failed:
+    case numerics::LmRun::Stop::jacobian_failed:
       o.message = "the model could not be simulated near the estimate";
       break;
-    case dsp::LmRun::Stop::stalled:
+    case numerics::LmRun::Stop::stalled:
       o.message = "no decrease of the output error (gradient cosine " + std::to_string(run.stall_cosine) + ")";
       break;
     default:

@@ -1,9 +1,9 @@
-#include "dsp/levenberg_marquardt.hpp"
+#include "numerics/levenberg_marquardt.hpp"
 
 #include <algorithm>
 #include <stdexcept>
 
-namespace piezo::dsp {
+namespace piezo::numerics {
 
 namespace {
 
@@ -197,4 +197,4 @@ Eigen::MatrixXd lm_covariance(const Eigen::MatrixXd& j) {
   return (j.transpose() * j).completeOrthogonalDecomposition().pseudoInverse();
 }
 
-}  // namespace piezo::dsp
+}  // namespace piezo::numerics

@@ -1,14 +1,14 @@
-// The shared least-squares engine (dsp/levenberg_marquardt) against problems
+// The shared least-squares engine (numerics/levenberg_marquardt) against problems
 // whose answers are known in closed form: a linear model (normal equations),
 // Rosenbrock's valley, a bound, a region the model cannot evaluate, and the
 // hooks the callers use (screen, exact retry, caller's stop).
-#include "dsp/levenberg_marquardt.hpp"
+#include "numerics/levenberg_marquardt.hpp"
 
 #include <gtest/gtest.h>
 
 #include <random>
 
-using namespace piezo::dsp;
+using namespace piezo::numerics;
 
 namespace {
 

@@ -28,7 +28,7 @@
 #include <optional>
 #include <string>
 
-namespace piezo::dsp {
+namespace piezo::numerics {
 
 struct LmSettings {
   int max_iterations = 100;
@@ -147,4 +147,4 @@ bool forward_difference_jacobian(
 // complete orthogonal decomposition (rank-deficient directions get 0, not ∞).
 Eigen::MatrixXd lm_covariance(const Eigen::MatrixXd& j);
 
-}  // namespace piezo::dsp
+}  // namespace piezo::numerics
