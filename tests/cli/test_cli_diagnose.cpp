@@ -56,7 +56,7 @@ bool is_number_or_null(const json& v) { return v.is_number() || v.is_null(); }
 
 // Pixels within ±30 per channel of a colour inside a rectangle of an RGBA image.
 int count_colour(const unsigned char* px, int w, const piezo::jobs::report::PixelRect& r,
-                 piezo::jobs::report::Rgba c) {
+                 piezo::jobs::report::Colour c) {
   int n = 0;
   for (int y = static_cast<int>(r.y0); y < static_cast<int>(r.y1); ++y)
     for (int x = static_cast<int>(r.x0); x < static_cast<int>(r.x1); ++x) {
