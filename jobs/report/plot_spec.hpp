@@ -47,6 +47,7 @@ struct Colour {
     a = static_cast<std::uint8_t>(v[3]);
   }
   constexpr Colour(const char* hex) : Colour(std::string_view(hex)) {}  // NOLINT
+  Colour(const std::string& hex) : Colour(std::string_view(hex)) {}     // NOLINT
   Colour(int) = delete;  // a literal 0 is not a colour (nor a null "#rrggbb")
   bool operator==(const Colour&) const = default;
 };

@@ -158,12 +158,12 @@ TEST(LotReport, WritesMarkdownJsonAndTheHistogramsAsSvgAndPng) {
     hi |= ser.colour == "#d62728" && ser.dashed && ser.x == std::vector<double>{13.0, 13.0};
   }
   EXPECT_TRUE(lo && hi);
-  // The SVG: the limits' dashed red strokes (Cairo writes colours in per cent).
+  // The SVG: the limits' dashed red strokes (Cairo writes colours in per cent: #d62728).
   const std::string svg = render_svg(fig);
   std::size_t dashed_red = 0;
   const std::regex style("<path style=\"([^\"]*)\"");
   for (auto it = std::sregex_iterator(svg.begin(), svg.end(), style); it != std::sregex_iterator(); ++it)
-    dashed_red += (*it)[1].str().find("stroke:rgb(84%,15%,16%)") != std::string::npos &&
+    dashed_red += (*it)[1].str().find("stroke:rgb(83.921569%,15.294118%,15.686275%)") != std::string::npos &&
                   (*it)[1].str().find("stroke-dasharray") != std::string::npos;
   EXPECT_GE(dashed_red, 2u) << "the two limit lines (and the legend's sample)";
 
