@@ -100,34 +100,32 @@ std::vector<double> linear_ticks(double lo, double hi, int target) {
   return out;
 }
 
-std::vector<double> log_ticks(double lo, double hi, bool fine) {
+namespace {
+// The multiples `ms` of every decade inside [lo, hi].
+std::vector<double> decade_multiples(double lo, double hi, const std::vector<double>& ms) {
   std::vector<double> out;
   if (!(hi > lo) || !(lo > 0) || !std::isfinite(hi)) return out;
   for (int e = static_cast<int>(std::floor(std::log10(lo)));
        e <= static_cast<int>(std::ceil(std::log10(hi))); ++e)
-    for (double m : {1.0, 2.0, 5.0}) {
-      if (m != 1.0 && !fine) continue;
+    for (double m : ms) {
       const double t = m * std::pow(10.0, e);
       if (t >= lo * (1 - 1e-12) && t <= hi * (1 + 1e-12)) out.push_back(t);
     }
   return out;
 }
+}  // namespace
+
+std::vector<double> log_ticks(double lo, double hi, bool fine) {
+  return fine ? decade_multiples(lo, hi, {1, 2, 5}) : decade_multiples(lo, hi, {1});
+}
 
 std::vector<double> log_minor_ticks(double lo, double hi) {
-  std::vector<double> out;
-  if (!(hi > lo) || !(lo > 0) || !std::isfinite(hi)) return out;
-  for (int e = static_cast<int>(std::floor(std::log10(lo)));
-       e <= static_cast<int>(std::ceil(std::log10(hi))); ++e)
-    for (int m = 1; m <= 9; ++m) {
-      const double t = m * std::pow(10.0, e);
-      if (t >= lo * (1 - 1e-12) && t <= hi * (1 + 1e-12)) out.push_back(t);
-    }
-  return out;
+  return decade_multiples(lo, hi, {1, 2, 3, 4, 5, 6, 7, 8, 9});
 }
 
 AxisTicks axis_ticks(double lo, double hi, Scale s, double length_px, double label_px) {
   AxisTicks t;
-  const double room = std::abs(length_px), spacing = std::max(2.0 * label_px, 30.0);
+  const double room = std::abs(length_px), spacing = std::max(1.5 * label_px, 24.0);
   const int fit = static_cast<int>(room / spacing);  // labels that fit along the axis
   if (s == Scale::Linear) {
     // At least three labels where the room allows (a 1-2-2.5-5 step can leave fewer).
@@ -138,8 +136,12 @@ AxisTicks axis_ticks(double lo, double hi, Scale s, double length_px, double lab
     return t;
   }
   if (!(hi > lo) || !(lo > 0)) return t;
-  t.major = log_ticks(lo, hi, true);
-  if (static_cast<int>(t.major.size()) > fit) t.major = log_ticks(lo, hi, false);
+  // The finest labelling that fits: every multiple, 1-2-5, 1-3, decades.
+  static const std::vector<std::vector<double>> kLabellings = {{1, 2, 3, 4, 5, 6, 7, 8, 9}, {1, 2, 5}, {1, 3}, {1}};
+  for (const auto& ms : kLabellings) {
+    t.major = decade_multiples(lo, hi, ms);
+    if (static_cast<int>(t.major.size()) <= fit) break;
+  }
   // Too many decades for their labels: every k-th decade (the rest stay grid).
   const double decades = std::log10(hi / lo);
   const std::vector<double> all = t.major;

@@ -49,7 +49,8 @@ std::vector<double> log_minor_ticks(double lo, double hi);
 
 // The labelled ticks and the grid-only ones of an axis `length_px` long with
 // labels about `label_px` wide (along the axis) each: as many round values as
-// fit, log axes in decades or 1-2-5 steps (the minor grid: every multiple).
+// fit; a log axis by every multiple of a decade, 1-2-5, 1-3 or decades,
+// the finest that fits (the minor grid: every multiple).
 struct AxisTicks {
   std::vector<double> major, minor;
 };
