@@ -16,7 +16,7 @@
 #include "jobs/json/output_error_json.hpp"
 #include "jobs/nominal_material.hpp"
 #include "jobs/pipeline/capture_fit.hpp"
-#include "jobs/report/figure_png.hpp"
+#include "jobs/report/plot_cairo.hpp"
 #include "update/model_figures.hpp"
 
 namespace piezo::jobs {

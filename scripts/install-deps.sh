@@ -12,7 +12,7 @@ PACKAGES=(
   libeigen3-dev libspectra-dev libfftw3-dev
   libhdf5-dev hdf5-tools
   libusb-1.0-0-dev libcomedi-dev
-  libglfw3-dev libimgui-dev libstb-dev libgl-dev
+  libglfw3-dev libimgui-dev libstb-dev libgl-dev libcairo2-dev
   libcli11-dev nlohmann-json3-dev libtomlplusplus-dev libssl-dev
   libgtest-dev libgmock-dev libbenchmark-dev
   xvfb xauth libgl1-mesa-dri

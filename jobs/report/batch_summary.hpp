@@ -11,7 +11,7 @@
 #include <nlohmann/json.hpp>
 
 #include "jobs/report/robust_stats.hpp"
-#include "jobs/report/svg_plot.hpp"
+#include "jobs/report/plot_cairo.hpp"
 
 namespace piezo::jobs::report {
 

@@ -7,11 +7,12 @@
 // channel skew shows) — each over the ±1σ band of the measurement's own
 // noise. The misfit regions of the diagnosis (capacitive band, resonances,
 // anti-resonances, bands between, tail) are shaded alternately in every panel
-// and named; the title carries the verdict. Drawn on a PngCanvas (png_canvas.hpp).
+// and named; the title carries the verdict. A Figure of plot_spec.hpp, drawn
+// by Cairo (plot_cairo.hpp).
 #include <filesystem>
 #include <string>
 
-#include "jobs/report/png_canvas.hpp"
+#include "jobs/report/plot_cairo.hpp"
 #include "update/gap_diagnosis.hpp"
 
 namespace piezo::jobs::report {
@@ -22,12 +23,9 @@ struct DiagnosisPlotOptions {
   std::string subtitle;  // e.g. the captures; the verdict's numbers follow on a line of their own
 };
 
-struct PixelRect {
-  double x0 = 0, y0 = 0, x1 = 0, y1 = 0;
-};
-
-// Where the panels lie on a canvas of this size (the plot areas, inside the
-// axes), top to bottom: |Z|, the residual of |Z| in dB, the residual of the phase.
+// Where the panels lie on a figure of this size (the plot areas, inside the
+// axes), top to bottom: |Z|, the residual of |Z| in dB, the residual of the
+// phase; with a subtitle (as `diagnose --plot` draws it).
 struct DiagnosisPlotLayout {
   PixelRect z, db, deg;
 };
@@ -35,16 +33,16 @@ DiagnosisPlotLayout diagnosis_plot_layout(int width, int height);
 
 // Colours of the plot, public so that tests and docs can find them in the image.
 namespace diagnosis_palette {
-inline constexpr Rgba kMeasured{20, 30, 120, 255};   // navy
-inline constexpr Rgba kBefore{230, 110, 0, 255};     // orange, dashed
-inline constexpr Rgba kAfter{40, 170, 60, 255};      // green
-inline constexpr Rgba kSigma{150, 150, 150, 110};    // translucent grey band
-inline constexpr Rgba kRegionA{205, 222, 246, 255};  // light blue
-inline constexpr Rgba kRegionB{246, 234, 200, 255};  // light sand
+inline constexpr Colour kMeasured{20, 30, 120, 255};   // navy
+inline constexpr Colour kBefore{230, 110, 0, 255};     // orange, dashed
+inline constexpr Colour kAfter{40, 170, 60, 255};      // green
+inline constexpr Colour kSigma{150, 150, 150, 110};    // translucent grey band
+inline constexpr Colour kRegionA{205, 222, 246, 255};  // light blue
+inline constexpr Colour kRegionB{246, 234, 200, 255};  // light sand
 }  // namespace diagnosis_palette
 
 // Throws std::invalid_argument when the diagnosis holds no curves.
-PngCanvas render_diagnosis_plot(const update::GapDiagnosis& d,
+Figure diagnosis_figure(const update::GapDiagnosis& d,
                                 const DiagnosisPlotOptions& opt = {});
 // Throws std::runtime_error naming the file when it cannot be written.
 void write_diagnosis_png(const update::GapDiagnosis& d, const DiagnosisPlotOptions& opt,

@@ -4,7 +4,7 @@
 // and updated model; resonance and anti-resonance markers. The headless twin
 // of the GUI's plots window (ui/gui/plots_window.cpp) in its default view.
 #include "jobs/pipeline/pipeline.hpp"
-#include "jobs/report/svg_plot.hpp"
+#include "jobs/report/plot_cairo.hpp"
 
 namespace piezo::jobs::report {
 

@@ -2,6 +2,7 @@
 #include "jobs/report/index_html.hpp"
 
 #include <cmath>
+#include <cstring>
 #include <fstream>
 #include <sstream>
 #include <stdexcept>
@@ -29,14 +30,30 @@ std::string esc(const std::string& s) {
 }
 
 // An SVG file of the report, inline (its XML prolog dropped); empty if absent.
-std::string inline_svg(const fs::path& file) {
+// Its ids (Cairo's glyph0-1, clip1, ...) are prefixed, so that two figures on
+// the page do not resolve each other's glyphs and clip paths.
+std::string inline_svg(const fs::path& file, const std::string& prefix) {
   std::ifstream in(file, std::ios::binary);
   if (!in) return {};
   std::ostringstream t;
   t << in.rdbuf();
-  std::string s = t.str();
+  const std::string s = t.str();
   const auto p = s.find("<svg");
-  return p == std::string::npos ? std::string() : s.substr(p);
+  if (p == std::string::npos) return {};
+  std::string out;
+  out.reserve(s.size() - p + 1024);
+  for (std::size_t i = p; i < s.size();) {
+    bool hit = false;
+    for (const char* ref : {"id=\"", "href=\"#", "url(#"})
+      if (s.compare(i, std::strlen(ref), ref) == 0) {
+        out += ref + prefix;
+        i += std::strlen(ref);
+        hit = true;
+        break;
+      }
+    if (!hit) out += s[i++];
+  }
+  return out;
 }
 
 std::string str(const nlohmann::json& j, const char* key) {
@@ -120,7 +137,7 @@ std::string index_html(const std::vector<std::pair<std::string, nlohmann::json>>
   o << "</table>\n";
   for (const auto& [file, title] : {std::pair("lot_histograms.svg", "Lot histograms against the limits"),
                                     std::pair("distributions.svg", "Distributions across transducers")}) {
-    const std::string svg = inline_svg(report_dir / file);
+    const std::string svg = inline_svg(report_dir / file, fs::path(file).stem().string() + "-");
     if (!svg.empty()) o << "<h2>" << title << "</h2>\n" << svg << "\n";
   }
   o << "</body></html>\n";

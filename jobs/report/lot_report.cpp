@@ -5,7 +5,7 @@
 #include <sstream>
 
 #include "jobs/json/json_text.hpp"
-#include "jobs/report/figure_png.hpp"
+#include "jobs/report/plot_cairo.hpp"
 #include "jobs/report/markdown.hpp"
 
 namespace piezo::jobs::report {

@@ -9,7 +9,7 @@
 
 #include "jobs/report/limits.hpp"
 #include "jobs/report/lot_summary.hpp"
-#include "jobs/report/svg_plot.hpp"
+#include "jobs/report/plot_cairo.hpp"
 
 namespace piezo::jobs::report {
 

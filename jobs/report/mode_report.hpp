@@ -7,7 +7,7 @@
 #include <string>
 
 #include "jobs/pipeline/pipeline.hpp"
-#include "jobs/report/svg_plot.hpp"
+#include "jobs/report/plot_cairo.hpp"
 
 namespace piezo::jobs::report {
 

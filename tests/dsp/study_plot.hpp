@@ -4,13 +4,13 @@
 // |Z| error in dB against frequency (whole band and the modes' zoom) with the
 // Cramér–Rao band and the ±1 dB target. Rows are drawn in the order given (put
 // the smooth estimates last to keep them on top). Drawn by the project's
-// headless SVG writer (jobs/report/svg_plot).
+// Cairo plot renderer (jobs/report/plot_cairo).
 #include <filesystem>
 #include <string>
 #include <vector>
 
 #include "impedance_study.hpp"
-#include "jobs/report/svg_plot.hpp"
+#include "jobs/report/plot_cairo.hpp"
 
 namespace piezo::study {
 

@@ -191,9 +191,15 @@ TEST(Chapter5Fe, TenPercentNoiseTableBoundsAndPlot) {
   ss << is.rdbuf();
   const std::string svg = ss.str();
   EXPECT_NE(svg.find("<svg"), std::string::npos);
+  // The legend's entries are in the figure (Cairo draws text as glyphs: the
+  // SVG holds their outlines, not the strings).
+  std::string labels;
+  for (const auto& p : fig.panels)
+    for (const auto& ser : p.series) labels += ser.label + "\n";
   for (const char* label : {"true (FE modal)", "prony (1000)", "prony (3000)", "fft diff (50000)",
                             "CRB 1σ, 3000 samples"})
-    EXPECT_NE(svg.find(label), std::string::npos) << label;
+    EXPECT_NE(labels.find(label), std::string::npos) << label;
+  EXPECT_NE(svg.find("<use xlink:href=\"#glyph"), std::string::npos);
   std::printf("figure: %s\n", path.c_str());
 }
 

@@ -122,8 +122,8 @@ TEST(ResidualPlot, RegionsShadedByKindAndCurvesInKhz) {
 
   auto spec = residual_plot_spec(d, false);
   ASSERT_EQ(spec.bands.size(), 2u);
-  EXPECT_EQ(spec.bands[0].color, kColRegionPhase);
-  EXPECT_EQ(spec.bands[1].color, kColRegionShift);
+  EXPECT_EQ(im_colour(spec.bands[0].colour), kColRegionPhase);
+  EXPECT_EQ(im_colour(spec.bands[1].colour), kColRegionShift);
   EXPECT_DOUBLE_EQ(spec.bands[1].x0, 40.0);  // kHz
   EXPECT_NE(spec.bands[1].detail.find("+0.120 %"), std::string::npos) << spec.bands[1].detail;
   // ±2σ (one listed, one not) and the base residual; no added effect, no second residual.
@@ -131,14 +131,14 @@ TEST(ResidualPlot, RegionsShadedByKindAndCurvesInKhz) {
   EXPECT_DOUBLE_EQ(spec.series[0].y[2], 1.0);
   EXPECT_DOUBLE_EQ(spec.series[1].y[2], -1.0);
   EXPECT_FALSE(spec.series[1].listed);
-  EXPECT_EQ(spec.series[2].color, kColResidual);
+  EXPECT_EQ(im_colour(spec.series[2].colour), kColResidual);
   EXPECT_DOUBLE_EQ(spec.series[2].x[2], 50.0);
   EXPECT_DOUBLE_EQ(spec.series[2].y[1], -0.2);
 
   d.added = {"series_resistance"};
   spec = residual_plot_spec(d, true);
   ASSERT_EQ(spec.series.size(), 4u);
-  EXPECT_EQ(spec.series[3].color, kColResidualAfter);
+  EXPECT_EQ(im_colour(spec.series[3].colour), kColResidualAfter);
   EXPECT_NE(spec.series[3].label.find("series_resistance"), std::string::npos);
   EXPECT_DOUBLE_EQ(spec.series[2].y[2], 3.0);  // phase, degrees
   EXPECT_EQ(spec.y_label, "deg");
@@ -204,7 +204,7 @@ TEST(DriverChoices, OneEntryPerRegistryFamilyWithUsableAddresses) {
 // read-out gives the marker's label and each curve's own text at that x.
 TEST(PlotReadout, SnapsToTheNearestResonanceAndReadsEachCurve) {
   using piezo::gui::Marker;
-  std::vector<Marker> markers = {{50e3, 0, "fr 50 kHz", true}, {50.5e3, 0, "plain", false}, {52e3, 0, "fa 52 kHz", true}};
+  std::vector<Marker> markers = {{50e3, {}, "fr 50 kHz", true}, {50.5e3, {}, "plain", false}, {52e3, {}, "fa 52 kHz", true}};
   auto to_px = [](double f) { return static_cast<float>(f / 100.0); };  // 100 Hz per pixel
   EXPECT_EQ(piezo::gui::snap_marker(markers, 503.0f, to_px), &markers[0]);   // 3 px from fr
   EXPECT_EQ(piezo::gui::snap_marker(markers, 505.0f, to_px), &markers[0]);   // "plain" is nearer but does not snap
@@ -212,7 +212,7 @@ TEST(PlotReadout, SnapsToTheNearestResonanceAndReadsEachCurve) {
   EXPECT_EQ(piezo::gui::snap_marker(markers, 510.0f, to_px), nullptr);       // 10 px from both
   piezo::gui::PlotSpec spec;
   std::vector<std::complex<double>> z = {{100, -100}, {1000, 0}, {0, 2000}};
-  piezo::gui::Series s{"Z", {49e3, 50e3, 51e3}, {0, 0, 0}, 0, 1.0f, false};
+  piezo::gui::Series s{"Z", {49e3, 50e3, 51e3}, {0, 0, 0}, {}, 1.0};
   s.readout = [z](std::size_t i) { return piezo::gui::impedance_readout(z[i]); };
   spec.series.push_back(s);
   const auto lines = piezo::gui::readout_at(spec, 50.2e3, &markers[0]);

@@ -105,10 +105,9 @@ struct AppState {
   std::optional<Problem> error;   // stopped the last job or export; shown with what to do
   std::vector<Problem> warnings;  // of the last result, with what to do
   std::vector<std::string> log;
-  // Log frequency for the impedance; linear for the residual, whose regions
-  // crowd around the resonances in the top octave.
-  PlotView mag_view{true, true}, phase_view{true, false}, sv_view{false, true},
-      residual_view{false, false};
+  // The plots' views (their scales are in the specs, plots_window.cpp).
+  PlotView mag_view, phase_view, sv_view, residual_view;
+  bool residual_log_f = false;  // the residual plot on a log frequency axis
   bool show_fft = false, show_xspec = false;
   // The per-mode figures and the admittance (Nyquist) view of one mode, in
   // place of the residual/phase/SV row (jobs/mode_nyquist.hpp; computed when a
@@ -116,7 +115,7 @@ struct AppState {
   bool show_modes = false;
   int nyquist_mode = 0;  // index into `nyquist`
   std::vector<jobs::ModeNyquist> nyquist;
-  PlotView nyquist_view{false, false};
+  PlotView nyquist_view;
   bool residual_phase = false;  // the residual plot shows phase (deg) instead of |Z| (dB)
   DiagnosisShown diagnosis_shown;
   // Screen rectangles of named buttons, for scripted input in tests.

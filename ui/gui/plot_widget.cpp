@@ -4,6 +4,7 @@
 #include <cmath>
 #include <cstdio>
 
+#include "jobs/report/plot_axes.hpp"
 #include "ui/gui/palette.hpp"
 
 namespace piezo::gui {
@@ -12,25 +13,7 @@ namespace {
 double fwd(double v, bool log) { return log ? std::log10(std::max(v, 1e-300)) : v; }
 double inv(double v, bool log) { return log ? std::pow(10.0, v) : v; }
 
-// "Nice" tick positions in transformed units.
-std::vector<double> ticks(double a, double b, bool log) {
-  std::vector<double> t;
-  if (!(b > a)) return t;
-  if (log) {
-    for (double d = std::floor(a); d <= b; d += 1.0)
-      for (int m = 1; m < 10; ++m) {
-        double v = d + std::log10(static_cast<double>(m));
-        if (v >= a && v <= b && (m == 1 || b - a < 2.5)) t.push_back(v);
-      }
-    return t;
-  }
-  double span = b - a, step = std::pow(10.0, std::floor(std::log10(span / 5)));
-  if (span / step > 10) step *= 2;
-  if (span / step > 10) step *= 2.5;
-  for (double v = std::ceil(a / step) * step; v <= b; v += step) t.push_back(v);
-  return t;
-}
-
+// A read-out value (ticks are labelled by plot_axes' tick_label).
 std::string fmt(double v) {
   char buf[32];
   double a = std::fabs(v);
@@ -83,12 +66,13 @@ std::vector<std::pair<ImU32, std::string>> readout_at(const PlotSpec& spec, doub
   for (const auto& s : spec.series) {
     // The nearest sample in x, and only inside the series' own x range (a
     // curve that ends at 120 kHz has no value to read at 200 kHz).
-    if (!s.listed || !s.hover || s.x.empty() || s.y.size() < s.x.size() || x < s.x.front() || x > s.x.back())
+    if (!s.listed || s.x.empty() || s.y.size() < s.x.size() || x < s.x.front() || x > s.x.back() ||
+        !std::is_sorted(s.x.begin(), s.x.end()))
       continue;
     auto it = std::lower_bound(s.x.begin(), s.x.end(), x);
     std::size_t i = std::min<std::size_t>(static_cast<std::size_t>(it - s.x.begin()), s.x.size() - 1);
     if (i > 0 && x - s.x[i - 1] < s.x[i] - x) --i;
-    lines.emplace_back(s.color, s.label + ": " + (s.readout ? s.readout(i) : fmt(s.y[i])));
+    lines.emplace_back(im_colour(s.colour), s.label + ": " + (s.readout ? s.readout(i) : fmt(s.y[i])));
   }
   for (const auto& band : spec.bands)
     if (!band.detail.empty() && x >= std::min(band.x0, band.x1) && x <= std::max(band.x0, band.x1))
@@ -97,48 +81,11 @@ std::vector<std::pair<ImU32, std::string>> readout_at(const PlotSpec& spec, doub
 }
 
 void fit_view(const PlotSpec& spec, PlotView& view, bool all) {
-  double xmin = INFINITY, xmax = -INFINITY, ymin = INFINITY, ymax = -INFINITY;
-  const bool framed = !all && spec.fit_x1 > spec.fit_x0 && (!view.log_x || spec.fit_x0 > 0);
-  std::vector<double> ys;  // the samples the y range is taken from
-  for (const auto& s : spec.series)
-    for (std::size_t i = 0; i < s.x.size() && i < s.y.size(); ++i) {
-      if ((view.log_x && s.x[i] <= 0) || (view.log_y && s.y[i] <= 0)) continue;
-      if (!std::isfinite(s.x[i]) || !std::isfinite(s.y[i])) continue;
-      xmin = std::min(xmin, s.x[i]);
-      xmax = std::max(xmax, s.x[i]);
-      if (framed && (s.x[i] < spec.fit_x0 || s.x[i] > spec.fit_x1)) continue;
-      ys.push_back(s.y[i]);
-    }
-  if (framed && xmax > xmin) {  // the frame, inside the data
-    xmin = std::max(xmin, spec.fit_x0);
-    xmax = std::min(xmax, spec.fit_x1);
-  }
-  if (!ys.empty()) {
-    const double q = all ? 0.0 : std::clamp(spec.fit_y_quantile, 0.0, 0.49);
-    const auto lo = static_cast<std::size_t>(q * static_cast<double>(ys.size() - 1));
-    const auto hi = ys.size() - 1 - lo;
-    std::nth_element(ys.begin(), ys.begin() + static_cast<std::ptrdiff_t>(lo), ys.end());
-    ymin = ys[lo];
-    std::nth_element(ys.begin(), ys.begin() + static_cast<std::ptrdiff_t>(hi), ys.end());
-    ymax = ys[hi];
-  }
-  if (!(xmax > xmin)) {
-    xmin = view.log_x ? 1 : 0;
-    xmax = 10;
-  }
-  if (!(ymax > ymin)) {
-    ymin = view.log_y ? ymin * 0.5 : ymin - 1;
-    ymax = view.log_y ? std::max(ymax, ymin) * 2 : ymax + 1;
-    if (!std::isfinite(ymin) || !std::isfinite(ymax)) {
-      ymin = view.log_y ? 1 : 0;
-      ymax = 10;
-    }
-  }
-  double ly0 = fwd(ymin, view.log_y), ly1 = fwd(ymax, view.log_y), pad = 0.05 * (ly1 - ly0);
-  view.x0 = xmin;
-  view.x1 = xmax;
-  view.y0 = inv(ly0 - pad, view.log_y);
-  view.y1 = inv(ly1 + pad, view.log_y);
+  const auto r = jobs::report::fit_range(spec, all);
+  view.x0 = r.x0;
+  view.x1 = r.x1;
+  view.y0 = r.y0;
+  view.y1 = r.y1;
   view.fitted = true;
 }
 
@@ -156,14 +103,15 @@ bool plot(const char* id, const PlotSpec& spec, PlotView& view, ImVec2 size) {
   ImGui::InvisibleButton("canvas", avail);
   const bool hovered = ImGui::IsItemHovered();
   const ImGuiIO& io = ImGui::GetIO();
+  const bool log_x = spec.x_scale == Scale::Log, log_y = spec.y_scale == Scale::Log;
 
-  double X0 = fwd(view.x0, view.log_x), X1 = fwd(view.x1, view.log_x);
-  double Y0 = fwd(view.y0, view.log_y), Y1 = fwd(view.y1, view.log_y);
+  double X0 = fwd(view.x0, log_x), X1 = fwd(view.x1, log_x);
+  double Y0 = fwd(view.y0, log_y), Y1 = fwd(view.y1, log_y);
   auto sx = [&](double x) {
-    return a.x + static_cast<float>((fwd(x, view.log_x) - X0) / (X1 - X0)) * (b.x - a.x);
+    return a.x + static_cast<float>((fwd(x, log_x) - X0) / (X1 - X0)) * (b.x - a.x);
   };
   auto sy = [&](double y) {
-    return b.y - static_cast<float>((fwd(y, view.log_y) - Y0) / (Y1 - Y0)) * (b.y - a.y);
+    return b.y - static_cast<float>((fwd(y, log_y) - Y0) / (Y1 - Y0)) * (b.y - a.y);
   };
 
   // Interaction: wheel zooms about the cursor, drag pans, double-click fits.
@@ -191,57 +139,40 @@ bool plot(const char* id, const PlotSpec& spec, PlotView& view, ImVec2 size) {
   }
   if (hovered && ImGui::IsMouseDoubleClicked(ImGuiMouseButton_Left)) {
     fit_view(spec, view, /*all=*/true);  // every sample ("Fit views" returns to the spec's frame)
-    X0 = fwd(view.x0, view.log_x);
-    X1 = fwd(view.x1, view.log_x);
-    Y0 = fwd(view.y0, view.log_y);
-    Y1 = fwd(view.y1, view.log_y);
+    X0 = fwd(view.x0, log_x);
+    X1 = fwd(view.x1, log_x);
+    Y0 = fwd(view.y0, log_y);
+    Y1 = fwd(view.y1, log_y);
   }
-  view.x0 = inv(X0, view.log_x);
-  view.x1 = inv(X1, view.log_x);
-  view.y0 = inv(Y0, view.log_y);
-  view.y1 = inv(Y1, view.log_y);
+  view.x0 = inv(X0, log_x);
+  view.x1 = inv(X1, log_x);
+  view.y0 = inv(Y0, log_y);
+  view.y1 = inv(Y1, log_y);
 
   // Frame, grid, ticks.
   dl->AddRectFilled(a, b, kColPlotBg);
   const ImU32 grid = IM_COL32(70, 75, 90, 255), text = IM_COL32(200, 200, 210, 255);
-  // Tick labels that would overlap are left out; on a log axis the decades
-  // are labelled first, the 2…9 multiples only where there is room.
-  std::vector<std::pair<float, float>> taken;  // occupied label extents along the axis
-  auto place_label = [&](float centre, float extent, float gap) {
-    const float lo = centre - 0.5f * extent - gap, hi = centre + 0.5f * extent + gap;
-    for (const auto& [l, h] : taken)
-      if (lo < h && hi > l) return false;
-    taken.emplace_back(lo, hi);
-    return true;
-  };
-  auto is_decade = [](double t) { return std::fabs(t - std::round(t)) < 1e-9; };
-  const auto xt = ticks(X0, X1, view.log_x), yt = ticks(Y0, Y1, view.log_y);
-  for (double t : xt) {
-    float x = a.x + static_cast<float>((t - X0) / (X1 - X0)) * (b.x - a.x);
+  // Ticks as many as their labels leave room for (jobs/report/plot_axes).
+  using jobs::report::axis_ticks;
+  using jobs::report::tick_label;
+  const float x_label_w = ImGui::CalcTextSize(tick_label(view.x1, spec.x_scale, spec.x_unit).c_str()).x + 6;
+  const auto xt = axis_ticks(view.x0, view.x1, spec.x_scale, b.x - a.x, x_label_w);
+  const auto yt = axis_ticks(view.y0, view.y1, spec.y_scale, b.y - a.y, ImGui::GetTextLineHeight() + 4);
+  const ImU32 minor = (grid & ~IM_COL32_A_MASK) | IM_COL32(0, 0, 0, 110);
+  for (double t : xt.minor) dl->AddLine(ImVec2(sx(t), a.y), ImVec2(sx(t), b.y), minor);
+  for (double t : yt.minor) dl->AddLine(ImVec2(a.x, sy(t)), ImVec2(b.x, sy(t)), minor);
+  for (double t : xt.major) {
+    const float x = sx(t);
     dl->AddLine(ImVec2(x, a.y), ImVec2(x, b.y), grid);
+    const std::string label = tick_label(t, spec.x_scale, spec.x_unit);
+    const float w = ImGui::CalcTextSize(label.c_str()).x;
+    dl->AddText(ImVec2(x - 0.5f * w, b.y + 4), text, label.c_str());
   }
-  for (int pass = 0; pass < 2; ++pass)
-    for (double t : xt) {
-      if (view.log_x && (pass == 0) != is_decade(t)) continue;
-      if (!view.log_x && pass == 1) continue;
-      const float x = a.x + static_cast<float>((t - X0) / (X1 - X0)) * (b.x - a.x);
-      const std::string label = fmt(inv(t, view.log_x));
-      const float w = ImGui::CalcTextSize(label.c_str()).x;
-      if (place_label(x, w, 4)) dl->AddText(ImVec2(x - 0.5f * w, b.y + 4), text, label.c_str());
-    }
-  taken.clear();
-  for (double t : yt) {
-    float y = b.y - static_cast<float>((t - Y0) / (Y1 - Y0)) * (b.y - a.y);
+  for (double t : yt.major) {
+    const float y = sy(t);
     dl->AddLine(ImVec2(a.x, y), ImVec2(b.x, y), grid);
+    dl->AddText(ImVec2(p0.x + 2, y - 7), text, tick_label(t, spec.y_scale, spec.y_unit).c_str());
   }
-  for (int pass = 0; pass < 2; ++pass)
-    for (double t : yt) {
-      if (view.log_y && (pass == 0) != is_decade(t)) continue;
-      if (!view.log_y && pass == 1) continue;
-      const float y = b.y - static_cast<float>((t - Y0) / (Y1 - Y0)) * (b.y - a.y);
-      if (place_label(y, ImGui::GetTextLineHeight(), 1))
-        dl->AddText(ImVec2(p0.x + 2, y - 7), text, fmt(inv(t, view.log_y)).c_str());
-    }
   // Title centred over the frame, the y label at the top left (they overlap
   // when both sit at the left edge and the y label is long).
   const float title_w = ImGui::CalcTextSize(spec.title.c_str()).x;
@@ -253,13 +184,13 @@ bool plot(const char* id, const PlotSpec& spec, PlotView& view, ImVec2 size) {
   dl->PushClipRect(a, b, true);
   for (const auto& band : spec.bands) {
     float xa = sx(band.x0), xb = sx(band.x1);
-    dl->AddRectFilled(ImVec2(xa, a.y), ImVec2(xb, b.y), band.color);
+    dl->AddRectFilled(ImVec2(xa, a.y), ImVec2(xb, b.y), im_colour(band.colour));
     if (!band.label.empty() && ImGui::CalcTextSize(band.label.c_str()).x + 4 < xb - xa)
       dl->AddText(ImVec2(xa + 2, b.y - 16), text, band.label.c_str());
   }
   for (const auto& m : spec.markers) {
     float x = sx(m.x);
-    dl->AddLine(ImVec2(x, a.y), ImVec2(x, b.y), m.color, 1.0f);
+    dl->AddLine(ImVec2(x, a.y), ImVec2(x, b.y), im_colour(m.colour), 1.0f);
   }
   // Lines keep a vertex only once it is a pixel away from the last one kept:
   // the frequency grids are denser than the screen, and every triangle costs
@@ -269,8 +200,7 @@ bool plot(const char* id, const PlotSpec& spec, PlotView& view, ImVec2 size) {
   for (const auto& s : spec.series) {
     pts.clear();
     for (std::size_t i = 0; i < s.x.size() && i < s.y.size(); ++i) {
-      if ((view.log_x && s.x[i] <= 0) || (view.log_y && s.y[i] <= 0) || !std::isfinite(s.y[i]))
-        continue;
+      if (!jobs::report::usable(s.x[i], spec.x_scale) || !jobs::report::usable(s.y[i], spec.y_scale)) continue;
       const ImVec2 p(sx(s.x[i]), sy(s.y[i]));
       const bool last = i + 1 == std::min(s.x.size(), s.y.size());
       if (!s.points && !last && !pts.empty() && std::fabs(p.x - pts.back().x) < 1.0f &&
@@ -280,9 +210,9 @@ bool plot(const char* id, const PlotSpec& spec, PlotView& view, ImVec2 size) {
     }
     if (s.points) {
       for (const auto& p : pts)
-        dl->AddRectFilled(ImVec2(p.x - 2, p.y - 2), ImVec2(p.x + 2, p.y + 2), s.color);
+        dl->AddRectFilled(ImVec2(p.x - 2, p.y - 2), ImVec2(p.x + 2, p.y + 2), im_colour(s.colour));
     } else if (pts.size() > 1) {
-      dl->AddPolyline(pts.data(), static_cast<int>(pts.size()), s.color, 0, s.thickness);
+      dl->AddPolyline(pts.data(), static_cast<int>(pts.size()), im_colour(s.colour), 0, static_cast<float>(s.width));
     }
   }
   dl->PopClipRect();
@@ -301,7 +231,7 @@ bool plot(const char* id, const PlotSpec& spec, PlotView& view, ImVec2 size) {
   for (const auto& s : spec.series) {
     if (!s.listed) continue;
     float w = ImGui::CalcTextSize(s.label.c_str()).x;
-    dl->AddRectFilled(ImVec2(b.x - w - 28, ly + 3), ImVec2(b.x - w - 14, ly + 11), s.color);
+    dl->AddRectFilled(ImVec2(b.x - w - 28, ly + 3), ImVec2(b.x - w - 14, ly + 11), im_colour(s.colour));
     dl->AddText(ImVec2(b.x - w - 8, ly), text, s.label.c_str());
     ly += 16;
   }
@@ -331,7 +261,7 @@ bool plot(const char* id, const PlotSpec& spec, PlotView& view, ImVec2 size) {
   if (hovered && io.MousePos.x >= a.x && io.MousePos.x <= b.x && io.MousePos.y >= a.y &&
       io.MousePos.y <= b.y) {
     const Marker* snapped = snap_marker(spec.markers, io.MousePos.x, to_px);
-    double cx = snapped ? snapped->x : inv(X0 + (io.MousePos.x - a.x) / (b.x - a.x) * (X1 - X0), view.log_x);
+    double cx = snapped ? snapped->x : inv(X0 + (io.MousePos.x - a.x) / (b.x - a.x) * (X1 - X0), log_x);
     const float line_x = snapped ? sx(snapped->x) : io.MousePos.x;
     dl->AddLine(ImVec2(line_x, a.y), ImVec2(line_x, b.y), IM_COL32(255, 255, 255, snapped ? 140 : 60));
     if (ImGui::IsMouseClicked(ImGuiMouseButton_Right)) {

@@ -1,7 +1,9 @@
 #pragma once
 // A small plot widget on ImGui's draw lists (no plotting library is packaged
-// for ImGui on Debian): linear or logarithmic axes, several series, vertical
-// markers, shaded bands, mouse-wheel zoom, drag to pan, double-click to fit,
+// for ImGui on Debian) that draws the reports' plot description
+// (jobs/report/plot_spec.hpp, axes and ticks from plot_axes.hpp): linear or
+// logarithmic axes, several series, vertical markers, shaded bands,
+// mouse-wheel zoom, drag to pan, double-click to fit,
 // a hover read-out that snaps to the markers that ask for it (resonances), a
 // read-out pinned by a right click, and a legend. The view state lives in PlotView (owned by
 // the caller's window state, not in function statics).
@@ -13,59 +15,35 @@
 #include <string>
 #include <vector>
 
+#include "jobs/report/plot_spec.hpp"
+
 namespace piezo::gui {
 
-struct Series {
-  std::string label;
-  std::vector<double> x, y;
-  ImU32 color = IM_COL32(255, 255, 255, 255);
-  float thickness = 1.5f;
-  bool points = false;  // draw markers instead of a line
-  bool listed =
-      true;  // in the legend and the hover read-out (false: e.g. the lower half of a ±band)
-  // The read-out of sample i (hover and pinned marker); empty: the y value.
-  // E.g. the impedance curves: |Z|, phase, R and X.
-  std::function<std::string(std::size_t)> readout{};
-  bool hover = true;  // in the hover read-out (which looks samples up by x: x must rise)
-};
-
-struct Marker {
-  double x = 0;
-  ImU32 color = IM_COL32(255, 255, 255, 120);
-  std::string label{};  // heads the read-out when the cursor snaps to it (e.g. "fr 51.59 kHz")
-  bool snap = false;  // the read-out cursor jumps to it within kSnapPixels
-};
+// The plot description is the reports' (jobs/report/plot_spec.hpp): a panel
+// with its series, markers (`snap`: the read-out cursor jumps to it within
+// kSnapPixels), shaded bands (`detail` joins the hover read-out inside the
+// band) and the view it opens on; here only the view state is the GUI's own.
+using PlotSpec = jobs::report::Panel;
+using Series = jobs::report::Series;
+using Marker = jobs::report::VMarker;
+using Band = jobs::report::Band;
+using jobs::report::Colour;
+using jobs::report::Scale;
 inline constexpr float kSnapPixels = 8.0f;
 
-struct Band {
-  double x0 = 0, x1 = 0;
-  ImU32 color = IM_COL32(255, 255, 0, 40);
-  std::string label;   // drawn inside the band when it fits
-  std::string detail;  // added to the hover read-out while the cursor is in the band
-};
+inline ImU32 im_colour(Colour c) { return IM_COL32(c.r, c.g, c.b, c.a); }
+inline constexpr Colour colour_of(ImU32 c) {
+  return {static_cast<std::uint8_t>(c >> IM_COL32_R_SHIFT), static_cast<std::uint8_t>(c >> IM_COL32_G_SHIFT),
+          static_cast<std::uint8_t>(c >> IM_COL32_B_SHIFT), static_cast<std::uint8_t>(c >> IM_COL32_A_SHIFT)};
+}
 
 struct PlotView {
-  bool log_x = true, log_y = false;
   double x0 = 1, x1 = 10, y0 = 0, y1 = 1;  // visible range (data units)
   bool fitted = false;                     // fit to data on the next draw
   ImVec4 frame{0, 0, 0, 0};  // where plot() drew the data area last (x0, y0, x1, y1; screen pixels)
   // A read-out pinned by a right click (snapped like the hover one); a right
   // click near it removes it.
   std::optional<double> pinned{};
-};
-
-struct PlotSpec {
-  std::string title, x_label, y_label;
-  std::vector<Series> series;
-  std::vector<Marker> markers;
-  std::vector<Band> bands;
-  // How fit_view frames the data (issue 41 item 5): an x range to open on
-  // (e.g. |Z| on the resonance band; double-click still fits), the y range
-  // then from the samples inside it; and a y range from the quantiles
-  // [q, 1 - q] of those samples, so a few points at the band's edges do not
-  // flatten the rest (0: the full range).
-  double fit_x0 = 0, fit_x1 = 0;  // fit_x1 > fit_x0: open on [fit_x0, fit_x1]
-  double fit_y_quantile = 0;
 };
 
 // Draws the plot in a child region of `size`; returns true while hovered.
@@ -87,6 +65,7 @@ std::string impedance_readout(std::complex<double> z);
 
 // The read-out lines at data x: the marker's label (when snapped) and each
 // listed series' nearest sample inside its own x range.
+// (A series is read only where its x rises: the look-up is by x.)
 std::vector<std::pair<ImU32, std::string>> readout_at(const PlotSpec& spec, double x, const Marker* snapped);
 
 }  // namespace piezo::gui

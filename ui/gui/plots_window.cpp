@@ -42,8 +42,8 @@ void impedance_specs(const AppState& s, PlotSpec& mag, PlotSpec& ph) {
     const auto& c = *cp;
     if (c.label.find("FFT") != std::string::npos && !s.show_fft) continue;
     if (c.label.find("cross") != std::string::npos && !s.show_xspec) continue;
-    const float width = c.label.find("updated") != std::string::npos ? 6.0f : 2.0f;
-    Series m{c.label, c.f_hz, {}, colour_for(c.label), width, false};
+    const double width = c.label.find("updated") != std::string::npos ? 6.0 : 2.0;
+    Series m{c.label, c.f_hz, {}, colour_of(colour_for(c.label)), width};
     Series p = m;
     for (const auto& z : c.z_ohm) {
       m.y.push_back(std::abs(z));
@@ -56,9 +56,9 @@ void impedance_specs(const AppState& s, PlotSpec& mag, PlotSpec& ph) {
   }
   // The read-out snaps to the estimate's resonances and anti-resonances.
   for (double f : s.result->resonances_hz)
-    mag.markers.push_back({f, IM_COL32(255, 255, 255, 90), "resonance fr " + khz(f), true});
+    mag.markers.push_back({f, {255, 255, 255, 90}, "resonance fr " + khz(f), true});
   for (double f : s.result->antiresonances_hz)
-    mag.markers.push_back({f, IM_COL32(255, 160, 160, 90), "anti-resonance fa " + khz(f), true});
+    mag.markers.push_back({f, {255, 160, 160, 90}, "anti-resonance fa " + khz(f), true});
   // Open on the resonance band (issue 41 item 5): from 0.8 x the lowest
   // resonance to 1.25 x the highest anti-resonance, so the modes fill the
   // plot instead of its right tenth; a double-click shows the whole estimate.
@@ -99,7 +99,7 @@ void cell(const dsp::Uncertain& u, double scale, const char* f) {
 // plot beside it) and that mode's admittance plane: the estimate's points in
 // the fit window, the fitted network and the motional circle.
 void render_modes_row(AppState& s, float width, float height) {
-  PlotSpec ny{"admittance (mode)", "G [mS]", "B [mS]", {}, {}, {}};
+  PlotSpec ny{.title = "admittance (mode)", .x_label = "G [mS]", .y_label = "B [mS]"};
   if (!s.nyquist.empty()) {
     s.nyquist_mode = std::clamp(s.nyquist_mode, 0, static_cast<int>(s.nyquist.size()) - 1);
     const auto& n = s.nyquist[static_cast<std::size_t>(s.nyquist_mode)];
@@ -111,12 +111,11 @@ void render_modes_row(AppState& s, float width, float height) {
       for (std::size_t i = 0; i < v.size(); ++i) o[i] = 1e3 * v[i];
       return o;
     };
-    ny.series.push_back({"motional circle", ms(n.circle_g_s), ms(n.circle_b_s), IM_COL32(255, 255, 255, 110), 1.0f, false});
-    ny.series.push_back({"fitted BVD", ms(n.fit_g_s), ms(n.fit_b_s), kColUpdated, 2.0f, false});
-    ny.series.push_back({"measured (Prony-SS)", ms(n.g_s), ms(n.b_s), kColMeasured, 1.0f, true});
+    ny.series.push_back({"motional circle", ms(n.circle_g_s), ms(n.circle_b_s), {255, 255, 255, 110}, 1.0});
+    ny.series.push_back({"fitted BVD", ms(n.fit_g_s), ms(n.fit_b_s), colour_of(kColUpdated), 2.0});
+    ny.series.push_back({"measured (Prony-SS)", ms(n.g_s), ms(n.b_s), colour_of(kColMeasured), 1.0, false, true});
   }
-  // (Not in the hover read-out, which looks samples up by a rising x: G is not.)
-  for (auto& se : ny.series) se.hover = false;
+  // (G does not rise with frequency: these series stay out of the hover read-out.)
   plot("nyquist", ny, s.nyquist_view, ImVec2(width * 0.42f, height));
   ImGui::SameLine();
   ImGui::BeginChild("modes_table", ImVec2(0, height), true);
@@ -195,7 +194,7 @@ void render_plots_window(AppState& s) {
   ImGui::SameLine();
   if (ImGui::Checkbox("Residual phase", &s.residual_phase)) s.residual_view.fitted = false;
   ImGui::SameLine();
-  if (ImGui::Checkbox("log f", &s.residual_view.log_x)) s.residual_view.fitted = false;
+  if (ImGui::Checkbox("log f", &s.residual_log_f)) s.residual_view.fitted = false;
   if (ImGui::IsItemHovered()) ImGui::SetTooltip("Logarithmic frequency axis for the residual plot");
   ImGui::SameLine();
   tracked_checkbox(s, "Modes", &s.show_modes);
@@ -205,19 +204,23 @@ void render_plots_window(AppState& s) {
   if (ImGui::Button("Fit views"))
     s.mag_view.fitted = s.phase_view.fitted = s.sv_view.fitted = s.residual_view.fitted = s.nyquist_view.fitted =
         false;
-  PlotSpec mag{"|Z|", "f [Hz]", "ohm", {}, {}, {}}, ph{"phase", "f [Hz]", "deg", {}, {}, {}};
+  // Log frequency for the impedance; linear for the residual (unless asked),
+  // whose regions crowd around the resonances in the top octave.
+  PlotSpec mag{.title = "|Z|", .x_label = "f [Hz]", .y_label = "ohm", .x_scale = Scale::Log, .y_scale = Scale::Log};
+  PlotSpec ph{.title = "phase", .x_label = "f [Hz]", .y_label = "deg", .x_scale = Scale::Log};
   impedance_specs(s, mag, ph);
-  PlotSpec res{"gap: residual (no diagnosis)", "f [kHz]", "dB", {}, {}, {}};
+  PlotSpec res{.title = "gap: residual (no diagnosis)", .x_label = "f [kHz]", .y_label = "dB"};
   if (s.result && s.result->diagnosis)
     res = residual_plot_spec(*s.result->diagnosis, s.residual_phase);
-  PlotSpec sv{"Hankel SVs", "index", "s_k/s_1", {}, {}, {}};
+  res.x_scale = s.residual_log_f ? Scale::Log : Scale::Linear;
+  PlotSpec sv{.title = "Hankel SVs", .x_label = "index", .y_label = "s_k/s_1", .y_scale = Scale::Log};
   if (s.result && !s.result->singular_values.empty()) {
     sv.title = "Hankel SVs (order " + std::to_string(s.result->order) + ")";
-    Series pts{"s_k/s_1", {}, s.result->singular_values, kColMeasured, 1.0f, true};
+    Series pts{"s_k/s_1", {}, s.result->singular_values, colour_of(kColMeasured), 1.0, false, true};
     for (std::size_t i = 0; i < pts.y.size(); ++i) pts.x.push_back(static_cast<double>(i + 1));
     sv.series.push_back(std::move(pts));
-    sv.markers.push_back({s.result->order + 0.5, IM_COL32(255, 80, 80, 200)});
-    sv.bands.push_back({0.5, s.result->order + 0.5, IM_COL32(255, 80, 80, 30), "",
+    sv.markers.push_back({s.result->order + 0.5, {255, 80, 80, 200}});
+    sv.bands.push_back({0.5, s.result->order + 0.5, {255, 80, 80, 30}, "", "",
                         "kept by Prony-SS (order " + std::to_string(s.result->order) + ")"});
   }
 

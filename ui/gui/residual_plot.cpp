@@ -42,22 +42,19 @@ std::vector<double> khz(const std::vector<double>& f_hz) {
 }
 
 Series residual_series(const std::string& label, const update::GapCurve& c, bool phase,
-                       ImU32 colour, float width) {
-  return {label, khz(c.f_hz), phase ? c.residual_deg : c.residual_db, colour, width, false};
+                       ImU32 colour, double width) {
+  return {label, khz(c.f_hz), phase ? c.residual_deg : c.residual_db, colour_of(colour), width};
 }
 }  // namespace
 
 PlotSpec residual_plot_spec(const update::GapDiagnosis& d, bool phase) {
-  PlotSpec spec{phase ? "gap: residual phase" : "gap: residual |Z|",
-                "f [kHz]",
-                phase ? "deg" : "dB",
-                {},
-                {},
-                {}};
+  PlotSpec spec{.title = phase ? "gap: residual phase" : "gap: residual |Z|",
+                .x_label = "f [kHz]",
+                .y_label = phase ? "deg" : "dB"};
   for (const auto& g : d.regions) {
     if (g.points == 0) continue;
-    spec.bands.push_back({g.f_lo_hz / 1e3, g.f_hi_hz / 1e3, region_colour(g.kind),
-                          short_kind(g.kind), region_detail(g)});
+    spec.bands.push_back({g.f_lo_hz / 1e3, g.f_hi_hz / 1e3, colour_of(region_colour(g.kind)),
+                          short_kind(g.kind), "", region_detail(g)});
   }
   // Fitted to the bulk of the residual (issue 41 item 5): the 1st to 99th
   // percentile of the samples, so the band's edges do not stretch the axis
@@ -65,7 +62,7 @@ PlotSpec residual_plot_spec(const update::GapDiagnosis& d, bool phase) {
   spec.fit_y_quantile = 0.01;
   // The noise first and thin, the residuals on top.
   const auto& sig = phase ? d.before.sigma_deg : d.before.sigma_db;
-  Series hi{"+/-2 sigma (noise)", khz(d.before.f_hz), {}, kColNoiseBand, 1.0f, false}, lo = hi;
+  Series hi{"+/-2 sigma (noise)", khz(d.before.f_hz), {}, colour_of(kColNoiseBand), 1.0}, lo = hi;
   lo.listed = false;
   for (double v : sig) {
     hi.y.push_back(2 * v);
@@ -74,11 +71,11 @@ PlotSpec residual_plot_spec(const update::GapDiagnosis& d, bool phase) {
   spec.series.push_back(std::move(hi));
   spec.series.push_back(std::move(lo));
   spec.series.push_back(
-      residual_series("updated model (base refit)", d.before, phase, kColResidual, 2.0f));
+      residual_series("updated model (base refit)", d.before, phase, kColResidual, 2.0));
   if (!d.added.empty()) {
     std::string label = "with";
     for (const auto& e : d.added) label += " " + e;
-    spec.series.push_back(residual_series(label, d.after, phase, kColResidualAfter, 2.0f));
+    spec.series.push_back(residual_series(label, d.after, phase, kColResidualAfter, 2.0));
   }
   return spec;
 }
