@@ -4,6 +4,8 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <fstream>
+#include <iterator>
 #include <vector>
 
 #include "acquisition/estimators/estimator.hpp"
@@ -133,4 +135,21 @@ TEST(EstimatorRegistry, DocsTableIsTheRegistrys) {
   const std::string table = estimator_table_markdown();
   EXPECT_EQ(test::doc_table("acquisition/README.md", table.substr(0, table.find('\n'))), table)
       << "update acquisition/README.md's estimator table to:\n" << table;
+}
+
+// The synopses of README.md and docs/cli.md spell --method's choices as the registry has them.
+TEST(EstimatorRegistry, DocsSynopsesListTheRegistrysKeys) {
+  const auto& r = builtin_estimators();
+  const std::string impedance = "--method " + join_keys(r.keys(), "|", "|");
+  const std::string figures =
+      "--method oe|" + join_keys(r.keys([](const EstimatorEntry& e) { return e.caps.transient_shots; }), "|", "|");
+  for (const std::string page : {"README.md", "docs/cli.md"}) {
+    std::ifstream in(std::string(PIEZO_SOURCE_DIR) + "/" + page);
+    const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    ASSERT_FALSE(text.empty()) << page;
+    EXPECT_NE(text.find(impedance), std::string::npos) << page << " should say " << impedance;
+    if (page == "docs/cli.md") {
+      EXPECT_NE(text.find(figures), std::string::npos) << page << " should say " << figures;
+    }
+  }
 }
