@@ -6,6 +6,7 @@
 #include <stdexcept>
 
 #include "acquisition/divider_record.hpp"
+#include "acquisition/estimators/estimator.hpp"
 #include "dsp/deskew.hpp"
 #include "dsp/features.hpp"
 
@@ -31,10 +32,6 @@ EstimateDefaults default_estimate(const Shot& first) {
 
 
 namespace {
-
-struct Band {
-  double fmin, fmax, step;
-};
 
 std::vector<const Shot*> dut_shots(const Capture& cap, const AssessmentOptions& opt) {
   if (opt.shot) {
@@ -68,45 +65,18 @@ std::vector<const Shot*> dut_shots(const Capture& cap, const AssessmentOptions& 
   return out;
 }
 
-OwnedRecord mean_of(const std::vector<OwnedRecord>& recs) {
-  OwnedRecord avg = recs.front();
-  for (std::size_t k = 1; k < recs.size(); ++k)
-    for (std::size_t i = 0; i < avg.v1.size(); ++i) {
-      avg.v1[i] += recs[k].v1[i];
-      avg.v2[i] += recs[k].v2[i];
-    }
-  for (std::size_t i = 0; i < avg.v1.size(); ++i) {
-    avg.v1[i] /= double(recs.size());
-    avg.v2[i] /= double(recs.size());
-  }
-  return avg;
+std::vector<dsp::DividerRecord> views(const std::vector<OwnedRecord>& recs) {
+  std::vector<dsp::DividerRecord> v;
+  for (const auto& r : recs) v.push_back(r.view());
+  return v;
 }
 
-// One estimate from owned records (averaged for prony/fft, segments for xspec).
-dsp::ImpedanceResult estimate(const std::string& method, const std::vector<OwnedRecord>& recs,
-                              const Band& b, const AssessmentOptions& opt,
-                              std::optional<std::size_t> order, std::size_t bootstrap) {
-  if (method == "xspec") {
-    std::vector<dsp::DividerRecord> v;
-    for (const auto& r : recs) v.push_back(r.view());
-    dsp::CrossSpectraOptions o = opt.xspec;
-    o.fmin_hz = b.fmin;
-    o.fmax_hz = b.fmax;
-    return dsp::impedance_xspec(v, o);
-  }
-  const OwnedRecord avg = mean_of(recs);  // prony / fft: averaged sample by sample
-  if (method == "fft") {
-    dsp::FftRatioOptions o = opt.fft;
-    o.fmin_hz = b.fmin;
-    o.fmax_hz = b.fmax;
-    return dsp::impedance_fft(avg.view(), o);
-  }
-  dsp::PronyImpedanceOptions o = opt.prony;
-  o.prony.band_hz = b.fmax;
-  o.features.fmin_hz = b.fmin;
-  if (order) o.prony.order = order;
-  o.bootstrap = bootstrap;
-  return dsp::impedance_prony(avg.view(), dsp::make_grid(b.fmin, b.fmax, b.step), o);
+// One estimate from owned records by the registry's entry (averaged, or as segments: its caps).
+dsp::ImpedanceResult estimate(const EstimatorEntry& e, const std::vector<OwnedRecord>& recs, const EstimateBand& b,
+                              const AssessmentOptions& opt, std::optional<std::size_t> order,
+                              std::optional<std::size_t> bootstrap) {
+  const auto v = views(recs);
+  return e.estimate(EstimateInput{v, {}, b, opt, order, bootstrap});
 }
 
 OwnedRecord single(const Capture& cap, const Shot& s) {
@@ -117,27 +87,30 @@ OwnedRecord single(const Capture& cap, const Shot& s) {
 }  // namespace
 
 ImpedanceAssessment assess_impedance(const Capture& cap, const AssessmentOptions& opt) {
-  if (opt.method != "prony" && opt.method != "fft" && opt.method != "xspec")
-    throw std::invalid_argument("assess_impedance: method '" + opt.method +
-                                "' (expected prony, fft or xspec)");
+  const EstimatorRegistry& estimators = builtin_estimators();
+  const EstimatorEntry* est = estimators.find(opt.method);
+  if (!est || !est->caps.transient_shots)
+    throw std::invalid_argument(
+        "assess_impedance: method '" + opt.method + "' (expected " +
+        join_keys(estimators.keys([](const EstimatorEntry& e) { return e.caps.transient_shots; })) + ")");
   ImpedanceAssessment out;
   const auto shots = dut_shots(cap, opt);
   for (const Shot* s : shots) out.shots.push_back(s->name);
   const double fs = shots.front()->sample_rate_hz;
-  Band b;
-  b.fmax = opt.fmax_hz > 0 ? opt.fmax_hz : fs / 4;
-  if (!(b.fmax <= fs / 2))
+  EstimateBand b;
+  b.fmax_hz = opt.fmax_hz > 0 ? opt.fmax_hz : fs / 4;
+  if (!(b.fmax_hz <= fs / 2))
     throw std::invalid_argument("fmax above the Nyquist frequency (" + std::to_string(fs / 2) +
                                 " Hz)");
-  b.step = opt.step_hz > 0 ? opt.step_hz : b.fmax / 2000;
-  b.fmin = opt.fmin_hz > 0 ? opt.fmin_hz : b.step;
-  if (!(b.fmin < b.fmax)) throw std::invalid_argument("fmin must lie below fmax");
+  b.step_hz = opt.step_hz > 0 ? opt.step_hz : b.fmax_hz / 2000;
+  b.fmin_hz = opt.fmin_hz > 0 ? opt.fmin_hz : b.step_hz;
+  if (!(b.fmin_hz < b.fmax_hz)) throw std::invalid_argument("fmin must lie below fmax");
 
   // Calibration (skew and standards) from the capture's calibration shots.
   if (opt.compensate) {
     CaptureCalibrationOptions co;
     co.fmin_hz = 0.0;
-    co.fmax_hz = b.fmax;
+    co.fmax_hz = b.fmax_hz;
     co.degree = opt.standard_degree;
     co.model = opt.model;
     co.deskew = opt.deskew;
@@ -180,8 +153,7 @@ ImpedanceAssessment assess_impedance(const Capture& cap, const AssessmentOptions
     // error near 84 kHz in test_fixture_acceptance).
   }
   const AssessmentOptions& o2 = opt;
-  const std::size_t boot_noise = opt.method == "prony" ? opt.prony.bootstrap : 0;
-  out.result = estimate(opt.method, ready, b, o2, std::nullopt, boot_noise);
+  out.result = estimate(*est, ready, b, o2, std::nullopt, std::nullopt);
   out.uncompensated = out.result;  // its band (z_sigma_ohm) belongs to the corrected estimate
   out.uncompensated.z_sigma_ohm.resize(0);
   const bool zdesk = opt.deskew && out.skew_applied_s != 0.0;
@@ -198,7 +170,7 @@ ImpedanceAssessment assess_impedance(const Capture& cap, const AssessmentOptions
       sigma_std[k] = comp->corrected_sigma(out.result.f_hz[k], out.result.z_ohm[k], 0.0);
     comp->apply(out.result);
     dsp::FeatureOptions fo = opt.prony.features;
-    fo.fmin_hz = b.fmin;
+    fo.fmin_hz = b.fmin_hz;
     out.result.features =
         dsp::find_features(out.result.f_hz, out.result.z_ohm, out.result.z_sigma_ohm, fo);
     out.notes.push_back(
@@ -219,7 +191,7 @@ ImpedanceAssessment assess_impedance(const Capture& cap, const AssessmentOptions
                                           [&](const std::vector<std::size_t>& idx) {
                                             std::vector<OwnedRecord> pick;
                                             for (auto i : idx) pick.push_back(ready[i]);
-                                            auto r = estimate(opt.method, pick, b, o2, order, 0);
+                                            auto r = estimate(*est, pick, b, o2, order, 0);
                                             if (zdesk) dsp::deskew_impedance(r, ready.front().r1_ohm, out.skew_applied_s);
                                             if (comp)
                                               for (Eigen::Index k = 0; k < r.f_hz.size(); ++k)
@@ -262,7 +234,7 @@ ImpedanceAssessment assess_impedance(const Capture& cap, const AssessmentOptions
     out.band = dsp::band_from_sigma(
         out.result.f_hz, out.result.z_ohm, have ? out.result.z_sigma_ohm : Eigen::VectorXd(),
         opt.coverage_factor,
-        std::string(opt.method == "prony" ? "Prony parametric bootstrap" : "noise propagation") +
+        est->sigma_source +
             (comp ? " + fixture standards" : ""));
     if (!have)
       out.notes.push_back(
@@ -280,7 +252,7 @@ ImpedanceAssessment assess_impedance(const Capture& cap, const AssessmentOptions
                                       out.band->abs_ohm[k] * out.band->phase_sigma_rad[k]);
   }
   // Model-order part (Prony): how much the estimate moves one order step up or down.
-  if (out.band && opt.order_spread && order && opt.method == "prony") {
+  if (out.band && opt.order_spread && order && est->caps.modes) {
     const Eigen::Index n = out.band->size();
     Eigen::VectorXd dl = Eigen::VectorXd::Zero(n), dp = Eigen::VectorXd::Zero(n);
     int used = 0;
@@ -288,7 +260,7 @@ ImpedanceAssessment assess_impedance(const Capture& cap, const AssessmentOptions
       const long q = static_cast<long>(*order) + sgn * static_cast<long>(opt.order_spread_step);
       if (q < 1) continue;
       try {
-        auto r = estimate(opt.method, ready, b, o2, static_cast<std::size_t>(q), 0);
+        auto r = estimate(*est, ready, b, o2, static_cast<std::size_t>(q), 0);
         if (zdesk) dsp::deskew_impedance(r, ready.front().r1_ohm, out.skew_applied_s);
         if (comp)
           for (Eigen::Index k = 0; k < n; ++k) r.z_ohm[k] = comp->correct(r.f_hz[k], r.z_ohm[k]);
@@ -327,21 +299,21 @@ ImpedanceAssessment assess_impedance(const Capture& cap, const AssessmentOptions
     std::vector<dsp::DividerRecord> v;
     for (const auto& r : ready) v.push_back(r.view());
     dsp::ShotValidityOptions vo = opt.validity_options;
-    vo.fmin_hz = b.fmin;
-    vo.fmax_hz = b.fmax;
+    vo.fmin_hz = b.fmin_hz;
+    vo.fmax_hz = b.fmax_hz;
     dsp::PronyImpedanceOptions po = opt.prony;
-    po.prony.band_hz = b.fmax;
+    po.prony.band_hz = b.fmax_hz;
     po.prony.order = order;
     po.bootstrap = 0;
     out.validity = dsp::check_shots(v, po, vo);
   }
-  if (opt.stabilization && opt.method == "prony") {
-    const OwnedRecord avg = mean_of(ready);
+  if (opt.stabilization && est->caps.modes) {
+    const OwnedRecord avg = mean_record(views(ready));
     dsp::PronyImpedanceOptions po = o2.prony;
-    po.prony.band_hz = b.fmax;
+    po.prony.band_hz = b.fmax_hz;
     po.bootstrap = 0;
     dsp::StabilizationOptions so = opt.stabilization_options;
-    if (so.fmax_hz <= 0) so.fmax_hz = b.fmax;
+    if (so.fmax_hz <= 0) so.fmax_hz = b.fmax_hz;
     out.stabilization = dsp::stabilization_chart(avg.view(), po, so);
   }
   return out;

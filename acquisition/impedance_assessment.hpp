@@ -22,6 +22,7 @@
 #include "dsp/kramers_kronig.hpp"
 #include "dsp/prony_impedance.hpp"
 #include "dsp/stabilization.hpp"
+#include "dsp/stepped_sine.hpp"
 #include "dsp/uncertainty.hpp"
 #include "dsp/validity.hpp"
 
@@ -60,7 +61,7 @@ struct EstimateDefaults {
 EstimateDefaults default_estimate(const Shot& first);
 
 struct AssessmentOptions {
-  std::string method = "prony";     // prony | fft | xspec
+  std::string method = "prony";     // a transient estimator's key (acquisition/estimators/): prony | fft | xspec
   std::optional<std::size_t> shot;  // one shot (capture index); empty: every transient dut shot
                                     // of the first one's drive, averaged (xspec: as segments)
   double fmin_hz = 0.0, fmax_hz = 0.0,
@@ -69,6 +70,7 @@ struct AssessmentOptions {
   dsp::PronyImpedanceOptions prony = bench_prony_options();
   dsp::FftRatioOptions fft;        // fmin/fmax filled from the band
   dsp::CrossSpectraOptions xspec;  // fmin/fmax filled from the band
+  dsp::SteppedSineOptions sine;    // features' fmin/fmax filled from the band (jobs/impedance_job.cpp)
 
   // A real bench's slow disturbances (issue 33): each shot's channel-1-minus-
   // channel-2 baseline (slow wander, mains hum) tested (dsp/divider_baseline.hpp)
@@ -123,7 +125,8 @@ struct ImpedanceAssessment {
 
 // Throws std::invalid_argument (naming the shot, the option or the problem)
 // for a capture without usable dut shots, a bad method or band, unusable
-// calibration shots.
+// calibration shots. The estimate is the estimator registry's entry of
+// `method` (acquisition/estimators/estimator.hpp), one that takes transient shots.
 ImpedanceAssessment assess_impedance(const Capture& cap, const AssessmentOptions& opt);
 
 }  // namespace piezo::acq

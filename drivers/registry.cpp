@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <stdexcept>
 
+#include "drivers/comedi/address.hpp"
 #include "drivers/comedi/driver.hpp"
 #include "drivers/infiniium/driver.hpp"
 #include "drivers/keysight33500/driver.hpp"
@@ -64,21 +65,36 @@ std::unique_ptr<Daq> DriverRegistry::open_board_daq(const std::string& address) 
   return nullptr;
 }
 
-void DriverRegistry::set_simulated_twin(const std::string& key, std::string how) {
+DriverRegistry::Extra& DriverRegistry::extra(const std::string& key) {
   if (!has_key(key)) throw std::invalid_argument("DriverRegistry: no driver '" + key + "'");
-  for (auto& t : twins_)
-    if (t.first == key) {
-      t.second = std::move(how);
-      return;
-    }
-  twins_.emplace_back(key, std::move(how));
+  for (auto& x : extras_)
+    if (x.key == key) return x;
+  extras_.push_back({key, {}, {}, {}});
+  return extras_.back();
+}
+
+void DriverRegistry::set_simulated_twin(const std::string& key, std::string how) {
+  extra(key).twin = std::move(how);
 }
 
 std::string DriverRegistry::simulated_twin(const std::string& key) const {
-  for (const auto& t : twins_)
-    if (t.first == key) return t.second;
+  for (const auto& x : extras_)
+    if (x.key == key) return x.twin;
   return {};
 }
+
+void DriverRegistry::set_use_addresses(const std::string& key, std::string awg, std::string daq) {
+  auto& x = extra(key);
+  x.awg_address = std::move(awg);
+  x.daq_address = std::move(daq);
+}
+
+std::pair<std::string, std::string> DriverRegistry::use_addresses(const std::string& key) const {
+  for (const auto& x : extras_)
+    if (x.key == key) return {x.awg_address, x.daq_address};
+  return {};
+}
+
 void DriverRegistry::add_dual(DualRoleEntry e) {
   for (const auto& a : boards_)
     if (a.key == e.key)
@@ -180,19 +196,65 @@ void register_builtin_drivers(DriverRegistry& r) {
   r.set_simulated_twin(
       "comedi",
       "measure --instrument sim --adc-bits 12 --daq 'comedi-sim:///dev/comedi0' (a PCI-6110 twin)");
+  // What the GUI's "Use" fills in: the embedded bench's AWG dialects and its
+  // Infiniium run in process ("sim"); a board DAQ its default address.
+  r.set_use_addresses("keysight33500", "sim", "");
+  r.set_use_addresses("tektronix_awg", "sim?awg=tektronix", "");
+  r.set_use_addresses("infiniium", "sim", "");
+  r.set_use_addresses("comedi", "", comedi::Address{}.to_string());
 }
 
 std::vector<DriverFamily> list_families(const DriverRegistry& r) {
   std::vector<DriverFamily> out;
-  for (const auto& e : r.awgs())
-    out.push_back({e.key, e.description, {"awg"}, "*IDN?", "", r.simulated_twin(e.key)});
-  for (const auto& e : r.daqs())
-    out.push_back({e.key, e.description, {"daq"}, "*IDN?", "", r.simulated_twin(e.key)});
-  for (const auto& e : r.duals())
-    out.push_back({e.key, e.description, {"awg", "daq"}, "*IDN?", "", r.simulated_twin(e.key)});
-  for (const auto& e : r.board_daqs())
-    out.push_back(
-        {e.key, e.description, {"daq"}, "address", e.address_form, r.simulated_twin(e.key)});
+  auto family = [&](const std::string& key, const std::string& description, std::vector<std::string> roles,
+                    std::string chosen_by, std::string address_form) {
+    auto [awg, daq] = r.use_addresses(key);
+    out.push_back({key, description, std::move(roles), std::move(chosen_by), std::move(address_form),
+                   r.simulated_twin(key), std::move(awg), std::move(daq)});
+  };
+  for (const auto& e : r.awgs()) family(e.key, e.description, {"awg"}, "*IDN?", "");
+  for (const auto& e : r.daqs()) family(e.key, e.description, {"daq"}, "*IDN?", "");
+  for (const auto& e : r.duals()) family(e.key, e.description, {"awg", "daq"}, "*IDN?", "");
+  for (const auto& e : r.board_daqs()) family(e.key, e.description, {"daq"}, "address", e.address_form);
+  return out;
+}
+
+std::string family_table_markdown(const DriverRegistry& r) {
+  auto cell = [](std::string& out, const std::string& text) {  // a '|' would end the table's cell
+    for (char c : text) {
+      if (c == '|') out += '\\';
+      out += c;
+    }
+  };
+  std::string out = "| key | roles | chosen by | what it is | simulated twin |\n| --- | --- | --- | --- | --- |\n";
+  for (const auto& f : list_families(r)) {
+    out += "| `";
+    out += f.key;
+    out += "` | ";
+    for (std::size_t k = 0; k < f.roles.size(); ++k) {
+      if (k) out += '+';
+      out += f.roles[k];
+    }
+    out += " | ";
+    if (f.chosen_by == "address") {
+      out += "its address `";
+      cell(out, f.address_form);
+      out += '`';
+    } else {
+      out += "`*IDN?`";
+    }
+    out += " | ";
+    cell(out, f.description);
+    out += " | ";
+    if (f.simulated_twin.empty()) {
+      out += '-';
+    } else {
+      out += '`';
+      cell(out, f.simulated_twin);
+      out += '`';
+    }
+    out += " |\n";
+  }
   return out;
 }
 

@@ -8,6 +8,7 @@
 // one connection, both roles.
 #include <functional>
 #include <memory>
+#include <utility>
 #include <string>
 #include <vector>
 
@@ -62,6 +63,11 @@ class DriverRegistry {
   // Throws std::invalid_argument for a key no entry has.
   void set_simulated_twin(const std::string& key, std::string how);
   std::string simulated_twin(const std::string& key) const;
+  // What a front end fills in to use a family (the GUI's "Use"): the AWG and
+  // the DAQ address ("" leaves that field as it is) — an in-process twin's
+  // address, or a board's default one. Throws std::invalid_argument for a key no entry has.
+  void set_use_addresses(const std::string& key, std::string awg, std::string daq);
+  std::pair<std::string, std::string> use_addresses(const std::string& key) const;
   const std::vector<DriverEntry<Awg>>& awgs() const { return awgs_; }
   const std::vector<DriverEntry<Daq>>& daqs() const { return daqs_; }
   const std::vector<DualRoleEntry>& duals() const { return duals_; }
@@ -84,7 +90,11 @@ class DriverRegistry {
   std::vector<DriverEntry<Daq>> daqs_;
   std::vector<DualRoleEntry> duals_;
   std::vector<BoardDaqEntry> boards_;
-  std::vector<std::pair<std::string, std::string>> twins_;  // key, how
+  struct Extra {
+    std::string key, twin, awg_address, daq_address;
+  };
+  std::vector<Extra> extras_;  // per key: the twin, the addresses to use it
+  Extra& extra(const std::string& key);
   bool has_key(const std::string& key) const;
 };
 
@@ -98,9 +108,14 @@ struct DriverFamily {
   std::string chosen_by;           // "*IDN?" (any SCPI address) or "address"
   std::string address_form;        // for chosen_by == "address"
   std::string simulated_twin;      // how to run it against its twin ("" if none)
+  std::string awg_address, daq_address;  // what a front end fills in to use it ("": unchanged)
 };
 // In registration order: AWGs, DAQs, dual-role instruments, board DAQs.
 std::vector<DriverFamily> list_families(const DriverRegistry& r);
+
+// The docs' table of the families (drivers/README.md, "The registered
+// families"; tests/drivers/test_driver_registry.cpp compares the two).
+std::string family_table_markdown(const DriverRegistry& r);
 
 // The registry filled by register_builtin_drivers() (built once, never changed).
 const DriverRegistry& builtin_drivers();

@@ -4,11 +4,21 @@
 #include <filesystem>
 
 #include "acquisition/calibration_plan.hpp"
-#include "drivers/sim/disturbances.hpp"
-#include "model/effects.hpp"
 #include "model/seed_circuit.hpp"
 
 namespace piezo::jobs {
+
+SimBenchRequest demo_sim_request(const DemoRequest& d) {
+  SimBenchRequest r;
+  r.material = "apc850";
+  r.isotropic = true;
+  r.set = "YE11=6.66e10,nu12=0.3333,d31=-210e-12,epsT33_rel=2294";
+  r.noise = d.noise;
+  r.seed = d.seed;
+  r.effects = d.effects;
+  r.disturbance = d.disturbances;  // also the held-out's bench
+  return r;
+}
 
 PipelineRequest demo_bench_request(const DemoRequest& d) {
   const DemoRequest* a = &d;
@@ -21,14 +31,7 @@ PipelineRequest demo_bench_request(const DemoRequest& d) {
   req.plan.pretrigger_samples = 200;
   req.plan.shots = a->shots;
   // The simulated "real" tube: the seed's Table 4/5 target material in the isotropic class.
-  req.sim.material = "apc850";
-  req.sim.isotropic = true;
-  req.sim.set = "YE11=6.66e10,nu12=0.3333,d31=-210e-12,epsT33_rel=2294";
-  req.sim.noise_rel = a->noise;
-  req.sim.seed = a->seed;
-  for (const auto& e : a->effects) model::apply_effect_assignment(req.sim.effects, e);
-  req.sim.disturbances =
-      drivers::sim::parse_disturbances(a->disturbances);  // also the held-out's bench
+  req.sim = sim_spec(demo_sim_request(d));
   req.diagnose = !a->no_diagnose;
   if (!a->no_calibrate && !a->calibrate.empty())
     req.calibration = acq::parse_calibration_list(a->calibrate, 1000.0);

@@ -11,6 +11,7 @@
 #include <string>
 #include <vector>
 
+#include "jobs/measure/sim_bench.hpp"
 #include "jobs/pipeline/pipeline.hpp"
 
 namespace piezo::jobs {
@@ -28,6 +29,11 @@ struct DemoRequest {
   bool no_calibrate = false;
   int shots = 16;
 };
+
+// The demo's simulated tube (the seed's Table 4/5 target material in the
+// isotropic class) with the request's noise, seed, effects and disturbances:
+// the simulated bench's request (jobs/measure/sim_bench.hpp) the GUI starts from.
+SimBenchRequest demo_sim_request(const DemoRequest& req);
 
 // The demo's bench and plan without its files: the simulated tube, the
 // record, the fixture standards, the held-out chirp, the nominal material.

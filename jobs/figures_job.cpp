@@ -119,6 +119,10 @@ void figures_from_output_error(const FiguresRequest& req, const acq::Capture& ca
 
 }  // namespace
 
+std::vector<std::string> figures_estimators() {
+  return acq::builtin_estimators().keys([](const acq::EstimatorEntry& e) { return e.caps.transient_shots; });
+}
+
 FiguresJobResult run_figures(const FiguresRequest& req) {
   if (req.max_modes < 1) throw InputError("--modes must be >= 1");
   if (req.band_lo_hz < 0 || (req.band_hi_hz > 0 && !(req.band_hi_hz > req.band_lo_hz)))
@@ -135,6 +139,11 @@ FiguresJobResult run_figures(const FiguresRequest& req) {
   if (capture && !req.columns.empty())
     throw InputError("--columns names a table's columns: " + req.file + " is a capture (.h5)");
   const bool oe = capture && (req.method.empty() || req.method == "oe");
+  if (capture && !oe) {
+    const auto keys = figures_estimators();
+    if (std::find(keys.begin(), keys.end(), req.method) == keys.end())
+      throw InputError("--method " + req.method + ": expected oe, " + acq::join_keys(keys));
+  }
   if (capture) {
     ImpedanceRequest ir;
     ir.file = req.file;

@@ -18,10 +18,15 @@
 #include <string>
 #include <vector>
 
+#include "acquisition/estimators/estimator.hpp"
 #include "dsp/equivalent_circuit.hpp"
 
 
 namespace piezo::jobs {
+
+// The impedance estimators `--method` takes for a capture besides oe: those of
+// the registry that take a transient (acq::builtin_estimators()), in its order.
+std::vector<std::string> figures_estimators();
 
 struct FiguresRequest {
   std::string file;

@@ -11,14 +11,11 @@
 #include "acquisition/capture_file.hpp"
 #include "acquisition/contained_read.hpp"
 #include "acquisition/divider_record.hpp"
-#include "dsp/cross_spectra.hpp"
 #include "dsp/deskew.hpp"
-#include "dsp/fft_ratio.hpp"
 #include "dsp/impedance_io.hpp"
 #include "dsp/mode_figures.hpp"
 #include "dsp/prony_impedance.hpp"
 #include "dsp/rayleigh.hpp"
-#include "dsp/stepped_sine.hpp"
 #include "dsp/windows.hpp"
 #include "jobs/job_error.hpp"
 #include "jobs/json/assessment_json.hpp"
@@ -181,18 +178,21 @@ ImpedanceJobResult run_impedance(const ImpedanceRequest& a) {
   std::optional<acq::CaptureCalibration>& sine_cal = out.sine_cal;
   double& band_hz = out.band_hz;
   band_hz = a.fmax;
-  if (a.method == "sine") {
-    std::vector<dsp::SineShot> shots;
+  const acq::EstimatorEntry* estimator = acq::builtin_estimators().find(a.method);
+  if (!estimator)
+    throw InputError("--method: unknown estimator '" + a.method + "' (expected " +
+                     acq::join_keys(acq::builtin_estimators().keys()) + ")");
+  if (estimator->caps.sine_shots) {
+    std::vector<dsp::DividerRecord> records;
+    std::vector<double> freqs;
     for (const auto* s : dut_shots(cap, true)) {
       if (!s->frequency_hz) throw InputError("sine shot " + s->name + " has no frequency_hz");
-      shots.push_back({acq::divider_record(cap, *s), *s->frequency_hz});
+      records.push_back(acq::divider_record(cap, *s));
+      freqs.push_back(*s->frequency_hz);
       names.push_back(s->name);
     }
-    if (shots.empty()) throw InputError("the capture holds no \"dut\" sine shot");
-    dsp::SteppedSineOptions o;
-    o.features.fmin_hz = a.fmin;
-    if (a.fmax > 0) o.features.fmax_hz = a.fmax;
-    r = dsp::impedance_stepped_sine(shots, o);
+    if (records.empty()) throw InputError("the capture holds no \"dut\" sine shot");
+    r = estimator->estimate(acq::EstimateInput{records, freqs, {a.fmin, a.fmax, 0.0}, trust, std::nullopt, std::nullopt});
     // Standards measured with a transient drive apply to a stepped-sine estimate
     // too (steady state: the skew is exactly the phase ramp e^{jωτ}).
     bool transient_standards = false;
@@ -213,7 +213,7 @@ ImpedanceJobResult run_impedance(const ImpedanceRequest& a) {
     if (sine_cal) sine_cal->compensate(r);
     if (r.z_sigma_ohm.size() == r.f_hz.size() && trust.uncertainty != acq::UncertaintySource::None)
       band = dsp::band_from_sigma(r.f_hz, r.z_ohm, r.z_sigma_ohm, trust.coverage_factor,
-                                  sine_cal ? "lock-in fit covariance + fixture standards" : "lock-in fit covariance");
+                                  sine_cal ? estimator->sigma_source + " + fixture standards" : estimator->sigma_source);
   } else {
     const acq::Shot& shot = pick_shot(cap, a);
     const double fs = shot.sample_rate_hz;
@@ -238,7 +238,7 @@ ImpedanceJobResult run_impedance(const ImpedanceRequest& a) {
     trust.xspec.window = {*win, 0.5};
     trust.xspec.prep.max_samples = a.samples.value_or(0);
     // prony and fft: one shot unless --average; xspec: every shot of the drive as a segment
-    if (a.method != "xspec" && (!a.average || a.one_shot || a.shot)) trust.shot = static_cast<std::size_t>(&shot - cap.shots.data());
+    if (!estimator->caps.segments && (!a.average || a.one_shot || a.shot)) trust.shot = static_cast<std::size_t>(&shot - cap.shots.data());
     assessed = acq::assess_impedance(cap, trust);
     r = assessed->result;
     names = assessed->shots;

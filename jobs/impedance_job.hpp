@@ -6,6 +6,9 @@
 // stabilization chart; stepped sine compensated here), its JSON (features,
 // Prony order and singular values, trust, per-mode figures), CSV and
 // Touchstone forms. ui/cli/cmd_impedance.cpp parses the options and prints.
+// The estimators and their keys: acq::builtin_estimators()
+// (acquisition/estimators/estimator.hpp), which the front ends read for their
+// choices and help.
 #include <cstddef>
 #include <iosfwd>
 #include <nlohmann/json.hpp>
@@ -14,6 +17,7 @@
 #include <vector>
 
 #include "acquisition/capture.hpp"
+#include "acquisition/estimators/estimator.hpp"
 #include "acquisition/impedance_assessment.hpp"
 #include "dsp/drive_band.hpp"
 #include "dsp/impedance_types.hpp"
@@ -21,7 +25,7 @@
 namespace piezo::jobs {
 
 struct ImpedanceRequest {
-  std::string file, method = "prony", window = "rect";
+  std::string file, method = "prony", window = "rect";  // method: an estimator's key
   std::optional<std::size_t> shot, samples, order, segment;
   // 0 / unset: the one estimate's (acq::default_estimate: the pipeline's band,
   // grid and Prony record length).

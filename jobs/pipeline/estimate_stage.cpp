@@ -6,6 +6,7 @@
 #include <cstdio>
 
 #include "acquisition/divider_record.hpp"
+#include "acquisition/estimators/estimator.hpp"
 #include "acquisition/impedance_assessment.hpp"
 #include "dsp/divider_baseline.hpp"
 #include "dsp/cross_spectra.hpp"
@@ -19,9 +20,11 @@ namespace piezo::jobs::detail {
 
 namespace {
 
-Curve curve_of(const std::string& label, const dsp::ImpedanceResult& r) {
+// "measured (LABEL)", LABEL the estimator's in the registry (acquisition/estimators/).
+Curve curve_of(const std::string& estimator, const dsp::ImpedanceResult& r) {
   Curve c;
-  c.label = label;
+  c.label = "measured (" + acq::builtin_estimators().at(estimator).label + ")";
+  c.estimator = estimator;
   c.f_hz.assign(r.f_hz.data(), r.f_hz.data() + r.f_hz.size());
   c.z_ohm.assign(r.z_ohm.data(), r.z_ohm.data() + r.z_ohm.size());
   return c;
@@ -180,7 +183,7 @@ dsp::ImpedanceResult estimate(const acq::Capture& cap, bool refine_features, Pip
       out.warnings.push_back("the measured fixture capacitance exceeds the measured capacitance: not corrected");
     }
   }
-  out.curves.push_back(curve_of("measured (Prony-SS)", prony));
+  out.curves.push_back(curve_of("prony", prony));
   for (const auto& f : prony.features.resonances) out.resonances_hz.push_back(f.f_hz);
   for (const auto& f : prony.features.antiresonances) out.antiresonances_hz.push_back(f.f_hz);
   if (prony.prony) {
@@ -191,14 +194,14 @@ dsp::ImpedanceResult estimate(const acq::Capture& cap, bool refine_features, Pip
     dsp::FftRatioOptions fo;
     fo.fmin_hz = step;
     fo.fmax_hz = fmax;
-    out.curves.push_back(curve_of("measured (FFT)", dsp::impedance_fft(acq::divider_record(cap, first), fo)));
+    out.curves.push_back(curve_of("fft", dsp::impedance_fft(acq::divider_record(cap, first), fo)));
     std::vector<dsp::DividerRecord> recs;
     for (const auto* s : shots)
       if (s->excitation == first.excitation) recs.push_back(acq::divider_record(cap, *s));
     dsp::CrossSpectraOptions xo;
     xo.fmin_hz = step;
     xo.fmax_hz = fmax;
-    out.curves.push_back(curve_of("measured (cross-spectra)", dsp::impedance_xspec(recs, xo)));
+    out.curves.push_back(curve_of("xspec", dsp::impedance_xspec(recs, xo)));
   } catch (const std::exception& e) {
     out.warnings.push_back(std::string("overlay estimators: ") + e.what());
   }

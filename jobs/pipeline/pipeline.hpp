@@ -83,6 +83,9 @@ struct Curve {
   std::string label;
   std::vector<double> f_hz;
   std::vector<std::complex<double>> z_ohm;
+  // A measured curve's estimator: its key in acq::builtin_estimators()
+  // (acquisition/estimators/), which front ends style it by; "" for a model's.
+  std::string estimator = {};
 };
 
 struct ParamRow {

@@ -5,17 +5,8 @@
 #include <fstream>
 #include <map>
 #include <set>
+#include <cstdio>
 #include <stdexcept>
-
-#include <fcntl.h>
-#include <poll.h>
-#include <sys/prctl.h>
-#include <signal.h>
-#include <sys/wait.h>
-#include <unistd.h>
-
-#include <cerrno>
-#include <cstring>
 
 #include "acquisition/capture_file.hpp"
 #include "acquisition/contained_read.hpp"
@@ -24,6 +15,7 @@
 #include "jobs/replay/record_wire.hpp"
 #include "jobs/replay/replay_record.hpp"
 #include "jobs/replay/sha256.hpp"
+#include "jobs/replay/worker_pool.hpp"
 #include "jobs/report/batch_summary.hpp"
 #include "jobs/report/capture_report.hpp"
 #include "jobs/report/index_html.hpp"
@@ -310,247 +302,52 @@ Outcome replay_capture(const fs::path& file, const ReplayOptions& opt, const Sin
   return out;
 }
 
-// ---------------------------------------------------------- worker processes
-// Each worker is a forked copy of this process that replays the captures the
-// batch sends it (their index in `files`, 8 bytes on its task pipe) and answers
-// with frames (record_wire.hpp) on its result pipe. The batch itself stays one
-// thread and is the only writer of the results file. A worker that dies (a
-// crash inside a library, e.g. libhdf5 on a damaged file) or overruns the
-// capture timeout costs that capture only: it is recorded as failed and a new
-// worker takes the next one.
-struct WorkerProc {
-  pid_t pid = -1;
-  int task_fd = -1, result_fd = -1;
-  std::string buf;
-  std::optional<std::size_t> task;
-  Clock::time_point started;
-  std::string stage, sha;
-};
-
-void write_all(int fd, const void* data, std::size_t n) {
-  const char* p = static_cast<const char*>(data);
-  while (n) {
-    const ssize_t w = ::write(fd, p, n);
-    if (w < 0 && errno == EINTR) continue;
-    if (w <= 0) throw std::runtime_error(std::string("pipe write: ") + std::strerror(errno));
-    p += w;
-    n -= static_cast<std::size_t>(w);
-  }
-}
-
-bool read_exact(int fd, void* data, std::size_t n) {
-  char* p = static_cast<char*>(data);
-  while (n) {
-    const ssize_t r = ::read(fd, p, n);
-    if (r < 0 && errno == EINTR) continue;
-    if (r <= 0) return false;
-    p += r;
-    n -= static_cast<std::size_t>(r);
-  }
-  return true;
-}
-
-// Closes every descriptor above stdio except a and b (in a forked worker).
-void keep_only_fds(int a, int b) {
-  const int lo = std::min(a, b), hi = std::max(a, b);
-  if (lo > 3) ::close_range(3, static_cast<unsigned>(lo - 1), 0);
-  if (hi - lo > 1) ::close_range(static_cast<unsigned>(lo + 1), static_cast<unsigned>(hi - 1), 0);
-  ::close_range(static_cast<unsigned>(hi + 1), ~0U, 0);
-}
-
-class WorkerPool {
+// The batch's side of the worker processes (worker_pool.hpp): a worker replays
+// files[i] and sends its outcome (record_wire.hpp); the batch puts outcomes in
+// the sink, and records a capture whose worker crashed or hung as failed.
+class ReplayWork {
  public:
-  WorkerPool(const std::vector<fs::path>& files, const ReplayOptions& opt, Sink& sink,
+  ReplayWork(const std::vector<fs::path>& files, const ReplayOptions& opt, Sink& sink,
              const std::atomic<bool>& cancel)
       : files_(files), opt_(opt), sink_(sink), cancel_(cancel) {}
-  ~WorkerPool() {
-    for (auto& w : workers_) stop(w, /*kill_it=*/true);
-  }
 
   void run() {
-    const std::size_t n = std::min(opt_.jobs, std::max<std::size_t>(1, files_.size()));
-    workers_.resize(n);
-    for (auto& w : workers_) spawn(w);
-    std::size_t next = 0;
-    for (;;) {
-      if (cancel_) {  // interrupted: what is under way is not recorded (a rerun resumes it)
-        for (auto& w : workers_) stop(w, true);
-        return;
-      }
-      for (auto& w : workers_)
-        if (!w.task && next < files_.size()) {
-          if (w.pid < 0) spawn(w);
-          const std::uint64_t i = next++;
-          w.task = i;
-          w.started = Clock::now();
-          w.stage.clear();
-          w.sha.clear();
-          write_all(w.task_fd, &i, sizeof i);
-        }
-      bool busy = false;
-      for (const auto& w : workers_) busy |= w.task.has_value();
-      if (!busy) break;
-      wait_and_collect();
-    }
-    for (auto& w : workers_) stop(w, false);
+    WorkerPoolCallbacks cb;
+    cb.work = [this](std::size_t i, const auto& stage) {
+      // A damaged file must not take the machine's memory (contained_read.hpp);
+      // twice its size for a held-out partner beside it.
+      std::error_code ec;
+      const auto size = std::filesystem::file_size(files_[i], ec);
+      acq::limit_memory_for_capture(ec ? 0 : 2 * size);
+      return encode_outcome(replay_capture(files_[i], opt_, sink_, cancel_,
+                                           [&](const char* what, const std::string& sha) { stage(what, sha); }));
+    };
+    cb.done = [this](std::size_t, const std::string& payload) { apply(decode_outcome(payload)); };
+    cb.lost = [this](const LostTask& t) { lost(t); };
+    WorkerPool pool({files_.size(), opt_.jobs, opt_.capture_timeout_s}, std::move(cb), cancel_);
+    pool.run();
   }
 
  private:
-  void spawn(WorkerProc& w) {
-    int task[2], result[2];
-    if (::pipe2(task, O_CLOEXEC) != 0) throw std::runtime_error("replay: pipe: " + std::string(std::strerror(errno)));
-    if (::pipe2(result, O_CLOEXEC) != 0) {
-      ::close(task[0]), ::close(task[1]);
-      throw std::runtime_error("replay: pipe: " + std::string(std::strerror(errno)));
+  void lost(const LostTask& t) {
+    const std::string path = files_[t.task].string();
+    if (t.kind == "hung") {
+      char b[200];
+      std::snprintf(b, sizeof b,
+                    "replay did not finish within %.0f s (%s); the worker was killed and the "
+                    "capture left out",
+                    opt_.capture_timeout_s,
+                    t.stage == "reading" ? "the HDF5 library hung reading the file" : "hung");
+      record_lost(t.task, t.detail, "hung", b, t.elapsed_s);
+      return;
     }
-    const pid_t parent = ::getpid();
-    const pid_t pid = ::fork();
-    if (pid < 0) {
-      for (int fd : {task[0], task[1], result[0], result[1]}) ::close(fd);
-      throw std::runtime_error("replay: cannot start a worker process: " + std::string(std::strerror(errno)));
-    }
-    if (pid == 0) {
-      // The worker dies with the batch (a killed batch must not leave workers
-      // behind that hold its results file open and locked).
-      ::prctl(PR_SET_PDEATHSIG, SIGKILL);
-      if (::getppid() != parent) ::_exit(1);
-      // Only its own two pipe ends and stdio stay open: not the results file and
-      // its lock, not the JSON lines, not a sibling's pipe (whose write end kept
-      // here would hide that sibling's death from the batch).
-      keep_only_fds(task[0], result[1]);
-      worker_main(task[0], result[1]);
-    }
-    ::close(task[0]);
-    ::close(result[1]);
-    w.pid = pid;
-    w.task_fd = task[1];
-    w.result_fd = result[0];
-    w.buf.clear();
-    w.task.reset();
-  }
-
-  [[noreturn]] void worker_main(int task_fd, int result_fd) {
-    int code = 0;
-    try {
-      std::uint64_t i;
-      while (read_exact(task_fd, &i, sizeof i)) {
-        if (i >= files_.size()) break;
-        auto stage = [&](const char* what, const std::string& sha) {
-          const std::string f = frame('S', std::string(what) + '\0' + sha);
-          write_all(result_fd, f.data(), f.size());
-        };
-        // A damaged file must not take the machine's memory (contained_read.hpp);
-        // twice its size for a held-out partner beside it.
-        std::error_code ec;
-        const auto size = std::filesystem::file_size(files_[i], ec);
-        acq::limit_memory_for_capture(ec ? 0 : 2 * size);
-        const Outcome o = replay_capture(files_[i], opt_, sink_, cancel_, stage);
-        const std::string f = frame('O', encode_outcome(o));
-        write_all(result_fd, f.data(), f.size());
-      }
-    } catch (...) {
-      code = 1;
-    }
-    ::_exit(code);  // no atexit handlers: the batch's open files are not this process's to flush
-  }
-
-  void stop(WorkerProc& w, bool kill_it) {
-    if (w.pid < 0) return;
-    if (kill_it) ::kill(w.pid, SIGKILL);
-    if (w.task_fd >= 0) ::close(w.task_fd);  // EOF on its task pipe: the worker exits
-    if (w.result_fd >= 0) ::close(w.result_fd);
-    int status;
-    while (::waitpid(w.pid, &status, 0) < 0 && errno == EINTR) {
-    }
-    w.pid = -1;
-    w.task_fd = w.result_fd = -1;
-    w.task.reset();
-  }
-
-  void wait_and_collect() {
-    std::vector<pollfd> fds;
-    std::vector<WorkerProc*> who;
-    double wait_s = 0.2;  // the cancel flag is looked at this often
-    for (auto& w : workers_)
-      if (w.task) {
-        fds.push_back({w.result_fd, POLLIN, 0});
-        who.push_back(&w);
-        wait_s = std::min(wait_s, std::max(0.0, opt_.capture_timeout_s - seconds_since(w.started)));
-      }
-    const int r = ::poll(fds.data(), fds.size(), static_cast<int>(wait_s * 1000.0) + 1);
-    if (r < 0 && errno != EINTR) throw std::runtime_error(std::string("replay: poll: ") + std::strerror(errno));
-    for (std::size_t k = 0; r > 0 && k < fds.size(); ++k) {
-      if (!fds[k].revents) continue;
-      WorkerProc& w = *who[k];
-      char b[65536];
-      const ssize_t n = ::read(w.result_fd, b, sizeof b);
-      if (n < 0 && errno == EINTR) continue;
-      if (n <= 0) {
-        died(w);
-        continue;
-      }
-      w.buf.append(b, static_cast<std::size_t>(n));
-      char kind;
-      std::string payload;
-      try {
-        while (w.task && next_frame(w.buf, kind, payload)) {
-          if (kind == 'S') {
-            const auto z = payload.find('\0');
-            w.stage = payload.substr(0, z);
-            if (z != std::string::npos) w.sha = payload.substr(z + 1);
-          } else if (kind == 'O') {
-            apply(decode_outcome(payload));
-            w.task.reset();
-          }
-        }
-      } catch (const std::runtime_error&) {  // garbled frames: the worker is not trusted further
-        ::kill(w.pid, SIGKILL);
-        died(w);
-      }
-    }
-    for (auto& w : workers_)
-      if (w.task && seconds_since(w.started) > opt_.capture_timeout_s) {
-        ::kill(w.pid, SIGKILL);
-        char b[200];
-        std::snprintf(b, sizeof b,
-                      "replay did not finish within %.0f s (%s); the worker was killed and the "
-                      "capture left out",
-                      opt_.capture_timeout_s,
-                      w.stage == "reading" ? "the HDF5 library hung reading the file" : "hung");
-        kill_and_record(w, "hung", b);
-      }
-  }
-
-  // The worker's pipe closed: it exited or died, maybe in the middle of a capture.
-  void died(WorkerProc& w) {
-    int status = 0;
-    ::close(w.task_fd);
-    ::close(w.result_fd);
-    while (::waitpid(w.pid, &status, 0) < 0 && errno == EINTR) {
-    }
-    w.pid = -1;
-    w.task_fd = w.result_fd = -1;
-    if (!w.task) return;
-    const std::size_t i = *w.task;
-    const std::string path = files_[i].string();
-    std::string how = WIFSIGNALED(status) ? acq::describe_signal(WTERMSIG(status))
-                                          : "exit code " + std::to_string(WEXITSTATUS(status));
     std::string msg =
-        w.stage == "reading"
-            ? "the HDF5 library crashed reading " + path + " (" + how +
+        t.stage == "reading"
+            ? "the HDF5 library crashed reading " + path + " (" + t.how +
                   "): the file is damaged or not a capture; it was left out"
-            : "the replay worker died (" + how + ") while processing " + path +
-                  (w.stage.empty() ? "" : " (stage: " + w.stage + ")") + "; the capture was left out";
-    record_lost(i, w.sha, "crashed", msg, seconds_since(w.started));
-    w.task.reset();
-  }
-
-  void kill_and_record(WorkerProc& w, const std::string& kind, const std::string& msg) {
-    const std::size_t i = *w.task;
-    const std::string sha = w.sha;
-    const double t = seconds_since(w.started);
-    stop(w, true);
-    record_lost(i, sha, kind, msg, t);
+            : "the replay worker died (" + t.how + ") while processing " + path +
+                  (t.stage.empty() ? "" : " (stage: " + t.stage + ")") + "; the capture was left out";
+    record_lost(t.task, t.detail, "crashed", msg, t.elapsed_s);
   }
 
   void record_lost(std::size_t i, std::string sha, const std::string& kind,
@@ -592,7 +389,6 @@ class WorkerPool {
   const ReplayOptions& opt_;
   Sink& sink_;
   const std::atomic<bool>& cancel_;
-  std::vector<WorkerProc> workers_;
 };
 
 }  // namespace
@@ -624,8 +420,7 @@ ReplaySummary run_replay(const ReplayOptions& opt, const ReplayCallbacks& cb,
 
   std::exception_ptr fatal;
   try {
-    WorkerPool pool(mine, opt, sink, cancel);
-    pool.run();
+    ReplayWork(mine, opt, sink, cancel).run();
   } catch (...) {  // the results file could not be written, or no worker could be started
     fatal = std::current_exception();
   }

@@ -18,7 +18,7 @@ const std::vector<std::string_view>& internal_function_names() {
       "frequency_grid", "gauss_legendre", "impedance_fft", "impedance_from_charge", "impedance_prony",
       "impedance_shot_ensemble", "impedance_stepped_sine", "impedance_xspec", "kramers_kronig_check",
       "largest_drop_order", "levenberg_marquardt", "lock_in", "lossy_capacitance", "make_grid",
-      "make_sim_bench", "make_window", "mode_figures", "mode_shape_cmcm", "mode_shape_unknown_name",
+      "make_sim_bench", "make_window", "mean_record", "mode_figures", "mode_shape_cmcm", "mode_shape_unknown_name",
       "open_bench", "open_transport", "open_usbtmc", "parasitic_branch", "parse_disturbances",
       "parse_ohm_at_hz", "phase_slope_delay", "predict_output_error", "prepare_divider", "probe_capture",
       "prony_ss", "rayleigh_fit", "rayleigh_from_damping", "rayleigh_from_two_modes", "read_impedance_file",

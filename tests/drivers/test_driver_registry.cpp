@@ -13,6 +13,7 @@
 #include "drivers/sim/sim_redpitaya.hpp"
 #include "drivers/sim/sim_tektronix_awg.hpp"
 #include "drivers/tektronix_awg/driver.hpp"
+#include "tests/support/doc_table.hpp"
 #include "tests/support/rc_physics.hpp"
 
 using namespace piezo;
@@ -169,3 +170,29 @@ TEST(DriverRegistry, BoardDaqsAreChosenByAddressAndListed) {
 }
 
 }  // namespace
+
+// drivers/README.md's table of the families is the registry's.
+TEST(DriverRegistry, ReadmeTableIsTheRegistrys) {
+  const std::string table = family_table_markdown(builtin_drivers());
+  EXPECT_EQ(test::doc_table("drivers/README.md", table.substr(0, table.find('\n'))), table)
+      << "update drivers/README.md's table of the families to:\n" << table;
+}
+
+// What the GUI's "Use" fills in comes from the registry: an in-process twin
+// for the *IDN? families that have one, a default address for a board DAQ.
+TEST(DriverRegistry, UseAddressesAreData) {
+  DriverRegistry x;
+  register_builtin_drivers(x);
+  EXPECT_THROW(x.set_use_addresses("no_such_driver", "a", "b"), std::invalid_argument);
+  for (const auto& f : list_families(x)) {
+    if (f.key == "tektronix_awg") {
+      EXPECT_EQ(f.awg_address, "sim?awg=tektronix");
+    }
+    if (f.key == "keysight33500" || f.key == "infiniium") {
+      EXPECT_EQ(f.awg_address, "sim");
+    }
+    if (f.chosen_by == "address") {
+      EXPECT_FALSE(f.daq_address.empty()) << f.key;
+    }
+  }
+}

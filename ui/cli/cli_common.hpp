@@ -1,6 +1,7 @@
 #pragma once
 // Shared conventions of the `piezobench` commands: exit codes, --json output,
-// error reporting. Every command registers itself through a register_* function.
+// error reporting. Every command registers itself through a register_* function,
+// listed in the command registry (ui/cli/commands.hpp).
 // The CLI's room (ui/cli): commands parse options, call a job (jobs/) and print.
 #include <CLI/CLI.hpp>
 #include <cstddef>
@@ -64,16 +65,20 @@ class ProgressBar {
 // at least 1, at most 256).
 std::size_t default_jobs();
 
-void register_capture_commands(CLI::App& app, Context& ctx);
+// The commands' register functions: each adds its one top-level command to
+// `app`; ui/cli/commands.cpp lists them (the command registry).
+void register_capture_command(CLI::App& app, Context& ctx);
 void register_demo_command(CLI::App& app, Context& ctx);
-void register_measure_commands(CLI::App& app, Context& ctx);
+void register_measure_command(CLI::App& app, Context& ctx);
+void register_sim_instrument_command(CLI::App& app, Context& ctx);
 void register_instruments_command(CLI::App& app, Context& ctx);
-void register_model_commands(CLI::App& app, Context& ctx);
+void register_model_command(CLI::App& app, Context& ctx);
 // `model mode-shape-cmcm` (cmd_model_mode_shape.cpp), under the `model` command.
 void register_mode_shape_command(CLI::App* model, Context& ctx);
 void register_impedance_command(CLI::App& app, Context& ctx);
 void register_update_command(CLI::App& app, Context& ctx);
-void register_replay_commands(CLI::App& app, Context& ctx);
+void register_replay_command(CLI::App& app, Context& ctx);
+void register_replay_merge_command(CLI::App& app, Context& ctx);
 void register_diagnose_command(CLI::App& app, Context& ctx);
 void register_figures_command(CLI::App& app, Context& ctx);
 

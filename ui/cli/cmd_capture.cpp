@@ -47,7 +47,7 @@ void print_text(const nlohmann::json& j) {
 
 }  // namespace
 
-void register_capture_commands(CLI::App& app, Context& ctx) {
+void register_capture_command(CLI::App& app, Context& ctx) {
   auto* capture = app.add_subcommand("capture", "Inspect piezo-capture/1 files");
   capture->require_subcommand(1);
   auto* info = capture->add_subcommand("info", "Set-up and per-shot summary of a capture");

@@ -111,10 +111,15 @@ void register_figures_command(CLI::App& app, Context& ctx) {
   cmd->add_option("--plot", a->plot, "PNG of the data and the fitted network");
   cmd->add_option("--modes", a->req.max_modes, "Modes (branches) at most")->capture_default_str();
   cmd->add_option("--band", a->band, "Frequency band LO:HI in Hz (default: the data's; a capture: its estimate's)");
+  // oe, then the impedance estimators that take a transient (acquisition/estimators/).
+  auto methods = jobs::figures_estimators();
   cmd->add_option("--method", a->req.method,
                   "A capture's estimator: oe (default: the output-error fit's updated FE model, its modes' "
-                  "figures), or fft, xspec, prony (the circuit fitted to that impedance estimate)")
-      ->check(CLI::IsMember({"oe", "fft", "xspec", "prony"}));
+                  "figures), or " + acq::join_keys(methods) + " (the circuit fitted to that impedance estimate)")
+      ->check(CLI::IsMember([&] {
+        methods.insert(methods.begin(), "oe");
+        return methods;
+      }()));
   cmd->add_option("--material", a->req.material, "oe: the nominal material (default: the capture's own)");
   cmd->add_option("--columns", a->req.columns,
                   "A table's columns in order, as quantity[unit], e.g. f[kHz],G[uS],B[uS] or "

@@ -128,14 +128,27 @@ void run(const ImpedanceArgs& a, Context& ctx) {
   }
 }
 
+// The estimators' labels, and --method's help: their keys, then one line each
+// (acq::builtin_estimators(), acquisition/estimators/estimator.hpp).
+std::string estimator_labels() {
+  std::string out;
+  for (const auto& e : acq::builtin_estimators().entries()) out += (out.empty() ? "" : ", ") + e.label;
+  return out;
+}
+
+std::string method_help() {
+  std::string out = acq::join_keys(acq::builtin_estimators().keys(), " | ", " | ");
+  for (const auto& e : acq::builtin_estimators().entries()) out += "\n  " + e.key + ": " + e.description;
+  return out;
+}
+
 }  // namespace
 
 void register_impedance_command(CLI::App& app, Context& ctx) {
   auto a = std::make_shared<ImpedanceArgs>();
-  auto* cmd = app.add_subcommand("impedance", "Impedance of a capture's dut shots (Prony-SS, FFT, cross spectra, stepped sine)");
+  auto* cmd = app.add_subcommand("impedance", "Impedance of a capture's dut shots (" + estimator_labels() + ")");
   cmd->add_option("CAPTURE", a->req.file, "Capture file (.h5)")->required();
-  cmd->add_option("--method", a->req.method, "prony | fft | xspec | sine")
-      ->check(CLI::IsMember({"prony", "fft", "xspec", "sine"}));
+  cmd->add_option("--method", a->req.method, method_help())->check(CLI::IsMember(acq::builtin_estimators().keys()));
   cmd->add_option("--shot", a->req.shot, "One shot by index (prony, fft); default: every dut shot of the drive, averaged");
   cmd->add_option("--samples", a->req.samples, "Samples after t = 0 (prony: default 6000, as the pipeline; fft/xspec: all)");
   cmd->add_option("--order", a->req.order, "Prony model order (default: automatic)")->check(CLI::PositiveNumber);

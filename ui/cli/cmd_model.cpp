@@ -130,7 +130,7 @@ void run_sensitivity(Context& ctx, const ModelRequest& a, double band_hz) {
 
 }  // namespace
 
-void register_model_commands(CLI::App& app, Context& ctx) {
+void register_model_command(CLI::App& app, Context& ctx) {
   auto* model = app.add_subcommand("model", "FE model of the radially poled tube");
   model->require_subcommand(1);
   add_json_flag(model, ctx);

@@ -88,7 +88,7 @@ std::size_t default_jobs() {
   return std::clamp<std::size_t>(cores, 1, 256);                 // run_replay's range
 }
 
-void register_replay_commands(CLI::App& app, Context& ctx) {
+void register_replay_command(CLI::App& app, Context& ctx) {
   // ------------------------------------------------------------------ replay
   auto* r = app.add_subcommand("replay",
                                "Replay recorded captures headless: impedance, update, diagnosis");
@@ -238,8 +238,9 @@ void register_replay_commands(CLI::App& app, Context& ctx) {
         ctx.exit_code = kBadInput;
     });
   });
+}
 
-  // ------------------------------------------------------------ replay-merge
+void register_replay_merge_command(CLI::App& app, Context& ctx) {
   auto* m = app.add_subcommand("replay-merge", "Merge the results files of sharded replays");
   struct MergeArgs {
     std::vector<std::string> inputs;

@@ -1,9 +1,11 @@
-// piezobench — command-line front end. Each command lives in its own cmd_*.cpp.
+// piezobench — command-line front end. Each command lives in its own cmd_*.cpp
+// and is listed once, in the command registry (commands.cpp).
 // Exit codes: 0 success, 2 bad input, 1 internal failure.
 #include <iostream>
 
 #include "ui/allocator_policy.hpp"
 #include "ui/cli/cli_common.hpp"
+#include "ui/cli/commands.hpp"
 #include "ui/cli/suggest.hpp"
 #include "ui/version.hpp"
 
@@ -16,16 +18,7 @@ int main(int argc, char** argv) {
   app.require_subcommand(1);
   Context ctx;
   app.add_flag("--json", ctx.json, "Machine-readable JSON output on stdout")->trigger_on_parse();
-  register_capture_commands(app, ctx);
-  register_demo_command(app, ctx);
-  register_measure_commands(app, ctx);
-  register_instruments_command(app, ctx);
-  register_model_commands(app, ctx);
-  register_impedance_command(app, ctx);
-  register_update_command(app, ctx);
-  register_replay_commands(app, ctx);
-  register_diagnose_command(app, ctx);
-  register_figures_command(app, ctx);
+  add_commands(app, ctx);
   try {
     app.parse(argc, argv);
   } catch (const CLI::Success& e) {

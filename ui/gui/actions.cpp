@@ -3,11 +3,10 @@
 // once; outcomes come back into the AppState on the UI thread.
 #include <cstdio>
 #include "drivers/instrument_uri.hpp"
-#include "drivers/sim/disturbances.hpp"
 #include "jobs/bench_probe.hpp"
 #include "jobs/export/report_export.hpp"
 #include "jobs/nominal_material.hpp"
-#include "jobs/sim_effects.hpp"
+#include "jobs/measure/sim_bench.hpp"
 #include "ui/gui/app_state.hpp"
 #include "ui/gui/calibration_prompt.hpp"
 
@@ -15,13 +14,12 @@ namespace piezo::gui {
 
 namespace {
 // The simulated bench's spec with the panel's effects and disturbances; throws
-// std::invalid_argument naming a bad item (jobs/sim_effects.hpp).
+// std::invalid_argument naming a bad item (jobs/measure/sim_bench.hpp).
 acq::SimSpec sim_spec(const AppState& s) {
-  acq::SimSpec sim = s.request.sim;
-  sim.effects = jobs::parse_sim_effects(s.instrument.sim_effects);  // "series_resistance=15, channel_skew=1e-7"
-  sim.disturbances =
-      drivers::sim::parse_disturbances(s.instrument.sim_disturbances);  // "offset=0.005,hum=0.005"
-  return sim;
+  jobs::SimBenchRequest r = s.instrument.sim;
+  r.effects = jobs::split_sim_effects(s.instrument.sim_effects);  // "series_resistance=15, channel_skew=1e-7"
+  r.disturbance = s.instrument.sim_disturbances;                  // "offset=0.005,hum=0.005"
+  return jobs::sim_spec(r);
 }
 }  // namespace
 
@@ -86,7 +84,7 @@ bool collect_job(AppState& s) {
   s.nyquist_mode = 0;
   if (s.result && s.result->mode_figures && s.result->mode_figures->error.empty())
     for (const auto& c : s.result->curves)
-      if (c.label == "measured (Prony-SS)")  // the estimate the figures were computed on
+      if (c.estimator == "prony")  // the estimate the figures were computed on
         s.nyquist = jobs::mode_nyquist(c.f_hz, c.z_ohm, s.result->mode_figures->figures);
   auto& in = s.instrument;
   if (s.error) {

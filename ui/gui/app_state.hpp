@@ -16,6 +16,7 @@
 #include "ui/gui/error_advice.hpp"
 #include "ui/gui/plot_widget.hpp"
 #include "ui/gui/task_queue.hpp"
+#include "jobs/measure/sim_bench.hpp"
 #include "jobs/mode_nyquist.hpp"
 #include "jobs/pipeline/pipeline.hpp"
 #include "jobs/report/limits.hpp"
@@ -56,6 +57,9 @@ struct InstrumentForm {
   // A real bench's slow disturbances on the simulated bench, the option string
   // of drivers::sim::parse_disturbances ("offset=0.005,hum=0.005,mains=50").
   char sim_disturbances[256] = "";
+  // The simulated bench the two fields above complete (the demo's tube, set
+  // at start-up from jobs::demo_sim_request; jobs/measure/sim_bench.hpp).
+  jobs::SimBenchRequest sim;
   int driver_choice = 0;  // the driver combo's entry (ui/gui/driver_choices.hpp)
   // (The order is the frame statistics' numbering; tests/gui relies on it.)
   enum class State {

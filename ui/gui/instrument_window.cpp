@@ -7,7 +7,7 @@
 #include <cstdio>
 
 #include "drivers/instrument_uri.hpp"
-#include "model/effects.hpp"
+#include "jobs/measure/sim_bench.hpp"
 #include "ui/gui/driver_choices.hpp"
 
 namespace piezo::gui {
@@ -97,7 +97,7 @@ void render_instrument_window(AppState& s) {
     if (ImGui::IsItemHovered())
       ImGui::SetTooltip("Bench effects the simulated bench adds and the model lacks, NAME=VALUE (SI), "
                         "comma separated:\n%s",
-                        model::effect_names(4).c_str());
+                        jobs::sim_effect_names(4).c_str());
     ImGui::InputTextWithHint("Disturbances", "e.g. offset=0.005,hum=0.005,mains=50",
                              in.sim_disturbances, sizeof in.sim_disturbances);
     if (ImGui::IsItemHovered())

@@ -215,6 +215,7 @@ int main(int argc, char** argv) {
     // target, so that updating has something to do), its held-out chirp; no
     // transducer id of its own. The standards follow the Plan panel's form.
     state.request = piezo::jobs::demo_bench_request(demo);
+    state.instrument.sim = piezo::jobs::demo_sim_request(demo);  // the panel's fields complete it
     state.request.plan.setup.transducer_id.reset();
     state.request.plan.shots = shots;
     if (state.request.heldout_plan) state.request.heldout_plan->shots = shots;

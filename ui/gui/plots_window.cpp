@@ -21,11 +21,12 @@ std::string khz(double f) {
   return b;
 }
 
-ImU32 colour_for(const std::string& label) {
-  if (label.find("original") != std::string::npos) return kColOriginal;
-  if (label.find("updated") != std::string::npos) return kColUpdated;
-  if (label.find("FFT") != std::string::npos) return kColFft;
-  if (label.find("cross") != std::string::npos) return kColXspec;
+// Measured curves by their estimator's key (acquisition/estimators/), models by label.
+ImU32 colour_for(const jobs::Curve& c) {
+  if (c.label.find("original") != std::string::npos) return kColOriginal;
+  if (c.label.find("updated") != std::string::npos) return kColUpdated;
+  if (c.estimator == "fft") return kColFft;
+  if (c.estimator == "xspec") return kColXspec;
   return kColMeasured;
 }
 
@@ -40,10 +41,10 @@ void impedance_specs(const AppState& s, PlotSpec& mag, PlotSpec& ph) {
     if (c.label.find("model") == std::string::npos) order.push_back(&c);
   for (const jobs::Curve* cp : order) {
     const auto& c = *cp;
-    if (c.label.find("FFT") != std::string::npos && !s.show_fft) continue;
-    if (c.label.find("cross") != std::string::npos && !s.show_xspec) continue;
+    if (c.estimator == "fft" && !s.show_fft) continue;
+    if (c.estimator == "xspec" && !s.show_xspec) continue;
     const double width = c.label.find("updated") != std::string::npos ? 6.0 : 2.0;
-    Series m{c.label, c.f_hz, {}, colour_of(colour_for(c.label)), width};
+    Series m{c.label, c.f_hz, {}, colour_of(colour_for(c)), width};
     Series p = m;
     for (const auto& z : c.z_ohm) {
       m.y.push_back(std::abs(z));

@@ -1,0 +1,53 @@
+// The replay's worker pool (jobs/replay/worker_pool.hpp) on its own: every
+// task's outcome comes back once; a worker that crashes or overruns the
+// timeout costs its task only (reported lost with its last stage), and the
+// tasks after it are still done by a new worker.
+#include <gtest/gtest.h>
+
+#include <atomic>
+#include <csignal>
+#include <map>
+#include <thread>
+
+#include "jobs/replay/worker_pool.hpp"
+
+using namespace piezo::jobs::replay;
+
+TEST(WorkerPool, OutcomesComeBackAndACrashOrAHangCostsItsTaskOnly) {
+  std::map<std::size_t, std::string> done;
+  std::map<std::size_t, LostTask> lost;
+  WorkerPoolCallbacks cb;
+  cb.work = [](std::size_t i, const auto& stage) -> std::string {
+    stage("working", "task " + std::to_string(i));
+    if (i == 2) std::raise(SIGKILL);                                        // a crash inside a library
+    if (i == 4) std::this_thread::sleep_for(std::chrono::seconds(30));      // a hang
+    return "outcome " + std::to_string(i * i);
+  };
+  cb.done = [&](std::size_t i, const std::string& o) { EXPECT_TRUE(done.emplace(i, o).second) << i; };
+  cb.lost = [&](const LostTask& t) { EXPECT_TRUE(lost.emplace(t.task, t).second) << t.task; };
+  std::atomic<bool> cancel{false};
+  WorkerPool pool({7, 2, 1.0}, cb, cancel);  // 1 s timeout: the hang is killed
+  pool.run();
+  ASSERT_EQ(done.size(), 5u);
+  for (std::size_t i : {0u, 1u, 3u, 5u, 6u}) EXPECT_EQ(done[i], "outcome " + std::to_string(i * i)) << i;
+  ASSERT_EQ(lost.size(), 2u);
+  EXPECT_EQ(lost[2].kind, "crashed");
+  EXPECT_NE(lost[2].how.find("SIGKILL"), std::string::npos) << lost[2].how;
+  EXPECT_EQ(lost[2].stage, "working");
+  EXPECT_EQ(lost[2].detail, "task 2");
+  EXPECT_EQ(lost[4].kind, "hung");
+  EXPECT_EQ(lost[4].detail, "task 4");
+  EXPECT_GE(lost[4].elapsed_s, 1.0);
+}
+
+TEST(WorkerPool, CancelStopsWithoutReportingWhatIsUnderWay) {
+  std::atomic<bool> cancel{true};
+  int reported = 0;
+  WorkerPoolCallbacks cb;
+  cb.work = [](std::size_t, const auto&) -> std::string { return "x"; };
+  cb.done = [&](std::size_t, const std::string&) { ++reported; };
+  cb.lost = [&](const LostTask&) { ++reported; };
+  WorkerPool pool({3, 2, 60.0}, cb, cancel);
+  pool.run();
+  EXPECT_EQ(reported, 0);
+}
