@@ -22,7 +22,12 @@ SEGMENT = re.compile(r"([A-Za-z0-9_-]*)((?:\[[^\]]*\])*)$")
 
 def resolve(result, path):
     """The value at `path` in `result`, or None (absent, null or NaN)."""
-    node = result
+    return resolve_with_holder(result, path)[1]
+
+
+def resolve_with_holder(result, path):
+    """(the object that holds the value, the value) at `path`; (None, None) if absent."""
+    node, holder = result, None
     segments, depth, cur = [], 0, ""
     for ch in path:  # '.' splits keys outside brackets only ([fs_hz=45e3..56e3])
         depth += (ch == "[") - (ch == "]")
@@ -38,41 +43,72 @@ def resolve(result, path):
             raise ValueError(f"bad path {path!r}")
         key, brackets = m.group(1), m.group(2)
         if key:
+            holder = node
             if isinstance(node, dict):
                 if key not in node:
-                    return None
+                    return None, None
                 node = node[key]
             elif isinstance(node, list):
                 named = [e for e in node if isinstance(e, dict) and e.get("name") == key]
                 if not named:
-                    return None
+                    return None, None
                 node = named[0]
             else:
-                return None
+                return None, None
         for sel in re.findall(r"\[([^\]]*)\]", brackets):
             if not isinstance(node, list):
-                return None
+                return None, None
             if "=" in sel:
                 field, rng = sel.split("=", 1)
                 lo, hi = (float(x) for x in rng.split("..", 1))
                 hits = [e for e in node if isinstance(e, dict) and isinstance(e.get(field), (int, float))
                         and not isinstance(e.get(field), bool) and lo <= e[field] <= hi]
                 if not hits:
-                    return None
+                    return None, None
                 node = hits[0]
             else:
                 i = int(sel)
                 if i >= len(node):
-                    return None
+                    return None, None
                 node = node[i]
     if isinstance(node, dict) and isinstance(node.get("updated"), (int, float)) and not isinstance(node.get("updated"), bool):
-        node = node["updated"]
-    return node
+        holder, node = node, node["updated"]
+    return holder, node
+
+
+# README "Limits and the lot report": a figure whose own status says it is
+# unreliable, or a constant not identifiable, is not a measurement; nor is a
+# value the quantity cannot physically take (by the path's last key).
+NOT_A_MEASUREMENT = {"unreliable", "not identifiable", "not_identifiable", "non_physical"}
+
+
+def last_key(path):
+    seg = re.split(r"\.(?![^\[]*\])", path)[-1]
+    return re.sub(r"\[.*$", "", seg)
+
+
+def physically_impossible(key, x):
+    sigma = key.endswith("_sigma")
+    if ("tan_delta" in key or key == "loss_tangent") and not sigma and x < 0:
+        return True
+    if key in ("k_eff", "k33", "k31", "kp", "kt") and not 0 < x < 1:
+        return True
+    if ("capacitance" in key or key in ("c0_f", "c1_f")) and not sigma and x <= 0:
+        return True
+    if key.startswith("qm") and not sigma and key != "qm_inverse" and x <= 0:
+        return True
+    if key.endswith("_hz") and x <= 0:
+        return True
+    if key in ("YE11", "epsT33_rel") and x <= 0:
+        return True
+    return key == "nu12" and not -1 < x < 0.5
 
 
 def judge(limit, result):
     """'pass' | 'below min' | 'above max' | 'not allowed' | 'not measured'."""
-    v = resolve(result, limit["quantity"])
+    holder, v = resolve_with_holder(result, limit["quantity"])
+    if isinstance(holder, dict) and holder is not v and holder.get("status") in NOT_A_MEASUREMENT:
+        return "not measured", None
     if "allowed" in limit:
         if not isinstance(v, (str, bool)):
             return "not measured", None
@@ -80,6 +116,8 @@ def judge(limit, result):
         ok = any(type(a) is type(v) and a == v for a in limit["allowed"])
         return ("pass" if ok else "not allowed"), v
     if isinstance(v, bool) or not isinstance(v, (int, float)) or not math.isfinite(v):
+        return "not measured", None
+    if physically_impossible(last_key(limit["quantity"]), v):
         return "not measured", None
     if "min" in limit and v < limit["min"]:
         return "below min", v

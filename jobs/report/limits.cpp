@@ -154,7 +154,13 @@ const nlohmann::json* resolve_in(const nlohmann::json& result, const std::vector
       n = hit;
     }
   }
-  if (n->is_object() && n->contains("updated") && (*n)["updated"].is_number()) n = &(*n)["updated"];
+  // A constant's object ({"updated": …, "status": …}) holds its number: the
+  // holder is that object, whose status the limits read (a constant "not
+  // identifiable" must never pass; it did, the holder was the result).
+  if (n->is_object() && n->contains("updated") && (*n)["updated"].is_number()) {
+    if (parent) *parent = n;
+    n = &(*n)["updated"];
+  }
   if (parent && n->is_object()) *parent = n;
   return n;
 }

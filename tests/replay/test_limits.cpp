@@ -280,3 +280,19 @@ TEST(LimitsFile, ShippedExamplesParse) {
   EXPECT_EQ(lot.limits[2].path[0].selectors[0].lo, 45e3);
   EXPECT_EQ(lot.limits[2].path[0].selectors[0].hi, 56e3);
 }
+
+// A constant the update could not identify ({"updated": …, "status": "not
+// identifiable"}) is not a measurement: it never passes, whatever its value
+// (it passed before: the holder read for its status was the result, not the
+// constant's object; found by the lot acceptance's independent check).
+TEST(LimitsEvaluation, AConstantNotIdentifiableNeverPasses) {
+  const Limits L = parse_limits(kValid, "lot.toml");
+  auto r = result(6.5e10, 30, 0.01, "none");
+  ASSERT_EQ(evaluate_result(L, r).checks[0].state, "pass");
+  r["parameters"][0]["status"] = "not identifiable";
+  const auto v = evaluate_result(L, r);
+  EXPECT_EQ(v.status, "fail");
+  EXPECT_EQ(v.checks[0].state, "not measured");
+  EXPECT_TRUE(v.checks[0].value.is_null());
+  EXPECT_NE(v.checks[0].reason.find("not identifiable"), std::string::npos) << v.checks[0].reason;
+}
