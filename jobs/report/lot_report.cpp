@@ -142,7 +142,12 @@ Figure lot_figure(const Limits& L, const LotSummary& s) {
           out.y.push_back(0.0);
         }
     if (!out.x.empty()) p.series.push_back(std::move(out));
-    p.x_range = std::pair(h.lo, h.hi);
+    // The limits stay in view where the whole lot lies beyond one of them.
+    double x0 = h.lo, x1 = h.hi;
+    for (const auto& lim : {l.min, l.max})
+      if (lim) x0 = std::min(x0, *lim), x1 = std::max(x1, *lim);
+    const double pad = x0 < h.lo || x1 > h.hi ? 0.03 * (x1 - x0) : 0.0;
+    p.x_range = std::pair(x0 < h.lo ? x0 - pad : x0, x1 > h.hi ? x1 + pad : x1);
     p.y_range = std::pair(0.0, top * 1.6 + 1.0);  // headroom: the legend sits top right
     fig.panels.push_back(std::move(p));
   }
