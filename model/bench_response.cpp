@@ -39,8 +39,9 @@ cd tube_admittance(const ModalPortModel& port, const RayleighDamping& d, const E
 namespace {
 // The catalogue's entries of each circuit/DAQ stage, found once (this is the
 // fits' inner loop: a few entries, no search).
+constexpr int kStages = static_cast<int>(EffectStage::channel2) + 1;
 struct StageEntries {
-  std::vector<const EffectInfo*> at[5];
+  std::vector<const EffectInfo*> at[kStages];
   StageEntries() {
     for (const auto& e : effect_catalogue()) at[static_cast<int>(e.stage)].push_back(&e);
   }
@@ -49,7 +50,7 @@ const std::vector<const EffectInfo*>& entries(EffectStage s) {
   static const StageEntries all;
   return all.at[static_cast<int>(s)];
 }
-// The term of e at ω if e is present in fx (its value not the neutral one).
+// Whether e is present in fx (its value not the neutral one).
 bool present(const EffectInfo& e, const EffectSet& fx) {
   static const EffectSet neutral;
   return fx.*(e.field) != neutral.*(e.field);
