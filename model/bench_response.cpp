@@ -65,7 +65,8 @@ cd recorded_transfer(cd y_tube, const EffectSet& fx, double r1_nominal_ohm, doub
   cd y = y_tube;
   for (const EffectInfo* e : entries(EffectStage::series))
     if (present(*e, fx))
-      if (const cd z = e->term(fx.*(e->field), omega); z != 0.0) y = y / (1.0 + z * y);
+      if (const cd z = e->term(fx.*(e->field), omega); z != 0.0)
+        y = z.imag() == 0.0 ? y / (1.0 + z.real() * y) : y / (1.0 + z * y);  // a real term: a real product
   for (const EffectInfo* e : entries(EffectStage::shunt))
     if (present(*e, fx)) y += e->term(fx.*(e->field), omega);
   double r1 = r1_nominal_ohm;
@@ -77,7 +78,11 @@ cd recorded_transfer(cd y_tube, const EffectSet& fx, double r1_nominal_ohm, doub
   // only the rounding depends on it).
   const auto& daq = entries(EffectStage::channel2);
   for (auto it = daq.rbegin(); it != daq.rend(); ++it)
-    if (present(**it, fx)) h *= (*it)->term(fx.*((*it)->field), omega);
+    if (present(**it, fx)) {
+      const cd f = (*it)->term(fx.*((*it)->field), omega);
+      if (f.imag() == 0.0) h *= f.real();  // (the same numbers, without a complex product's NaN checks)
+      else h *= f;
+    }
   return h;
 }
 
