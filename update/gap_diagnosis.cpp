@@ -216,7 +216,7 @@ GapDiagnosis diagnose_gap(model::ModalSolver& solver, const MaterialClass& cls, 
       if (!info) throw std::invalid_argument("gap diagnosis: unknown effect '" + pool[c] + "'");
       rep.unit = std::string(info->unit);
       rep.typical = info->typical;  // in the effect's unit (the catalogue's; x = 1 is this size)
-      const double x_unit = typical_effect_magnitude(*info);  // the coordinate's unit (S for the DAQ's input)
+      const double x_unit = model::effect_coordinate_unit(*info);  // the coordinate's unit (S for the DAQ's input)
       std::vector<std::string> fx = model_effects;
       fx.push_back(pool[c]);
       m.set_effects(fx);

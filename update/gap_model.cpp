@@ -16,12 +16,6 @@ constexpr int kMat = 4;
 constexpr double kMassStep = 0.002;  // end-mass fraction step for its linearisation (0.1 x unit)
 }  // namespace
 
-double typical_effect_magnitude(const model::EffectInfo& e) {
-  // The catalogue's one typical size (model/effects.hpp), as the coordinate's
-  // unit: daq_input_resistance as a conductance (1 µS for 1 MΩ).
-  return model::effect_coordinate_unit(e);
-}
-
 struct GapModel::Linear {
   double xm[kMat] = {0, 0, 0, 0};  // material x of the linearisation point
   model::ModalPortModel base;

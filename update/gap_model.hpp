@@ -34,9 +34,6 @@ struct GapParamInfo {
   double lower = 0, upper = 0;  // bounds in x
 };
 
-// Typical bench magnitude of an effect (one unit of its x), SI.
-double typical_effect_magnitude(const model::EffectInfo& e);
-
 class GapModel {
  public:
   // `solver` must outlive the model. `damping_ref_hz`: where the damping

@@ -24,7 +24,7 @@ const std::vector<std::string_view>& internal_function_names() {
       "prony_ss", "rayleigh_fit", "rayleigh_from_damping", "rayleigh_from_two_modes", "read_impedance_file",
       "read_impedance_table", "recorded_transfer", "render_raster", "render_svg", "reported_impedance",
       "run_measurement", "scan_effects", "select_order", "select_shard", "solve_tsvd",
-      "stabilization_chart", "to_d_form", "to_e_form", "typical_effect_magnitude", "update_cmcm",
+      "stabilization_chart", "to_d_form", "to_e_form", "update_cmcm",
       "update_lm", "vector_fit", "write_impedance_csv", "write_touchstone_s1p", "xcorr_delay"};
   return names;
 }

@@ -36,8 +36,8 @@ std::optional<EffectCoordinate> effect_coordinate(const std::string& name) {
   const model::EffectInfo* info = model::find_effect(name);
   if (!info) return std::nullopt;
   EffectCoordinate c;
-  // The unit of the coordinate: the catalogue's typical size (model/effects.hpp,
-  // one table for both diagnosis paths).
+  // x units of the effect table's coordinate (model/effects.hpp, one table for
+  // both diagnosis paths).
   c.apply = [info](model::EffectSet& fx, double x) { model::add_effect_coordinate(*info, fx, x); };
   return c;
 }
