@@ -6,6 +6,7 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "numerics/gauss_newton.hpp"
 #include "update/cmcm.hpp"
 
 namespace piezo::update {
@@ -225,8 +226,8 @@ int refine(const ModeShapeEquations& eq, std::array<double, 8>& th, int max_it, 
         free.push_back(v);
         break;
       }
-  int it = 0;
-  for (; it < max_it; ++it) {
+  numerics::GaussNewtonProblem gn;
+  gn.linearise = [&](Eigen::VectorXd& r, Eigen::MatrixXd& j) {
     const auto a = alpha_of(th);
     Eigen::VectorXd x(static_cast<Eigen::Index>(eq.unknowns.size()));
     Eigen::MatrixXd da(static_cast<Eigen::Index>(eq.unknowns.size()),
@@ -237,19 +238,14 @@ int refine(const ModeShapeEquations& eq, std::array<double, 8>& th, int max_it, 
         da(static_cast<Eigen::Index>(c), static_cast<Eigen::Index>(v)) =
             dalpha(th, eq.unknowns[c], free[v]);
     }
-    const Eigen::VectorXd r = eq.g * x - eq.f;
-    const TsvdSolution step = solve_tsvd(eq.g * da, -r, rel_tol);
-    double d = 0;
-    for (std::size_t v = 0; v < free.size(); ++v) {
-      th[free[v]] += step.x[static_cast<Eigen::Index>(v)];
-      d = std::max(d, std::abs(step.x[static_cast<Eigen::Index>(v)]));
-    }
-    if (d < 1e-14) {
-      ++it;
-      break;
-    }
-  }
-  return it;
+    r = eq.g * x - eq.f;
+    j = eq.g * da;
+  };
+  gn.solve = [&](const Eigen::MatrixXd& j, const Eigen::VectorXd& minus_r) { return solve_tsvd(j, minus_r, rel_tol).x; };
+  gn.apply = [&](const Eigen::VectorXd& step) {
+    for (std::size_t v = 0; v < free.size(); ++v) th[free[v]] += step[static_cast<Eigen::Index>(v)];
+  };
+  return numerics::gauss_newton(gn, max_it, 1e-14);
 }
 
 }  // namespace

@@ -9,6 +9,7 @@
 #include <stdexcept>
 #include <string>
 
+#include "numerics/gauss_newton.hpp"
 #include "update/output_error.hpp"
 #include "update/output_error/baseline.hpp"
 #include "update/output_error/common.hpp"
@@ -101,18 +102,16 @@ OePrediction predict_output_error(model::ModalSolver& solver, const MaterialClas
       if (!rz.allFinite()) return std::nullopt;
       return rz;
     };
-    z = Eigen::VectorXd::Zero(np);
-    Eigen::VectorXd rz = r;
-    double cost = chi2;
-    for (int it = 0; it < 4; ++it) {
+    numerics::PenalisedGnProblem gn;
+    gn.residual = residual_at;
+    gn.jacobian = [&](const Eigen::VectorXd& z, const Eigen::VectorXd& rz) -> std::optional<Eigen::MatrixXd> {
       Eigen::MatrixXd w(rz.size(), np);
-      bool ok = true;
       // The constants' columns through the port models' tangent (Problem::set_tangent).
       model::EffectSet fz = effects;
       if (np > kParams) coord->apply(fz, z[kParams]);
       const Eigen::VectorXd zm = z.head(kParams);
       const bool tangent = prob.tangent_near(zm, fz.mass_loading);
-      for (Eigen::Index c = 0; c < np && ok; ++c) {
+      for (Eigen::Index c = 0; c < np; ++c) {
         const double h = c >= 4 ? 1e-4 : 1e-6;
         if (c < 4 && tangent)
           if (const auto tt = prob.tangent_transfer(zm, static_cast<int>(c), h, fz)) {
@@ -125,32 +124,17 @@ OePrediction predict_output_error(model::ModalSolver& solver, const MaterialClas
         Eigen::VectorXd zp = z;
         zp[c] += h;
         const auto rp = residual_at(zp);
-        if (!rp) ok = false;
-        else w.col(c) = (*rp - rz) / (zp[c] - z[c]);
+        if (!rp) return std::nullopt;
+        w.col(c) = (*rp - rz) / (zp[c] - z[c]);
       }
-      if (!ok) break;
       if (!tangent) prob.set_tangent(zm, 1e-6, fz.mass_loading);
-      const Eigen::VectorXd g = w.transpose() * rz + cinv * z;
-      const Eigen::MatrixXd a = w.transpose() * w + cinv;
-      Eigen::VectorXd step = -a.ldlt().solve(g);
-      if (!step.allFinite()) break;
-      bool accepted = false;
-      for (int half = 0; half < 4 && !accepted; ++half, step *= 0.5) {
-        const Eigen::VectorXd zt = z + step;
-        const auto rt = residual_at(zt);
-        if (!rt) continue;
-        const double ct = rt->squaredNorm() + zt.dot(cinv * zt);
-        if (ct < cost) {
-          const double drop = cost - ct;
-          z = zt;
-          rz = *rt;
-          cost = ct;
-          accepted = true;
-          if (drop < 1e-3 * out.dof) it = 4;  // converged (to a thousandth of χ²/ν)
-        }
-      }
-      if (!accepted) break;
-    }
+      return w;
+    };
+    // Converged when a step gains less than a thousandth of χ²/ν.
+    const auto gr = numerics::penalised_gauss_newton(gn, cinv, Eigen::VectorXd::Zero(np), r, chi2,
+                                                     {.max_iterations = 4, .max_halvings = 4, .min_drop = 1e-3 * out.dof});
+    z = gr.z;
+    const double cost = gr.cost;
     if (std::isfinite(cost) && cost >= 0) {
       chi2 = cost;
       out.prediction_uncertainty = true;
