@@ -1,5 +1,6 @@
 #include "dsp/uncertain_text.hpp"
 #include "update/gap_diagnosis.hpp"
+#include "update/gap_core.hpp"
 
 #include <Eigen/Dense>
 #include <algorithm>
@@ -19,7 +20,7 @@ namespace {
 using cd = std::complex<double>;
 constexpr int kBase = 6;  // material (4) + damping (2)
 
-double excess_gap(double chi2, int n) { return std::sqrt(std::max(0.0, chi2 / std::max(1, n) - 1.0)); }
+double excess_gap(double chi2, int n) { return gap_core::excess(chi2 / std::max(1, n)); }
 
 // A gap is a misfit beyond 3σ of χ²'s spread AND beyond `tolerance` of the
 // noise variance: the noise itself is measured from the shots (≈ 16 shots ×
@@ -296,8 +297,8 @@ GapDiagnosis diagnose_gap(model::ModalSolver& solver, const MaterialClass& cls, 
         rep.note = info->note;
       if (heldout) {
         rep.heldout_chi2_after = predictive_chi2(m, *heldout, f);
-        const double before = excess_gap(*ho_cur, out.n_heldout);
-        rep.heldout_shrink = before > 0 ? 1.0 - excess_gap(*rep.heldout_chi2_after, out.n_heldout) / before : 0.0;
+        const double n = std::max(1, out.n_heldout);
+        rep.heldout_shrink = gap_core::shrink(*ho_cur / n, *rep.heldout_chi2_after / n).value_or(0.0);
       }
       reports.push_back(rep);
     }
@@ -322,8 +323,13 @@ GapDiagnosis diagnose_gap(model::ModalSolver& solver, const MaterialClass& cls, 
       }
       out.effects = reports;
     }
-    // Greedy step: the best identifiable effect, if it is significant on the
-    // fit data and shrinks the held-out gap.
+    // Greedy step: the round's best identifiable effect, if it is significant
+    // on the fit data and passes the core's held-out check (gap_core.hpp):
+    // where the held-out data show a gap, it must shrink it; where they show
+    // none (a less sensitive drive or noisier capture: the model already
+    // predicts them within their noise), there is nothing to shrink, and the
+    // effect must not make them worse (its held-out χ² may not rise by more
+    // than the significance threshold or 3σ of χ²).
     const EffectReport* best = nullptr;
     for (const auto& r : reports)
       if (!r.alias && r.fitted) {
@@ -332,20 +338,24 @@ GapDiagnosis diagnose_gap(model::ModalSolver& solver, const MaterialClass& cls, 
       }
     const bool gap_left = significant_gap(chi_cur, out.dof_fit - static_cast<int>(model_effects.size()), opt.gap_tolerance) ||
                           (ho_cur && significant_gap(*ho_cur, out.n_heldout, opt.gap_tolerance));
-    // The held-out check: where the held-out data show a gap, the effect must
-    // shrink it; where they show none (a less sensitive drive or noisier
-    // capture: the model already predicts them within their noise), there is
-    // nothing to shrink, and the effect must not make them worse (its held-out
-    // χ² may not rise by more than the significance threshold or 3σ of χ²).
-    bool heldout_ok = true;
-    if (ho_cur && best && best->heldout_chi2_after) {
-      if (significant_gap(*ho_cur, out.n_heldout, opt.gap_tolerance))
-        heldout_ok = !(best->heldout_shrink && *best->heldout_shrink < opt.min_heldout_shrink);
-      else
-        heldout_ok = *best->heldout_chi2_after <=
-                     *ho_cur + std::max(opt.significance, 3.0 * std::sqrt(2.0 * out.n_heldout));
+    std::vector<gap_core::CandidateEvidence> offered;  // the best, if significant (explains: no lack-of-fit test here)
+    if (best && best->significant) {
+      gap_core::CandidateEvidence c{best->name, true, true};
+      if (ho_cur && best->heldout_chi2_after) {
+        c.heldout_predicted = true;
+        c.heldout_shrink = best->heldout_shrink.value_or(0.0);
+        c.heldout_within_noise = *best->heldout_chi2_after <=
+                                 *ho_cur + std::max(opt.significance, 3.0 * std::sqrt(2.0 * out.n_heldout));
+      }
+      offered.push_back(std::move(c));
     }
-    if (!best || !gap_left || !best->significant || !heldout_ok) break;
+    gap_core::ChoiceRule rule;
+    rule.heldout = ho_cur.has_value();
+    rule.heldout_gap = ho_cur && significant_gap(*ho_cur, out.n_heldout, opt.gap_tolerance);
+    rule.min_shrink = opt.min_heldout_shrink;
+    rule.dominant_shrink = opt.min_heldout_shrink;  // every offered candidate is significant and explains
+    rule.first_only = true;
+    if (!gap_left || !gap_core::choose_effect(offered, rule).chosen) break;
     if (ho_cur && !significant_gap(*ho_cur, out.n_heldout, opt.gap_tolerance) && out.steps.empty())
       out.heldout_without_gap = true;
     out.steps.push_back(*best);
@@ -374,15 +384,7 @@ GapDiagnosis diagnose_gap(model::ModalSolver& solver, const MaterialClass& cls, 
   }
 
   // 3. Verdict.
-  std::vector<std::string> aliases;
-  for (const auto& r : out.effects)
-    if (r.alias) aliases.push_back(r.name);
-  std::string alias_note;
-  if (!aliases.empty()) {
-    alias_note = " Not separable from the constants by the impedance alone (aliases): ";
-    for (std::size_t i = 0; i < aliases.size(); ++i) alias_note += (i ? ", " : "") + aliases[i];
-    alias_note += " - " + model::separation_advice(aliases) + ".";
-  }
+  std::string alias_note = gap_core::alias_sentence(gap_core::alias_names(out.effects), "the impedance alone");
   if (!out.measured.empty()) {
     alias_note += " Measured by the fixture calibration and held in the model: ";
     for (std::size_t i = 0; i < out.measured.size(); ++i) {  // with its unit (the effect table's, SI-prefixed)
@@ -418,15 +420,9 @@ GapDiagnosis diagnose_gap(model::ModalSolver& solver, const MaterialClass& cls, 
       std::snprintf(buf, sizeof buf, "Gap explained by %s = %s (held-out gap shrinks by %.0f %%)%s.",
                     s.name.c_str(), dsp::format_uncertain(s.value, s.sigma, s.unit).c_str(),
                     100 * (out.heldout_shrink ? *out.heldout_shrink : s.shrink_fit), more.c_str());
-    std::string twins;
     for (const auto& e : out.effects)
-      if (e.name == s.name)
-        for (const auto& n : e.indistinguishable_from) {
-          twins += (twins.empty() ? "" : ", ") + n;
-          out.verdict_alternatives.push_back(n);
-        }
-    if (!twins.empty()) twins = " This data cannot tell it from " + twins + " (same signature).";
-    out.verdict = buf + twins + alias_note;
+      if (e.name == s.name) out.verdict_alternatives = e.indistinguishable_from;
+    out.verdict = buf + gap_core::twins_sentence(out.verdict_alternatives, "This data") + alias_note;
   } else {
     out.verdict_effect = "unexplained";
     const GapRegion* worst = nullptr;

@@ -22,6 +22,9 @@
 //     of the excess gap g = √max(0, χ²/N − 1) on data the fit never saw.
 //     Greedy: the best significant effect is added and the rest refitted, at
 //     most `max_effects` times.
+//  The decisions both gap paths share — the shrink, the held-out check, the
+//  verdict's effect, the sentences — are the diagnosis core's
+//  (update/gap_core.hpp); this path computes the impedance residual's evidence.
 #include <atomic>
 #include <cmath>
 #include <functional>

@@ -1,6 +1,7 @@
 #include "dsp/uncertain_text.hpp"
 #include "dsp/probability_text.hpp"
 #include "update/gap_output_error.hpp"
+#include "update/gap_core.hpp"
 
 #include <algorithm>
 #include <atomic>
@@ -30,8 +31,6 @@ struct HeldoutPredictions {
     return nullptr;
   }
 };
-
-double excess(double chi2_per_dof) { return std::sqrt(std::max(0.0, chi2_per_dof - 1.0)); }
 
 // Below the fit's significance but seen (Δχ² ≥ 9, 3 sigma), not an alias, at
 // a physical value: a candidate the held-out data alone can confirm.
@@ -94,7 +93,6 @@ GapDiagnosis build(const OeResult& r, const std::string& fit_description, const 
   const std::vector<ResidualRegion>& regions = regions_heldout ? ho->base.regions : r.regions;
   d.regions = located_gap_regions(regions, regions_heldout);
   // g = √max(0, χ²/N − 1): the excess over the noise.
-  const double g_before = std::sqrt(std::max(0.0, r.chi2_per_dof - 1.0));
   const OeEffect* top = nullptr;
   for (const auto& e : r.effects) {
     EffectReport rep;
@@ -113,14 +111,13 @@ GapDiagnosis build(const OeResult& r, const std::string& fit_description, const 
     rep.sigma = e.sigma;
     rep.chi2_after = e.chi2_per_dof * std::max(1, d.dof_fit - 1);
     rep.delta_chi2 = e.delta_chi2;
-    rep.shrink_fit = g_before > 0 ? 1.0 - std::sqrt(std::max(0.0, e.chi2_per_dof - 1.0)) / g_before : 0.0;
+    rep.shrink_fit = gap_core::shrink(r.chi2_per_dof, e.chi2_per_dof).value_or(0.0);
     rep.significant = e.significant;
     rep.material = e.material;
     if (ho)
       if (const OePrediction* p = ho->of(e.name)) {
         rep.heldout_chi2_after = p->chi2_per_dof * p->dof;
-        const double g0 = excess(ho->base.chi2_per_dof);
-        if (g0 > 0) rep.heldout_shrink = 1.0 - excess(p->chi2_per_dof) / g0;
+        rep.heldout_shrink = gap_core::shrink(ho->base.chi2_per_dof, p->chi2_per_dof);
       }
     if (e.alias)
       rep.note = "the constants mimic it in this capture (alias): measure it (fixture calibration) to separate it";
@@ -130,16 +127,14 @@ GapDiagnosis build(const OeResult& r, const std::string& fit_description, const 
     if (e.significant && (!top || e.delta_chi2 > top->delta_chi2)) top = &e;
   }
   d.gap = r.lack_of_fit || top;
-  // The verdict: the first significant effect (largest Δχ² first) that
-  //  - explains the capture (no lack of fit left with it) — without held-out
-  //    data nothing less is a verdict (issue 21: never a false name); and
-  //  - with held-out data showing a gap, shrinks it by OeHeldout::min_shrink;
-  //    where the held-out data show none, does not create one.
-  // An effect that leaves some misfit in the fit, or one seen only below the
-  // fit's significance (weak_candidate, ranked after the significant ones),
-  // must remove most of a held-out gap (dominant_shrink): the verdict then
-  // says "not alone, or not exactly in the catalogue's form" / "below the
-  // fit's own significance".
+  // The verdict (gap_core::choose_effect): the first significant effect
+  // (largest Δχ² first) that explains the capture (no lack of fit left with
+  // it; without held-out data nothing less is a verdict: issue 21, never a
+  // false name) and passes the held-out check. An effect that leaves some
+  // misfit in the fit, or one seen only below the fit's significance
+  // (weak_candidate, ranked after the significant ones), must remove most of
+  // a held-out gap (dominant_shrink): the verdict then says "not alone, or not
+  // exactly in the catalogue's form" / "below the fit's own significance".
   const bool ho_gap = ho && ho->base.chi2_per_dof > ho->base.chi2_limit;
   std::vector<const OeEffect*> ranked, weak;
   for (const auto& e : r.effects)
@@ -150,33 +145,30 @@ GapDiagnosis build(const OeResult& r, const std::string& fit_description, const 
   std::stable_sort(weak.begin(), weak.end(), by_drop);
   const std::size_t n_significant = ranked.size();
   ranked.insert(ranked.end(), weak.begin(), weak.end());
-  auto shrink_of = [&](const OePrediction& p) {
-    return 1.0 - excess(p.chi2_per_dof) / excess(ho->base.chi2_per_dof);
-  };
-  const OeEffect* closest = nullptr;
-  bool partial = false, weak_verdict = false;
-  top = nullptr;
-  std::vector<const OeEffect*> failed_heldout;
+  auto shrink_of = [&](const OePrediction& p) { return *gap_core::shrink(ho->base.chi2_per_dof, p.chi2_per_dof); };
+  std::vector<gap_core::CandidateEvidence> evidence;
   for (const OeEffect* e : ranked) {
-    bool ok = false, part = false;
-    const OePrediction* p = ho ? ho->of(e->name) : nullptr;
-    if (!ho || !p) {
-      ok = e->explains;
-    } else if (ho_gap) {
-      const double sh = shrink_of(*p);
-      ok = e->explains && e->significant ? sh >= ho->min_shrink : sh >= ho->dominant_shrink;
-      part = ok && !e->explains;
-      weak_verdict = ok && !e->significant;
-    } else {
-      ok = e->explains && p->chi2_per_dof <= p->chi2_limit;
+    gap_core::CandidateEvidence c{e->name, e->significant, e->explains};
+    if (const OePrediction* p = ho ? ho->of(e->name) : nullptr) {
+      c.heldout_predicted = true;
+      if (ho_gap) c.heldout_shrink = shrink_of(*p);
+      c.heldout_within_noise = p->chi2_per_dof <= p->chi2_limit;
     }
-    if (ok) {
-      top = e;
-      partial = part;
-      break;
-    }
-    if (ho && p && (e->explains || ho_gap) && e->significant) failed_heldout.push_back(e);
+    evidence.push_back(std::move(c));
   }
+  gap_core::ChoiceRule rule;
+  rule.heldout = ho != nullptr;
+  rule.heldout_gap = ho_gap;
+  if (ho) {
+    rule.min_shrink = ho->min_shrink;
+    rule.dominant_shrink = ho->dominant_shrink;
+  }
+  const gap_core::Choice choice = gap_core::choose_effect(evidence, rule);
+  const OeEffect* closest = nullptr;
+  const bool partial = choice.partial, weak_verdict = choice.weak;
+  top = choice.chosen ? ranked[*choice.chosen] : nullptr;
+  std::vector<const OeEffect*> failed_heldout;
+  for (std::size_t i : choice.failed_heldout) failed_heldout.push_back(ranked[i]);
   if (!top && n_significant > 0) closest = ranked.front();
   // Held out: another drive, another record.
   std::string heldout_note;
@@ -231,11 +223,9 @@ GapDiagnosis build(const OeResult& r, const std::string& fit_description, const 
     d.added = {top->name};
     for (const auto& rep : d.effects)
       if (rep.name == top->name) d.steps = {rep};
-    std::string twins;
-    for (const auto& e : r.effects)
+    for (const auto& e : r.effects)  // twins: a χ² with it within max(4, 1 %) of the verdict's
       if (&e != top && e.significant &&
           top->delta_chi2 - e.delta_chi2 <= std::max(4.0, 0.01 * top->delta_chi2)) {
-        twins += (twins.empty() ? "" : ", ") + e.name;
         d.verdict_alternatives.push_back(e.name);
         for (auto& rep : d.effects)
           if (rep.name == top->name) rep.indistinguishable_from.push_back(e.name);
@@ -251,7 +241,7 @@ GapDiagnosis build(const OeResult& r, const std::string& fit_description, const 
     d.verdict = buf;
     if (weak_verdict)
       d.verdict += " Below the fit's own significance: named because it removes most of the held-out gap.";
-    if (!twins.empty()) d.verdict += " This capture cannot tell it from " + twins + " (same signature).";
+    d.verdict += gap_core::twins_sentence(d.verdict_alternatives, "This capture");
     d.verdict += ho ? heldout_note : " Not checked on held-out data.";
   } else {
     d.verdict_effect = "unexplained";
@@ -280,14 +270,7 @@ GapDiagnosis build(const OeResult& r, const std::string& fit_description, const 
     const std::string where = located_sentence(d.regions, regions_heldout ? "held-out prediction" : "residual");
     d.verdict = buf + where + near + heldout_note;
   }
-  std::vector<std::string> aliases;
-  for (const auto& e : r.effects)
-    if (e.alias) aliases.push_back(e.name);
-  if (!aliases.empty()) {
-    d.verdict += " Not separable from the constants by this capture (aliases): ";
-    for (std::size_t i = 0; i < aliases.size(); ++i) d.verdict += (i ? ", " : "") + aliases[i];
-    d.verdict += " - " + model::separation_advice(aliases) + ".";
-  }
+  d.verdict += gap_core::alias_sentence(gap_core::alias_names(d.effects), "this capture");
   // Shots that disagree (a drift, a step): the pooled record mixes two or
   // more states of the tube, whose misfit an effect of the catalogue may
   // mimic (a step of epsT33 and d31 read as channel_skew): no effect is named.

@@ -35,17 +35,22 @@ void parameter_table(const jobs::PipelineResult& r) {
     ImGui::PopStyleColor();
   }
   // Columns sized to their content (value and sigma in one cell, σ to two
-  // significant digits), a horizontal scroll bar where the panel is narrower.
+  // significant digits; the relative σ in the value's tooltip), a horizontal
+  // scroll bar where the panel is narrower. At the default 1280 × 800 the
+  // parameter, its value, status and change fit; original, the uncorrected
+  // value, CMCM and the truth scroll in.
   const int cols = 5 + (seed ? 1 : 0) + (sim ? 1 : 0) + (corr ? 1 : 0);
   const float rows_h = ImGui::GetTextLineHeightWithSpacing() * static_cast<float>(r.params.size() + 1) +
                        ImGui::GetStyle().ScrollbarSize + 6.0f;
-  if (!ImGui::BeginTable("params", cols,
-                         ImGuiTableFlags_Borders | ImGuiTableFlags_RowBg | ImGuiTableFlags_SizingFixedFit |
-                             ImGuiTableFlags_ScrollX | ImGuiTableFlags_NoHostExtendX,
-                         ImVec2(0, rows_h)))
-    return;
+  ImGui::PushStyleVar(ImGuiStyleVar_CellPadding, ImVec2(3.0f, 2.0f));  // (4, 2) by default: 10 px more for text
+  const bool open = ImGui::BeginTable("params", cols,
+                                      ImGuiTableFlags_Borders | ImGuiTableFlags_RowBg | ImGuiTableFlags_SizingFixedFit |
+                                          ImGuiTableFlags_ScrollX | ImGuiTableFlags_NoHostExtendX,
+                                      ImVec2(0, rows_h));
+  ImGui::PopStyleVar();
+  if (!open) return;
   ImGui::TableSetupScrollFreeze(1, 0);
-  ImGui::TableSetupColumn("parameter [unit]");
+  ImGui::TableSetupColumn("parameter");  // its unit in the cell: the header is the column's widest text
   ImGui::TableSetupColumn("updated ± sigma");
   ImGui::TableSetupColumn("status");
   ImGui::TableSetupColumn("change %");
@@ -60,16 +65,16 @@ void parameter_table(const jobs::PipelineResult& r) {
     ImGui::Text("%s [%s]", p.name.c_str(), p.unit.c_str());
     ImGui::TableNextColumn();
     const double rel = p.sigma ? 100.0 * *p.sigma / std::abs(p.updated) : NAN;
-    ImGui::Text("%s%s", jobs::format_uncertain(p.updated, p.sigma.value_or(NAN), {}, kGuiCell).c_str(),
-                std::isfinite(rel) ? (" (" + jobs::format_value(rel, "%", 2) + ")").c_str() : "");
-    if (ImGui::IsItemHovered()) {
+    ImGui::TextUnformatted(jobs::format_uncertain(p.updated, p.sigma.value_or(NAN), {}, kGuiCell).c_str());
+    if (ImGui::IsItemHovered()) {  // the relative sigma here keeps the first four columns in a 1280-wide window
+      const std::string rel_text = std::isfinite(rel) ? "relative sigma " + jobs::format_value(rel, "%", 2) + "\n" : "";
       if (r.output_error && r.output_error->ok())
-        ImGui::SetTooltip("%s\ncorr(nu12, d31) %+.2f, chi2/dof %.3g (limit %.3g), %s", method,
+        ImGui::SetTooltip("%s%s\ncorr(nu12, d31) %+.2f, chi2/dof %.3g (limit %.3g), %s", rel_text.c_str(), method,
                           r.output_error->corr_nu12_d31, r.output_error->chi2_per_dof,
                           r.output_error->chi2_limit,
                           update::damping_summary(*r.output_error).c_str());
       else
-        ImGui::SetTooltip("%s", method);
+        ImGui::SetTooltip("%s%s", rel_text.c_str(), method);
     }
     ImGui::TableNextColumn();
     if (p.status == "ok") {
