@@ -10,13 +10,22 @@ namespace piezo::gui {
 
 namespace {
 void effects_table(const update::GapDiagnosis& d, DiagnosisShown& shown) {
-  const ImGuiTableFlags flags =
-      ImGuiTableFlags_Borders | ImGuiTableFlags_RowBg | ImGuiTableFlags_SizingFixedFit;
-  if (!ImGui::BeginTable("effects", 4, flags)) return;
+  // The ranking's evidence (d chi2, held-out shrink) next to the name, the
+  // value with its unit last: at the default 1280 x 800 the first three
+  // columns fit, a long value scrolls in (the verdict states the named one's).
+  const ImGuiTableFlags flags = ImGuiTableFlags_Borders | ImGuiTableFlags_RowBg | ImGuiTableFlags_SizingFixedFit |
+                                ImGuiTableFlags_ScrollX | ImGuiTableFlags_NoHostExtendX;
+  const float rows_h = ImGui::GetTextLineHeightWithSpacing() * static_cast<float>(d.effects.size() + 1) +
+                       ImGui::GetStyle().ScrollbarSize + 6.0f;
+  ImGui::PushStyleVar(ImGuiStyleVar_CellPadding, ImVec2(3.0f, 2.0f));
+  const bool open = ImGui::BeginTable("effects", 4, flags, ImVec2(0, rows_h));
+  ImGui::PopStyleVar();
+  if (!open) return;
+  ImGui::TableSetupScrollFreeze(1, 0);
   ImGui::TableSetupColumn("effect (ranked)");
-  ImGui::TableSetupColumn("value (sigma)");
   ImGui::TableSetupColumn("d chi2");
   ImGui::TableSetupColumn("shrink");
+  ImGui::TableSetupColumn("value (sigma)");
   ImGui::TableHeadersRow();
   for (const auto& e : d.effects) {
     const bool added = std::find(d.added.begin(), d.added.end(), e.name) != d.added.end();
@@ -27,11 +36,6 @@ void effects_table(const update::GapDiagnosis& d, DiagnosisShown& shown) {
                                     : ImGui::GetStyleColorVec4(ImGuiCol_Text);
     ImGui::TextColored(colour, "%s", e.name.c_str());
     if (!e.note.empty() && ImGui::IsItemHovered()) ImGui::SetTooltip("%s", e.note.c_str());
-    ImGui::TableNextColumn();
-    if (e.fitted)
-      ImGui::Text("%.3g (%.2g) %s", e.value, e.sigma, e.unit.c_str());
-    else
-      ImGui::TextDisabled("-");
     ImGui::TableNextColumn();
     if (e.fitted)
       ImGui::Text("%.1f%s", e.delta_chi2, e.significant ? " *" : "");
@@ -53,6 +57,11 @@ void effects_table(const update::GapDiagnosis& d, DiagnosisShown& shown) {
     } else {
       ImGui::TextDisabled("-");
     }
+    ImGui::TableNextColumn();
+    if (e.fitted)
+      ImGui::Text("%.3g (%.2g) %s", e.value, e.sigma, e.unit.c_str());
+    else
+      ImGui::TextDisabled("-");
     ++shown.effects;
   }
   ImGui::EndTable();
