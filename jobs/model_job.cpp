@@ -156,20 +156,26 @@ nlohmann::json model_impedance_json(const ModelRequest& a, const SweepRequest& s
   return j;
 }
 
-SensitivityJobResult run_sensitivity(ModelRequest a, double band_hz) {
+SensitivityJobResult run_sensitivity(ModelRequest a, const SensitivityRequest& study) {
   const auto r = resolve(a);
   const auto m = pm::resolve_material({a.material, a.isotropic, a.set});
+  const double band_hz = study.band_hz;
   pm::SensitivityOptions o;
   o.band_hz = band_hz;
   o.mesh = {a.n_radial, a.n_axial};
+  o.form = study.form;
+  o.seed_protocol = study.seed_protocol;
   try {
     o.validate();
   } catch (const std::invalid_argument& e) {
     throw InputError(e.what());
   }
-  const auto res = pm::d_form_sensitivity(a.geometry, m.d, o);
+  const auto res = pm::form_sensitivity(a.geometry, m.d, o);
+  const auto& params = pm::sensitivity_params(o.form);
   nlohmann::json j;
   j["material"] = a.material;
+  j["form"] = pm::to_string(o.form);
+  j["seed_protocol"] = o.seed_protocol;
   j["model_class"] = r.model_class;
   j["mesh"] = {{"n_radial", a.n_radial}, {"n_axial", a.n_axial}};
   j["band_hz"] = band_hz;
@@ -178,13 +184,14 @@ SensitivityJobResult run_sensitivity(ModelRequest a, double band_hz) {
                   {"c_static_f", res.nominal.c_static_f}};
   j["cases"] = nlohmann::json::array();
   for (const auto& c : res.cases) {
-    nlohmann::json cj = {{"param", pm::d_param_name(c.param)},
+    nlohmann::json cj = {{"param", c.name},
                          {"factor", c.factor},
-                         {"seed_says_sensitive", pm::seed_says_sensitive(c.param)},
-                         {"valid", c.valid}};
-    if (!c.valid) {
-      cj["reason"] = c.reason;
-    } else {
+                         {"seed_says_sensitive", params[static_cast<std::size_t>(c.index)].seed_says_sensitive},
+                         {"valid", c.valid},
+                         {"physical", c.physical},
+                         {"solved", c.solved}};
+    if (!c.reason.empty()) cj["reason"] = c.reason;
+    if (c.solved) {
       cj["short_circuit"] = tracked_json(c.short_modes);
       cj["open_circuit"] = tracked_json(c.open_modes);
       cj["c_static_change"] = c.c_static_change;

@@ -61,7 +61,12 @@ struct SensitivityJobResult {
   std::string model_class;
   nlohmann::json json;
 };
+struct SensitivityRequest {
+  double band_hz = model::SensitivityOptions{}.band_hz;
+  model::SensitivityForm form = model::SensitivityForm::d;  // --form d|engineering|e
+  bool seed_protocol = false;                                // --seed-protocol
+};
 // Throws InputError for bad study options.
-SensitivityJobResult run_sensitivity(ModelRequest req, double band_hz);
+SensitivityJobResult run_sensitivity(ModelRequest req, const SensitivityRequest& study);
 
 }  // namespace piezo::jobs

@@ -70,15 +70,25 @@ PiezoMatrices to_matrices(const PiezoMaterialE& m) {
   return r;
 }
 
-PiezoMaterialE to_e_form(const PiezoMaterialD& m) {
-  const char* fn = "to_e_form";
+namespace {
+// Eqs 8-12; `checked`: sE positive definite (LLT) and εS ≥ 0 required, else
+// any invertible sE (LU) and whatever εS follows.
+PiezoMaterialE e_form_of(const PiezoMaterialD& m, bool checked) {
+  const char* fn = checked ? "to_e_form" : "to_e_form_unchecked";
   if (!finite_all({m.s_e11, m.s_e12, m.s_e13, m.s_e33, m.s_e44, m.d31, m.d33, m.d15, m.eps_t11,
                    m.eps_t33}))
     fail(fn, "non-finite constant");
   auto dm = to_matrices(m);
-  Eigen::LLT<Eigen::Matrix<double, 6, 6>> llt(dm.elastic);
-  if (llt.info() != Eigen::Success) fail(fn, "compliance sE is not positive definite");
-  const Eigen::Matrix<double, 6, 6> c = llt.solve(Eigen::Matrix<double, 6, 6>::Identity());  // eq 8
+  Eigen::Matrix<double, 6, 6> c;
+  if (checked) {
+    Eigen::LLT<Eigen::Matrix<double, 6, 6>> llt(dm.elastic);
+    if (llt.info() != Eigen::Success) fail(fn, "compliance sE is not positive definite");
+    c = llt.solve(Eigen::Matrix<double, 6, 6>::Identity());  // eq 8
+  } else {
+    const Eigen::FullPivLU<Eigen::Matrix<double, 6, 6>> lu(dm.elastic);
+    if (!lu.isInvertible()) fail(fn, "compliance sE is singular");
+    c = lu.inverse();
+  }
   const Eigen::Matrix<double, 3, 6> e = dm.piezo * c;                                        // eq 9
   const Eigen::Matrix3d eps_s = dm.dielectric - dm.piezo * c * dm.piezo.transpose();        // eq 11
   PiezoMaterialE r;
@@ -94,10 +104,15 @@ PiezoMaterialE to_e_form(const PiezoMaterialD& m) {
   const double tiny = 1e-12 * m.eps_t33;
   r.eps_s11 = std::abs(eps_s(0, 0)) < tiny ? 0.0 : eps_s(0, 0);
   r.eps_s33 = eps_s(2, 2);
-  if (r.eps_s11 < 0 || !(r.eps_s33 > 0))
+  if (checked && (r.eps_s11 < 0 || !(r.eps_s33 > 0)))
     fail(fn, "clamped permittivity epsS = epsT − d·cE·dᵀ is negative (coupling factor > 1)");
   return r;
 }
+}  // namespace
+
+PiezoMaterialE to_e_form(const PiezoMaterialD& m) { return e_form_of(m, true); }
+
+PiezoMaterialE to_e_form_unchecked(const PiezoMaterialD& m) { return e_form_of(m, false); }
 
 PiezoMaterialD to_d_form(const PiezoMaterialE& m) {
   const char* fn = "to_d_form";
@@ -169,11 +184,16 @@ IsotropicPiezoParams isotropic_params(const PiezoMaterialD& m) {
   return {1.0 / m.s_e11, -m.s_e12 / m.s_e11, m.d31, m.eps_t33};
 }
 
-void validate(const PiezoMaterialE& m, const char* caller) {
+void validate_finite(const PiezoMaterialE& m, const char* caller) {
   const std::string fn = std::string(caller) + " (material)";
   if (!finite_all({m.c_e11, m.c_e12, m.c_e13, m.c_e33, m.c_e44, m.e31, m.e33, m.e15, m.eps_s11,
                    m.eps_s33}))
     fail(fn.c_str(), "non-finite constant");
+}
+
+void validate(const PiezoMaterialE& m, const char* caller) {
+  const std::string fn = std::string(caller) + " (material)";
+  validate_finite(m, caller);
   Eigen::Matrix4d c;  // axisymmetric block, strains (1, 2, 3, 5)
   c << m.c_e11, m.c_e12, m.c_e13, 0, m.c_e12, m.c_e11, m.c_e13, 0, m.c_e13, m.c_e13, m.c_e33, 0, 0,
       0, 0, m.c_e44;

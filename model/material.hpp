@@ -71,6 +71,11 @@ PiezoMatrices to_matrices(const PiezoMaterialE& m);
 // matrix is not positive definite, or the resulting permittivity is negative.
 PiezoMaterialE to_e_form(const PiezoMaterialD& m);
 PiezoMaterialD to_d_form(const PiezoMaterialE& m);
+// The same algebra without the physical checks: any invertible sE (LU), a
+// negative εS kept. Only for the seed's own non-physical perturbations
+// (Appendix C: sE13 doubled, εT33 halved), reported as such. Throws for a
+// singular sE or a non-finite constant.
+PiezoMaterialE to_e_form_unchecked(const PiezoMaterialD& m);
 
 EngineeringConstants engineering_constants(const PiezoMaterialD& m);
 // Compliances from engineering constants (eq. 13); piezo/dielectric left as in `base`.
@@ -87,6 +92,8 @@ IsotropicPiezoParams isotropic_params(const PiezoMaterialD& m);
 // positive definite, epsS33 > 0, epsS11 ≥ 0 (= 0 is the isotropic class, see
 // model/README.md for why K_ΦΦ stays non-singular). Throws std::invalid_argument.
 void validate(const PiezoMaterialE& m, const char* caller);
+// Only that every constant is finite (ModalSolver::set_physical_checks(false)).
+void validate_finite(const PiezoMaterialE& m, const char* caller);
 
 // The ten e-form parameters in a fixed order; the split matrices of the
 // assembler (seed eqs 234, 242, 245) are indexed the same way.

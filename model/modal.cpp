@@ -129,6 +129,11 @@ std::vector<double> ModalResult::active_frequencies_hz() const {
   return f;
 }
 
+void ModalSolver::check(const PiezoMaterialE& material, const char* caller) const {
+  if (physical_checks_) validate(material, caller);
+  else validate_finite(material, caller);
+}
+
 ModalSolver::ModalSolver(const TubeModel& model) : model_(&model), factor_(model) {
   m_uu_ = model.split().m;
   all_u_.resize(model.n_u());
@@ -136,7 +141,7 @@ ModalSolver::ModalSolver(const TubeModel& model) : model_(&model), factor_(model
 }
 
 double ModalSolver::clamped_capacitance(const PiezoMaterialE& material, Eigen::VectorXd* g) {
-  validate(material, "ModalSolver::clamped_capacitance");
+  check(material, "ModalSolver::clamped_capacitance");
   Eigen::VectorXd x;
   const double c0 = factor_.charge_for_unit_voltage(weights(material), all_u_, &x);
   if (g) *g = (factor_.matrix() * x).head(model_->n_u());  // g = K_UΦ [Φ_int; 1]
@@ -154,7 +159,7 @@ const SpMat& ModalSolver::mass(double f) {
 
 double ModalSolver::static_capacitance(const PiezoMaterialE& material,
                                        Eigen::VectorXd* u_static) {
-  validate(material, "ModalSolver::static_capacitance");
+  check(material, "ModalSolver::static_capacitance");
   return static_solve(material, m_uu_, u_static);
 }
 
@@ -184,7 +189,7 @@ double ModalSolver::static_solve(const PiezoMaterialE& material, const SpMat& ma
 
 ModalResult ModalSolver::solve(const PiezoMaterialE& material, Electrodes electrodes,
                                const ModalOptions& opt) {
-  validate(material, "ModalSolver::solve");
+  check(material, "ModalSolver::solve");
   opt.validate();
   g_modal_solves.fetch_add(1, std::memory_order_relaxed);  // model/work_counters.hpp
   const int nu = model_->n_u();
@@ -294,7 +299,8 @@ ModalPortModel ModalSolver::port_model(const PiezoMaterialE& material, const Mod
       if (half_model_) half_solver_ = std::make_unique<ModalSolver>(*half_model_);
     }
     if (half_solver_) {
-      validate(material, "ModalSolver::port_model");
+      check(material, "ModalSolver::port_model");
+      half_solver_->physical_checks_ = physical_checks_;
       opt.validate();
       return half_port_model(material, opt);
     }

@@ -107,7 +107,14 @@ class ModalSolver {
 
   const TubeModel& model() const { return *model_; }
 
+  // Off: a material outside the physical domain (cE not positive definite,
+  // εS33 ≤ 0) is solved as it is, finite constants only — the seed's own
+  // non-physical perturbations of Appendix C (model/sensitivity.hpp), whose
+  // results are flagged there. On by default; every other caller keeps it on.
+  void set_physical_checks(bool on) { physical_checks_ = on; }
+
  private:
+  void check(const PiezoMaterialE& material, const char* caller) const;
   // M + f·ΔM (cached for the last f).
   const SpMat& mass(double end_mass_fraction);
   // Static solve for V = 1 with the rigid translation fixed; u_static is made
@@ -122,6 +129,7 @@ class ModalSolver {
   std::unique_ptr<TubeModel> half_model_;     // built on first use (mirror_symmetry)
   std::unique_ptr<ModalSolver> half_solver_;
   bool half_tried_ = false;
+  bool physical_checks_ = true;
   SpMat m_uu_, k_uu_;
   SpMat m_loaded_;
   double m_loaded_fraction_ = -1.0;

@@ -69,6 +69,26 @@ std::vector<TrackedMode> track(const ModalResult& nominal, const std::vector<int
   return out;
 }
 
+// Parameter `index` of `form` scaled by `factor`, in the d form (the d and
+// engineering forms) — the FE model's e form follows by to_e_form.
+PiezoMaterialD scaled_d(const PiezoMaterialD& base, SensitivityForm form, int index, double factor) {
+  PiezoMaterialD m = base;
+  if (form == SensitivityForm::engineering && index < 5) {
+    EngineeringConstants ec = engineering_constants(base);
+    double* field[5] = {&ec.y_e11, &ec.y_e33, &ec.nu12, &ec.nu13, &ec.g};
+    *field[index] *= factor;
+    return with_engineering_constants(base, ec);
+  }
+  d_param(m, static_cast<DParam>(index)) *= factor;  // the d form, and the engineering form's last five
+  return m;
+}
+
+double& e_param(PiezoMaterialE& m, int index) {
+  double* field[kNumDParams] = {&m.c_e11, &m.c_e12, &m.c_e13, &m.c_e33, &m.c_e44,
+                                &m.e31,   &m.e33,   &m.e15,   &m.eps_s11, &m.eps_s33};
+  return *field[index];
+}
+
 }  // namespace
 
 const char* d_param_name(DParam p) {
@@ -107,6 +127,48 @@ bool seed_says_sensitive(DParam p) {
   return p == DParam::s_e11 || p == DParam::s_e12 || p == DParam::d31 || p == DParam::eps_t33;
 }
 
+const char* to_string(SensitivityForm f) {
+  switch (f) {
+    case SensitivityForm::d:
+      return "d";
+    case SensitivityForm::engineering:
+      return "engineering";
+    case SensitivityForm::e:
+      return "e";
+  }
+  return "?";
+}
+
+const std::vector<SensitivityParam>& sensitivity_params(SensitivityForm f) {
+  using G = ParamGroup;
+  static const std::vector<SensitivityParam> d = {
+      {"sE11", G::elastic, true},  {"sE12", G::elastic, true},        {"sE13", G::elastic, false},
+      {"sE33", G::elastic, false}, {"sE44", G::elastic, false},       {"d31", G::piezoelectric, true},
+      {"d33", G::piezoelectric, false}, {"d15", G::piezoelectric, false}, {"epsT11", G::dielectric, false},
+      {"epsT33", G::dielectric, true}};
+  static const std::vector<SensitivityParam> eng = {
+      {"YE11", G::elastic, true},  {"YE33", G::elastic, false},       {"nu12", G::elastic, true},
+      {"nu13", G::elastic, false}, {"G", G::elastic, false},          {"d31", G::piezoelectric, true},
+      {"d33", G::piezoelectric, false}, {"d15", G::piezoelectric, false}, {"epsT11", G::dielectric, false},
+      {"epsT33", G::dielectric, true}};
+  static const std::vector<SensitivityParam> e = {
+      {"cE11", G::elastic, true},  {"cE12", G::elastic, true},        {"cE13", G::elastic, true},
+      {"cE33", G::elastic, true},  {"cE44", G::elastic, false},       {"e31", G::piezoelectric, true},
+      {"e33", G::piezoelectric, true}, {"e15", G::piezoelectric, false}, {"epsS11", G::dielectric, false},
+      {"epsS33", G::dielectric, true}};
+  switch (f) {
+    case SensitivityForm::d:
+      return d;
+    case SensitivityForm::engineering:
+      return eng;
+    case SensitivityForm::e:
+      return e;
+  }
+  throw std::invalid_argument("sensitivity_params: unknown form");
+}
+
+double seed_factor(ParamGroup g) { return g == ParamGroup::elastic ? 2.0 : 0.5; }
+
 void SensitivityOptions::validate() const {
   const std::string fn = "SensitivityOptions::validate: ";
   if (!(band_hz > 0) || !std::isfinite(band_hz))
@@ -135,9 +197,10 @@ int SensitivityResult::valid_cases(DParam p) const {
   return n;
 }
 
-SensitivityResult d_form_sensitivity(const TubeGeometry& geometry, const PiezoMaterialD& material,
-                                     const SensitivityOptions& options) {
-  const char* fn = "d_form_sensitivity";
+namespace {
+
+SensitivityResult study(const TubeGeometry& geometry, const PiezoMaterialD& material,
+                        const SensitivityOptions& options, const char* fn) {
   options.validate();
   geometry.validate();
   PiezoMaterialE nominal_e;
@@ -156,30 +219,64 @@ SensitivityResult d_form_sensitivity(const TubeGeometry& geometry, const PiezoMa
   const auto sc0_active = active_in_band(sc0, band), oc0_active = active_in_band(oc0, band);
   res.nominal = {frequencies(sc0, sc0_active), frequencies(oc0, oc0_active),
                  solver.static_capacitance(nominal_e)};
-  for (int i = 0; i < kNumDParams; ++i) {
-    const auto p = static_cast<DParam>(i);
-    for (double factor : options.factors) {
+  const auto& params = sensitivity_params(options.form);
+  for (int i = 0; i < static_cast<int>(params.size()); ++i) {
+    const std::vector<double> factors =
+        options.seed_protocol ? std::vector<double>{seed_factor(params[static_cast<std::size_t>(i)].group)}
+                              : options.factors;
+    for (double factor : factors) {
       SensitivityCase c;
-      c.param = p;
+      c.param = static_cast<DParam>(i);
+      c.index = i;
+      c.name = params[static_cast<std::size_t>(i)].name;
       c.factor = factor;
-      PiezoMaterialD m = material;
-      d_param(m, p) *= factor;
       PiezoMaterialE e;
       try {  // e.g. sE11 halved: sE not positive definite; d31 doubled: coupling > 1
-        e = to_e_form(m);
+        if (options.form == SensitivityForm::e) {
+          e = nominal_e;
+          e_param(e, i) *= factor;
+        } else {
+          e = to_e_form(scaled_d(material, options.form, i, factor));
+        }
         validate(e, fn);
       } catch (const std::invalid_argument& ex) {
+        c.physical = false;
         c.reason = ex.what();
+        if (!options.seed_protocol) {
+          res.cases.push_back(std::move(c));
+          continue;
+        }
+        try {  // the seed solved it anyway: so do we, flagged
+          if (options.form != SensitivityForm::e) e = to_e_form_unchecked(scaled_d(material, options.form, i, factor));
+          validate_finite(e, fn);
+        } catch (const std::invalid_argument& ex2) {
+          c.reason += std::string("; not solvable either: ") + ex2.what();
+          res.cases.push_back(std::move(c));
+          continue;
+        }
+      }
+      solver.set_physical_checks(c.physical);
+      // A non-physical case's non-convergence is its own (its reason), not the study's.
+      SensitivityResult scratch;
+      SensitivityResult& book = c.physical ? res : scratch;
+      try {
+        const auto sc = modes_up_to(solver, e, Electrodes::short_circuit, reach, options, book);
+        const auto oc = modes_up_to(solver, e, Electrodes::open_circuit, reach, options, book);
+        c.perturbed = {frequencies(sc, active_in_band(sc, band)),
+                       frequencies(oc, active_in_band(oc, band)), solver.static_capacitance(e)};
+        c.short_modes = track(sc0, sc0_active, sc, tm.split().m);
+        c.open_modes = track(oc0, oc0_active, oc, tm.split().m);
+      } catch (const std::exception& ex) {  // a non-physical material the solver cannot take
+        solver.set_physical_checks(true);
+        if (c.physical) throw;
+        c.reason += std::string("; its FE solve failed: ") + ex.what();
         res.cases.push_back(std::move(c));
         continue;
       }
-      c.valid = true;
-      const auto sc = modes_up_to(solver, e, Electrodes::short_circuit, reach, options, res);
-      const auto oc = modes_up_to(solver, e, Electrodes::open_circuit, reach, options, res);
-      c.perturbed = {frequencies(sc, active_in_band(sc, band)),
-                     frequencies(oc, active_in_band(oc, band)), solver.static_capacitance(e)};
-      c.short_modes = track(sc0, sc0_active, sc, tm.split().m);
-      c.open_modes = track(oc0, oc0_active, oc, tm.split().m);
+      solver.set_physical_checks(true);
+      if (!scratch.converged) c.reason += "; its modal solve did not converge: " + scratch.message;
+      c.solved = true;
+      c.valid = c.physical;
       c.c_static_change = c.perturbed.c_static_f / res.nominal.c_static_f - 1.0;
       c.max_abs_change = std::abs(c.c_static_change);
       for (const auto* v : {&c.short_modes, &c.open_modes})
@@ -191,6 +288,20 @@ SensitivityResult d_form_sensitivity(const TubeGeometry& geometry, const PiezoMa
     }
   }
   return res;
+}
+
+}  // namespace
+
+SensitivityResult d_form_sensitivity(const TubeGeometry& geometry, const PiezoMaterialD& material,
+                                     const SensitivityOptions& options) {
+  SensitivityOptions o = options;
+  o.form = SensitivityForm::d;
+  return study(geometry, material, o, "d_form_sensitivity");
+}
+
+SensitivityResult form_sensitivity(const TubeGeometry& geometry, const PiezoMaterialD& material,
+                                   const SensitivityOptions& options) {
+  return study(geometry, material, options, "form_sensitivity");
 }
 
 }  // namespace piezo::model

@@ -1,6 +1,6 @@
 #pragma once
-// Seed Appendix C.1: how much each d-form constant moves the tube's electrical
-// behaviour. Each of the ten constants is scaled (doubled and halved) alone and
+// Seed Appendix C (C.1 d form, C.2 e form): how much each constant moves the
+// tube's electrical behaviour. Each of the ten constants is scaled (doubled and halved) alone and
 // the FE model re-solved: the relative change of every electrically active
 // short-circuit frequency in the band (Tables C.1 / C.3 plot 0-200 kHz), of
 // the active open-circuit (anti-resonance) frequencies and of the static
@@ -25,6 +25,26 @@ double& d_param(PiezoMaterialD& m, DParam p);
 // The four the seed (eq 16) calls sensitive: sE11, sE12, d31, εT33.
 bool seed_says_sensitive(DParam p);
 
+// Appendix C's three parameterisations of the same material, ten constants each:
+//   d            sE11 sE12 sE13 sE33 sE44 d31 d33 d15 εT11 εT33 (Tables C.1, C.3)
+//   engineering  YE11 YE33 ν12 ν13 G (sE13 = −ν13/YE33, eq 13) and the d-form's
+//                piezoelectric and dielectric five (Table C.2)
+//   e            cE11 cE12 cE13 cE33 cE44 e31 e33 e15 εS11 εS33 (Tables C.4, C.5)
+enum class SensitivityForm { d, engineering, e };
+const char* to_string(SensitivityForm f);  // "d", "engineering", "e"
+enum class ParamGroup { elastic, piezoelectric, dielectric };
+struct SensitivityParam {
+  const char* name;
+  ParamGroup group;
+  // The seed's reading: d and engineering forms, eq 16 (sE11/YE11, sE12/ν12,
+  // d31, εT33); e form, §C.2 (cE11, cE12, cE13, cE33, e31, e33, εS33).
+  bool seed_says_sensitive;
+};
+const std::vector<SensitivityParam>& sensitivity_params(SensitivityForm f);
+// The seed's own factor for a group: elastic doubled, piezoelectric and
+// dielectric halved (Appendix C's text).
+double seed_factor(ParamGroup g);
+
 struct SensitivityOptions {
   double band_hz = 200e3;  // upper band edge (Tables C.1, C.3: 0-200 kHz)
   std::vector<double> factors = {2.0, 0.5};
@@ -37,6 +57,12 @@ struct SensitivityOptions {
   // Perturbed modes are computed up to track_margin × band_hz, so a nominal mode
   // that a change pushes above the band edge is still found.
   double track_margin = 1.5;
+  SensitivityForm form = SensitivityForm::d;
+  // The seed's protocol: each constant scaled by seed_factor of its group only
+  // (`factors` unused), and a scaled material outside the physical domain
+  // solved as it is (ModalSolver::set_physical_checks(false)) and flagged,
+  // as the seed did (sE13 doubled, εT33 halved), instead of refused.
+  bool seed_protocol = false;
   void validate() const;  // throws std::invalid_argument
 };
 
@@ -60,9 +86,13 @@ struct TrackedMode {
 };
 
 struct SensitivityCase {
-  DParam param = DParam::s_e11;
+  DParam param = DParam::s_e11;  // the d form's; index into sensitivity_params(form) for every form
+  int index = 0;
+  std::string name;              // sensitivity_params(form)[index].name
   double factor = 1;
-  bool valid = false;  // false: the scaled material is not physical (reason says why)
+  bool valid = false;  // physical and solved (the numbers below describe a real material)
+  bool physical = true;   // false: the scaled material is outside the physical domain (reason says why)
+  bool solved = false;    // the numbers below are filled (a non-physical case only with seed_protocol)
   std::string reason;
   ElectricalSignature perturbed;
   std::vector<TrackedMode> short_modes, open_modes;  // one per nominal active mode
@@ -84,7 +114,11 @@ struct SensitivityResult {
 
 // Throws std::invalid_argument (naming the function) for an invalid nominal
 // material or geometry; a scaled material that is not physical is a case with
-// valid = false, not an exception.
+// valid = false, not an exception (solved and flagged with seed_protocol).
+// `material` is the d form; options.form chooses what is scaled.
+SensitivityResult form_sensitivity(const TubeGeometry& geometry, const PiezoMaterialD& material,
+                                   const SensitivityOptions& options = {});
+// form_sensitivity with the d form (Tables C.1, C.3).
 SensitivityResult d_form_sensitivity(const TubeGeometry& geometry, const PiezoMaterialD& material,
                                      const SensitivityOptions& options = {});
 

@@ -14,7 +14,7 @@ const std::vector<std::string_view>& internal_function_names() {
       "debye_network_for_loss", "deskew_channel", "deskew_impedance", "deskew_record", "element_split",
       "eps_s33_from", "eps_t33_from_low_z", "estimate_noise_std", "extract_features", "find_features",
       "find_preset", "fit_admittance_circle", "fit_bvd", "fit_equivalent_circuit", "fit_fixture", "fit_gap",
-      "fit_output_error", "fit_port_model", "fit_prony_charge", "forward_difference_jacobian",
+      "fit_output_error", "fit_port_model", "fit_prony_charge", "form_sensitivity", "forward_difference_jacobian",
       "frequency_grid", "gauss_legendre", "impedance_fft", "impedance_from_charge", "impedance_prony",
       "impedance_shot_ensemble", "impedance_stepped_sine", "impedance_xspec", "kramers_kronig_check",
       "largest_drop_order", "levenberg_marquardt", "lock_in", "lossy_capacitance", "make_grid",
@@ -24,7 +24,7 @@ const std::vector<std::string_view>& internal_function_names() {
       "prony_ss", "rayleigh_fit", "rayleigh_from_damping", "rayleigh_from_two_modes", "read_impedance_file",
       "read_impedance_table", "recorded_transfer", "render_raster", "render_svg", "reported_impedance",
       "run_measurement", "scan_effects", "select_order", "select_shard", "solve_tsvd",
-      "stabilization_chart", "to_d_form", "to_e_form", "update_cmcm",
+      "stabilization_chart", "to_d_form", "to_e_form", "to_e_form_unchecked", "update_cmcm",
       "update_lm", "vector_fit", "write_impedance_csv", "write_touchstone_s1p", "xcorr_delay"};
   return names;
 }

@@ -77,3 +77,23 @@ TEST(CmdModel, SensitivityJsonHasEveryConstantTwice) {
   EXPECT_NEAR(j["cases"][18]["c_static_change"].get<double>(), 1.0, 0.01);
   EXPECT_EQ(run("model sensitivity --band -5").code, 2);
 }
+
+TEST(CmdModel, SensitivitySeedProtocolFlagsWhatItSolvesOutsideThePhysicalDomain) {
+  auto r = run("model sensitivity --material apc850 --form e --seed-protocol --json");
+  ASSERT_EQ(r.code, 0) << r.out;
+  auto j = nlohmann::json::parse(r.out);
+  EXPECT_EQ(j["form"], "e");
+  EXPECT_TRUE(j["seed_protocol"].get<bool>());
+  ASSERT_EQ(j["cases"].size(), 10u);  // the seed's factor only: elastic x2, piezoelectric and dielectric x0.5
+  int flagged = 0;
+  for (const auto& c : j["cases"]) {
+    EXPECT_TRUE(c["solved"].get<bool>()) << c.dump();
+    if (!c["physical"].get<bool>()) {
+      ++flagged;
+      EXPECT_FALSE(c["valid"].get<bool>());
+      EXPECT_FALSE(c["reason"].get<std::string>().empty());
+    }
+  }
+  EXPECT_EQ(flagged, 1);  // cE13 doubled: cE not positive definite
+  EXPECT_EQ(run("model sensitivity --form q").code, 2);
+}

@@ -166,3 +166,97 @@ TEST(Sensitivity, PairingByShapeAndPreconditions) {
     EXPECT_NE(std::string(e.what()).find("d_form_sensitivity"), std::string::npos);
   }
 }
+
+// Seed Appendix C's other parameterisations and its own protocol (APC850).
+namespace {
+
+SensitivityResult run_form(SensitivityForm form, bool seed_protocol) {
+  const auto& p = find_preset("apc850");
+  TubeGeometry g;
+  g.density_kg_m3 = p.density_kg_m3;
+  SensitivityOptions o;
+  o.form = form;
+  o.seed_protocol = seed_protocol;
+  return form_sensitivity(g, p.material, o);
+}
+
+const SensitivityCase& find_case(const SensitivityResult& r, const std::string& name, double factor) {
+  for (const auto& c : r.cases)
+    if (c.name == name && c.factor == factor) return c;
+  throw std::runtime_error("no case " + name);
+}
+
+void expect_same(const SensitivityCase& a, const SensitivityCase& b) {
+  ASSERT_TRUE(a.solved && b.solved) << a.name << " / " << b.name;
+  ASSERT_EQ(a.short_modes.size(), b.short_modes.size());
+  ASSERT_EQ(a.open_modes.size(), b.open_modes.size());
+  for (std::size_t k = 0; k < a.short_modes.size(); ++k)
+    EXPECT_NEAR(a.short_modes[k].perturbed_hz, b.short_modes[k].perturbed_hz, 1e-7 * b.short_modes[k].perturbed_hz);
+  for (std::size_t k = 0; k < a.open_modes.size(); ++k)
+    EXPECT_NEAR(a.open_modes[k].perturbed_hz, b.open_modes[k].perturbed_hz, 1e-7 * b.open_modes[k].perturbed_hz);
+  EXPECT_NEAR(a.perturbed.c_static_f, b.perturbed.c_static_f, 1e-9 * std::abs(b.perturbed.c_static_f));
+}
+
+// "Matters" as above (kMatters), over the physical cases of each constant.
+void expect_seed_reading(const SensitivityResult& r, SensitivityForm form) {
+  const auto& params = sensitivity_params(form);
+  for (std::size_t i = 0; i < params.size(); ++i) {
+    double m = 0;
+    int valid = 0;
+    for (const auto& c : r.cases)
+      if (c.index == static_cast<int>(i) && c.valid) {
+        m = std::max(m, c.max_abs_change);
+        ++valid;
+      }
+    ASSERT_GT(valid, 0) << params[i].name;
+    if (params[i].seed_says_sensitive) {
+      EXPECT_GT(m, kMatters) << params[i].name;
+    } else {
+      EXPECT_LT(m, kMatters) << params[i].name;
+    }
+  }
+}
+
+}  // namespace
+
+TEST(Sensitivity, EngineeringFormCoincidesWithTheDFormWhereTheAlgebraSays) {
+  // sE12 = −ν12/YE11 and sE13 = −ν13/YE33 (eq 13), sE44 = 1/G: scaling ν12 or
+  // ν13 scales sE12 or sE13 alone, and G × 2 is sE44 × ½ — the same material,
+  // so the same FE numbers (to the solver's tolerance).
+  const auto d = run_form(SensitivityForm::d, true), eng = run_form(SensitivityForm::engineering, true);
+  expect_same(find_case(eng, "nu12", 2.0), find_case(d, "sE12", 2.0));
+  expect_same(find_case(eng, "nu13", 2.0), find_case(d, "sE13", 2.0));  // both outside the physical domain
+  const auto d_half = run_form(SensitivityForm::d, false);
+  expect_same(find_case(eng, "G", 2.0), find_case(d_half, "sE44", 0.5));
+}
+
+TEST(Sensitivity, EngineeringAndEFormsReadAsTheSeedSays) {
+  // App. C.1 (Table C.2): only YE11 and ν12 of the five engineering constants
+  // move the impedance; App. C.2: cE11, cE12, cE13, cE33, e31, e33 and εS33 all
+  // do, cE44, e15 and εS11 not. Doubled and halved, physical cases only.
+  expect_seed_reading(run_form(SensitivityForm::engineering, false), SensitivityForm::engineering);
+  expect_seed_reading(run_form(SensitivityForm::e, false), SensitivityForm::e);
+}
+
+TEST(Sensitivity, SeedProtocolSolvesAndFlagsTheNonPhysicalMaterials) {
+  const auto r = run_form(SensitivityForm::d, true);
+  ASSERT_EQ(r.cases.size(), 10u);  // one factor per constant: elastic x2, piezoelectric and dielectric x0.5
+  EXPECT_TRUE(r.converged) << r.message;
+  for (const auto& c : r.cases) {
+    EXPECT_EQ(c.factor, seed_factor(sensitivity_params(SensitivityForm::d)[static_cast<std::size_t>(c.index)].group));
+    EXPECT_TRUE(c.solved) << c.name << ": " << c.reason;
+    const bool seed_ran_non_physical = c.name == "sE13" || c.name == "epsT33";
+    EXPECT_EQ(c.physical, !seed_ran_non_physical) << c.name;
+    EXPECT_EQ(c.valid, c.physical) << c.name;
+    if (!c.physical) {
+      EXPECT_FALSE(c.reason.empty());
+    }
+    EXPECT_TRUE(std::isfinite(c.max_abs_change)) << c.name;
+  }
+  // εT33 halved: the free thin tube's capacitance is εT33·2πR̄L/t to the
+  // thin-wall order, so C_static halves (measured −50.20 %; εT33 doubled,
+  // a physical case, gives +100.2 %: the same 0.2 % from the wall's thickness).
+  EXPECT_NEAR(find_case(r, "epsT33", 0.5).c_static_change, -0.5, 0.01);
+  // sE13 doubled, outside the domain, still moves nothing beyond 1 % (the seed's reading of Table C.1).
+  EXPECT_LT(find_case(r, "sE13", 2.0).max_abs_change, kMatters);
+}

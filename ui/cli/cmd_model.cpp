@@ -2,12 +2,14 @@
 //   model materials                      presets and their sources
 //   model modal     --material M [--isotropic] [--set k=v,…] [--modes N] [--json]
 //   model impedance --material M --fmin HZ --fmax HZ --step HZ [--rayleigh-beta S] [--csv|--json]
-//   model sensitivity [--material M] [--band HZ] [--json]   (Appendix C.1, model/sensitivity.hpp)
+//   model sensitivity [--material M] [--band HZ] [--form d|engineering|e] [--seed-protocol] [--json]
+//                                                            (Appendix C, model/sensitivity.hpp)
 //   model mode-shape-cmcm [--json] …                         (Appendix D, cmd_model_mode_shape.cpp)
 // Exit codes: 0 ok, 2 bad input (unknown material, bad --set), 1 non-convergence
 // or internal failure. The CLI's room (ui/cli): options and printing; the
 // model work is jobs/model_job.hpp.
 #include <cstdio>
+#include <map>
 #include <string>
 #include <vector>
 
@@ -90,36 +92,44 @@ std::string percent_list(const std::vector<model::TrackedMode>& v) {
   return s;
 }
 
-void run_sensitivity(Context& ctx, const ModelRequest& a, double band_hz) {
-  const auto study = jobs::run_sensitivity(a, band_hz);
+void run_sensitivity(Context& ctx, const ModelRequest& a, const jobs::SensitivityRequest& req) {
+  const auto study = jobs::run_sensitivity(a, req);
   const auto& res = study.result;
+  const auto& params = model::sensitivity_params(req.form);
+  const double band_hz = req.band_hz;
   if (ctx.json) {
     print_json(study.json);
   } else {
-    std::printf("%s (%s class), mesh %d x %d, active modes below %.0f Hz; each d-form constant "
-                "scaled alone\n",
-                a.material.c_str(), study.model_class.c_str(), a.n_radial, a.n_axial, band_hz);
+    std::printf("%s (%s class), mesh %d x %d, active modes below %.0f Hz; each %s-form constant "
+                "scaled alone%s\n",
+                a.material.c_str(), study.model_class.c_str(), a.n_radial, a.n_axial, band_hz,
+                model::to_string(req.form),
+                req.seed_protocol ? " by the seed's factor (elastic x2, piezoelectric and dielectric x0.5), "
+                                    "non-physical materials solved and flagged (!)"
+                                  : "");
     std::printf("nominal: short");
     for (double f : res.nominal.short_hz) std::printf(" %.1f", f);
     std::printf(" Hz | open");
     for (double f : res.nominal.open_hz) std::printf(" %.1f", f);
     std::printf(" Hz | C_static %.5g F\n", res.nominal.c_static_f);
     std::printf("relative change [%%] of each nominal active mode (followed by shape, MAC) and of "
-                "C_static; * = sensitive per seed eq 16\n");
+                "C_static; * = sensitive per the seed (%s)\n",
+                req.form == model::SensitivityForm::e ? "App. C.2" : "eq 16");
     std::printf("  %-8s %-6s | %-*s | %-*s | %9s | %8s | %5s\n", "param", "factor",
                 static_cast<int>(9 * res.nominal.short_hz.size()), "short circuit",
                 static_cast<int>(9 * res.nominal.open_hz.size()), "open circuit", "C_static",
                 "max", "MAC");
     for (const auto& c : res.cases) {
-      std::printf("%c %-8s x%-5g | ", model::seed_says_sensitive(c.param) ? '*' : ' ',
-                  model::d_param_name(c.param), c.factor);
-      if (!c.valid) {
+      std::printf("%c %-8s x%-5g | ", params[static_cast<std::size_t>(c.index)].seed_says_sensitive ? '*' : ' ',
+                  c.name.c_str(), c.factor);
+      if (!c.solved) {
         std::printf("not physical: %s\n", c.reason.c_str());
         continue;
       }
       std::printf("%s | %s | %+9.3f | %8.3f | %5.3f\n", percent_list(c.short_modes).c_str(),
                   percent_list(c.open_modes).c_str(), 100 * c.c_static_change,
                   100 * c.max_abs_change, c.min_mac);
+      if (!c.physical) std::printf("    ! not physical, solved as the seed did: %s\n", c.reason.c_str());
     }
   }
   if (!res.converged) {
@@ -178,15 +188,25 @@ void register_model_command(CLI::App& app, Context& ctx) {
   });
 
   auto sens_args = std::make_shared<ModelRequest>();
-  auto band = std::make_shared<double>(piezo::model::SensitivityOptions{}.band_hz);
+  auto sreq = std::make_shared<jobs::SensitivityRequest>();
   auto* sens = model->add_subcommand(
-      "sensitivity", "Seed Appendix C.1: each d-form constant doubled and halved");
+      "sensitivity", "Seed Appendix C: each constant doubled and halved (d, engineering or e form)");
   add_model_options(sens, *sens_args);
-  sens->add_option("--band", *band, "Upper band edge [Hz] (seed Tables C.1, C.3: 200 kHz)")
+  sens->add_option("--band", sreq->band_hz, "Upper band edge [Hz] (seed Tables C.1, C.3: 200 kHz)")
       ->capture_default_str();
+  const std::map<std::string, model::SensitivityForm> forms = {{"d", model::SensitivityForm::d},
+                                                               {"engineering", model::SensitivityForm::engineering},
+                                                               {"e", model::SensitivityForm::e}};
+  sens->add_option("--form", sreq->form,
+                   "Which ten constants: d (Tables C.1, C.3), engineering (YE11 YE33 nu12 nu13 G; C.2), e (C.4, C.5)")
+      ->transform(CLI::CheckedTransformer(forms, CLI::ignore_case))
+      ->default_str("d");
+  sens->add_flag("--seed-protocol", sreq->seed_protocol,
+                 "The seed's factors (elastic x2, piezoelectric and dielectric x0.5); a non-physical material "
+                 "(sE13 x2, epsT33 x0.5) solved and flagged, as the seed did, instead of refused");
   add_json_flag(sens, ctx);
-  sens->callback([&ctx, sens_args, band] {
-    ctx.exit_code = run_command(ctx, [&] { run_sensitivity(ctx, *sens_args, *band); });
+  sens->callback([&ctx, sens_args, sreq] {
+    ctx.exit_code = run_command(ctx, [&] { run_sensitivity(ctx, *sens_args, *sreq); });
   });
 
   register_mode_shape_command(model, ctx);
