@@ -35,6 +35,7 @@ test-asan: deps
 	      -DPIEZO_BUILD_BENCH=OFF -DPIEZO_WERROR=ON $(CMAKEFLAGS)
 	cmake --build $(ASAN) -j$(JOBS)
 	cd $(ASAN) && ASAN_OPTIONS=detect_leaks=1 UBSAN_OPTIONS=print_stacktrace=1 \
+	      LSAN_OPTIONS=suppressions=$(CURDIR)/scripts/lsan-suppressions.txt \
 	      ctest --output-on-failure -j$(JOBS) -LE validate
 
 bench: build
