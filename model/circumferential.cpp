@@ -9,6 +9,10 @@
 #include <stdexcept>
 #include <string>
 
+#include <Spectra/MatOp/DenseSymMatProd.h>
+#include <Spectra/MatOp/SymShiftInvert.h>
+#include <Spectra/SymGEigsShiftSolver.h>
+
 #include "model/element.hpp"
 
 namespace piezo::model {
@@ -199,6 +203,46 @@ Blocks assemble(const TubeMesh& mesh, const Numbering& nb, const TubeGeometry& g
   return bl;
 }
 
+// The modes up to f_max by shift-invert Lanczos (σ below the rigid motions,
+// so K − σM is positive definite), growing the count until one lies above
+// f_max. False: not asked for, too small, or not converged (→ dense).
+bool lanczos(const Eigen::MatrixXd& k, const Eigen::MatrixXd& m, double f_max, Eigen::VectorXd& lam,
+             Eigen::MatrixXd& vec) {
+  const Eigen::Index n = k.rows();
+  if (!(f_max > 0) || n < 200) return false;
+  const double sigma = -std::pow(2.0 * M_PI * 1000.0, 2);
+  const double lam_max = std::pow(2.0 * M_PI * f_max, 2);
+  using Op = Spectra::SymShiftInvert<double, Eigen::Dense, Eigen::Dense>;
+  using BOp = Spectra::DenseSymMatProd<double>;
+  Op op(k, m);
+  BOp bop(m);
+  for (Eigen::Index nev = 16; nev < n / 2; nev *= 2) {
+    const Eigen::Index ncv = std::min<Eigen::Index>(n, 2 * nev + 1);
+    Spectra::SymGEigsShiftSolver<Op, BOp, Spectra::GEigsMode::ShiftInvert> eigs(op, bop, nev, ncv, sigma);
+    eigs.init();
+    eigs.compute(Spectra::SortRule::LargestMagn, 1000, 1e-10);
+    if (eigs.info() != Spectra::CompInfo::Successful) return false;
+    const Eigen::VectorXd l = eigs.eigenvalues();
+    if (l.maxCoeff() > lam_max) {
+      std::vector<Eigen::Index> order(static_cast<std::size_t>(l.size()));
+      std::iota(order.begin(), order.end(), Eigen::Index{0});
+      std::sort(order.begin(), order.end(), [&](Eigen::Index a, Eigen::Index b) { return l[a] < l[b]; });
+      const Eigen::MatrixXd v = eigs.eigenvectors();
+      Eigen::Index keep = 0;  // those up to f_max and the first above it
+      while (keep < l.size() && l[order[static_cast<std::size_t>(keep)]] <= lam_max) ++keep;
+      keep = std::min<Eigen::Index>(keep + 1, l.size());
+      lam.resize(keep);
+      vec.resize(n, keep);
+      for (Eigen::Index j = 0; j < keep; ++j) {
+        lam[j] = l[order[static_cast<std::size_t>(j)]];
+        vec.col(j) = v.col(order[static_cast<std::size_t>(j)]);
+      }
+      return true;
+    }
+  }
+  return false;
+}
+
 }  // namespace
 
 const char* to_string(HarmonicFamily f) {
@@ -208,6 +252,7 @@ const char* to_string(HarmonicFamily f) {
 void CircumferentialOptions::validate() const {
   if (n < 0 || n > 64) fail("harmonic n must lie in 0 … 64, got " + std::to_string(n));
   if (gauss_points < 2 || gauss_points > 4) fail("gauss_points must be 2 … 4");
+  if (!(max_frequency_hz >= 0) || !std::isfinite(max_frequency_hz)) fail("max_frequency_hz must be finite and >= 0");
   mesh.validate();
 }
 
@@ -271,12 +316,16 @@ CircumferentialResult circumferential_modes(const TubeGeometry& geometry, const 
   }
   if (n0cos) res.c_clamped = -kvv;
 
-  Eigen::GeneralizedSelfAdjointEigenSolver<Eigen::MatrixXd> ges(kc, bl.m);
-  if (ges.info() != Eigen::Success)
-    throw std::runtime_error("circumferential_modes: the dense eigensolver failed (harmonic " +
-                             std::to_string(options.n) + "); try another mesh");
-  const Eigen::VectorXd& lam = ges.eigenvalues();  // ascending, φᵀMφ = 1
-  const Eigen::MatrixXd& vec = ges.eigenvectors();
+  Eigen::VectorXd lam;  // ascending, φᵀMφ = 1
+  Eigen::MatrixXd vec;
+  if (!lanczos(kc, bl.m, options.max_frequency_hz, lam, vec)) {
+    Eigen::GeneralizedSelfAdjointEigenSolver<Eigen::MatrixXd> ges(kc, bl.m);
+    if (ges.info() != Eigen::Success)
+      throw std::runtime_error("circumferential_modes: the dense eigensolver failed (harmonic " +
+                               std::to_string(options.n) + "); try another mesh");
+    lam = ges.eigenvalues();
+    vec = ges.eigenvectors();
+  }
   // Rigid motions: |ω²| far below the elastic scale (√(cE11/ρ)/L)².
   const double scale = material.c_e11 / geometry.density_kg_m3 / std::pow(geometry.length_m, 2);
   if (keep_shapes) res.shapes.resize(nb.n_u, lam.size());

@@ -181,3 +181,20 @@ TEST(Circumferential, BadInputIsNamed) {
     EXPECT_NE(std::string(e.what()).find("dense limit"), std::string::npos) << e.what();
   }
 }
+
+TEST(Circumferential, LanczosBelowAFrequencyMatchesTheDenseSpectrum) {
+  // The fast path (modes up to f_max) against the dense reference, n = 2.
+  CircumferentialOptions o;
+  o.n = 2;
+  const auto dense = circumferential_modes(TubeGeometry{}, apc850(), o);
+  o.max_frequency_hz = 120e3;
+  const auto fast = circumferential_modes(TubeGeometry{}, apc850(), o);
+  ASSERT_GT(fast.modes.size(), 3u);
+  EXPECT_GT(fast.modes.back().frequency_hz, 120e3);
+  EXPECT_LT(fast.modes.size(), dense.modes.size());
+  for (std::size_t k = 0; k < fast.modes.size(); ++k) {
+    EXPECT_NEAR(fast.modes[k].frequency_hz / dense.modes[k].frequency_hz - 1.0, 0.0, 1e-9) << k;
+    EXPECT_NEAR(fast.modes[k].radial_share, dense.modes[k].radial_share, 1e-6) << k;
+    EXPECT_EQ(fast.modes[k].symmetric, dense.modes[k].symmetric) << k;
+  }
+}
