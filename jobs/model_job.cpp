@@ -68,6 +68,11 @@ nlohmann::json tracked_json(const std::vector<pm::TrackedMode>& v) {
 
 }  // namespace
 
+ResolvedModel resolve_model(ModelRequest& req) {
+  auto r = resolve(req);
+  return {r.material, std::move(r.model_class), std::move(r.parameters)};
+}
+
 nlohmann::json materials_json() {
   nlohmann::json j = nlohmann::json::array();
   for (const auto& p : pm::material_presets())

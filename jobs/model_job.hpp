@@ -26,6 +26,16 @@ struct ModelRequest {
   model::TubeGeometry geometry;
 };
 
+// The request's material: e-form constants, model class ("isotropic" | "full")
+// and the parameters as JSON; sets req.geometry's density from the preset.
+// Throws std::invalid_argument (unknown preset, bad override).
+struct ResolvedModel {
+  model::PiezoMaterialE material;
+  std::string model_class;
+  nlohmann::json parameters;
+};
+ResolvedModel resolve_model(ModelRequest& req);
+
 // `model materials`: [{name, description, density_kg_m3}] in the presets' order.
 nlohmann::json materials_json();
 

@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <array>
+#include <cmath>
 #include <cstdio>
 #include <memory>
 #include <nlohmann/json.hpp>
@@ -96,4 +97,30 @@ TEST(CmdModel, SensitivitySeedProtocolFlagsWhatItSolvesOutsideThePhysicalDomain)
   }
   EXPECT_EQ(flagged, 1);  // cE13 doubled: cE not positive definite
   EXPECT_EQ(run("model sensitivity --form q").code, 2);
+}
+
+TEST(CmdModel, ThreeDJsonHasTable3TorsionAndTheHarmonics) {
+  // Issue 44 items 1: Table 3's 3-D column (harmonic 0 against the 2-D code),
+  // the exact torsion, the harmonics' modes, Fig 17's comparison.
+  auto r = run("model three-d --max-n 2 --fmax 60000 --step 1000 --json");
+  ASSERT_EQ(r.code, 0) << r.out;
+  const auto j = nlohmann::json::parse(r.out);
+  ASSERT_EQ(j["table3"].size(), 6u);
+  for (const auto& row : j["table3"]) EXPECT_LT(std::abs(row["relative_difference"].get<double>()), 1e-9);
+  ASSERT_GE(j["torsion_check"].size(), 1u);
+  EXPECT_LT(std::abs(j["torsion_check"][0]["relative_difference"].get<double>()), 1e-5);
+  ASSERT_EQ(j["harmonics"].size(), 4u);  // n = 0 cos, n = 0 sin, n = 1, n = 2
+  EXPECT_EQ(j["harmonics"][2]["rigid_motions"].get<int>(), 2);
+  for (const auto& m : j["harmonics"][3]["modes"]) EXPECT_FALSE(m["electrically_active"].get<bool>());
+  // The 2-D port model (20 modes + residual) and the 3-D one (all modes) on
+  // a 1 kHz grid that misses the extrema: equal within 0.05 dB.
+  EXPECT_LT(j["fig17"]["three_d_vs_two_d"]["max_abs_db"].get<double>(), 0.05);
+}
+
+TEST(CmdModel, ConstrainedCsvAndBadPlotName) {
+  auto r = run("model constrained --fmin 1000 --fmax 3000 --step 1000 --csv");
+  ASSERT_EQ(r.code, 0);
+  EXPECT_EQ(r.out.rfind("f_hz,free_fe_abs_ohm,constrained_fe_abs_ohm,ring_abs_ohm\n", 0), 0u) << r.out;
+  EXPECT_EQ(run("model constrained --fmin 1000 --fmax 3000 --step 1000 --plot fig19.txt").code, 2);
+  EXPECT_EQ(run("model three-d --max-n 99").code, 2);
 }

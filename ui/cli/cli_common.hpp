@@ -15,6 +15,9 @@
 namespace piezo::update {
 struct OeOptions;
 }
+namespace piezo::jobs {
+struct ModelRequest;
+}
 
 namespace piezo::cli {
 
@@ -75,6 +78,10 @@ void register_instruments_command(CLI::App& app, Context& ctx);
 void register_model_command(CLI::App& app, Context& ctx);
 // `model mode-shape-cmcm` (cmd_model_mode_shape.cpp), under the `model` command.
 void register_mode_shape_command(CLI::App* model, Context& ctx);
+// `model three-d` and `model constrained` (cmd_model_3d.cpp), under `model`;
+// `add_model_options` adds the tube's options (--material, --nr, …).
+void register_model_3d_commands(CLI::App* model, Context& ctx,
+                                const std::function<void(CLI::App*, jobs::ModelRequest&)>& add_model_options);
 void register_impedance_command(CLI::App& app, Context& ctx);
 void register_update_command(CLI::App& app, Context& ctx);
 void register_replay_command(CLI::App& app, Context& ctx);
