@@ -4,12 +4,14 @@
 
 #include <cmath>
 #include <complex>
+#include <filesystem>
 #include <fstream>
 #include <map>
 #include <optional>
 #include <sstream>
 
 #include "jobs/job_error.hpp"
+#include "jobs/report/plot_cairo.hpp"
 #include "model/harmonic.hpp"
 #include "model/material_presets.hpp"
 #include "update/impedance_file.hpp"
@@ -70,6 +72,47 @@ std::vector<std::complex<double>> model_impedance(pm::ModalSolver& solver,
   o.n_modes = 20;
   const auto port = solver.port_model(m, o);
   return pm::impedance_from_admittance(pm::admittance_modal(port, f, d));
+}
+
+// Figs 36-37: α1, α2 per elastic CMCM iteration and α3 per piezo iteration.
+void write_history_plot(const pu::UpdateResult& r, bool seed, const std::string& file) {
+  namespace rp = report;
+  rp::Figure fig;
+  fig.title = "Figs 36-37: CMCM correction coefficients per iteration";
+  fig.subtitle = seed ? "the seed's procedure: one pass, i != j equations" : "our procedure: outer sweeps";
+  fig.note = "final: alpha1 " + std::to_string(r.alpha1) + ", alpha2 " + std::to_string(r.alpha2) + ", alpha3 " +
+             std::to_string(r.alpha3);
+  rp::Panel el, pz;
+  el.title = "elastic phase (resonances)";
+  el.y_label = "alpha";
+  pz.title = "piezoelectric phase (anti-resonances)";
+  pz.x_label = "iteration";
+  pz.y_label = "alpha3";
+  rp::Series a1{"alpha1"}, a2{"alpha2"}, a3{"alpha3"};
+  a2.colour = "#d62728";
+  a3.colour = "#2ca02c";
+  for (std::size_t k = 0; k < r.elastic_alpha_history.size(); ++k) {
+    a1.x.push_back(static_cast<double>(k + 1));
+    a1.y.push_back(r.elastic_alpha_history[k][0]);
+    a2.x.push_back(static_cast<double>(k + 1));
+    a2.y.push_back(r.elastic_alpha_history[k][1]);
+  }
+  for (std::size_t k = 0; k < r.piezo_alpha_history.size(); ++k) {
+    a3.x.push_back(static_cast<double>(k + 1));
+    a3.y.push_back(r.piezo_alpha_history[k]);
+  }
+  for (auto* s : {&a1, &a2, &a3}) s->points = s->x.size() < 40;
+  el.series = {a1, a2};
+  el.x_label = "iteration";
+  pz.series = {a3};
+  fig.panels = {el, pz};
+  const std::filesystem::path path(file);
+  if (path.extension() == ".svg")
+    rp::write_svg(fig, path);
+  else if (path.extension() == ".png")
+    rp::write_png(fig, path);
+  else
+    throw InputError("--history-plot " + file + ": give a .png or .svg file name");
 }
 
 }  // namespace
@@ -140,7 +183,10 @@ UpdateFeaturesResult run_update_features(const UpdateFeaturesRequest& a) {
 
   pu::UpdateOptions uo;
   uo.cmcm.max_iterations = a.max_iterations;
-  uo.cmcm.cross_modes = a.cross_modes;
+  uo.cmcm.cross_modes = a.cross_modes || a.seed_procedure;
+  uo.seed_procedure = a.seed_procedure;
+  if (a.seed_procedure && a.method == "lm") throw InputError("--seed-procedure is a CMCM procedure: use --method cmcm or both");
+  if (!a.history_plot.empty() && a.method == "lm") throw InputError("--history-plot draws the CMCM iterations: use --method cmcm or both");
   uo.capacitance =
       a.capacitance == "fe" ? pu::CapacitanceModel::fe : pu::CapacitanceModel::analytic;
 
@@ -201,6 +247,14 @@ UpdateFeaturesResult run_update_features(const UpdateFeaturesRequest& a) {
     updated = r.updated;
     out["updated"] = params_json(cls, r.updated);
     out["alpha"] = {{"alpha1", r.alpha1}, {"alpha2", r.alpha2}, {"alpha3", r.alpha3}};
+    out["procedure"] = {{"name", a.seed_procedure ? "seed" : "sweeps"}, {"cross_modes", uo.cmcm.cross_modes}};
+    {
+      nlohmann::json el = nlohmann::json::array(), pz = nlohmann::json::array();
+      for (const auto& h : r.elastic_alpha_history) el.push_back({h[0], h[1]});
+      for (double h : r.piezo_alpha_history) pz.push_back(std::isfinite(h) ? nlohmann::json(h) : nlohmann::json());
+      out["alpha_history"] = {{"elastic", el}, {"piezo", pz}};
+    }
+    if (!a.history_plot.empty()) write_history_plot(r, a.seed_procedure, a.history_plot);
     out["iterations"] = {{"elastic", r.iterations_elastic},
                          {"piezo", r.iterations_piezo},
                          {"elastic_per_sweep", r.elastic_per_sweep},

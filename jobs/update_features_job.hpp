@@ -20,6 +20,10 @@ struct UpdateFeaturesRequest {
   std::string method;  // cmcm | lm | both
   std::string overlay, damping, capacitance = "fe";
   bool isotropic = false, cross_modes = false;
+  // --seed-procedure: the seed's one pass (update::UpdateOptions::seed_procedure)
+  // with its i != j equations (cross_modes on).
+  bool seed_procedure = false;
+  std::string history_plot;  // --history-plot: Figs 36-37 (α per CMCM iteration) as PNG/SVG
   int max_iterations = update::CmcmOptions{}.max_iterations;
   int n_radial = model::MeshOptions{}.n_radial, n_axial = model::MeshOptions{}.n_axial;
   // Said at once: a damping fit from --damping that cannot be used.

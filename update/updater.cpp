@@ -81,12 +81,26 @@ UpdateResult update_cmcm(const model::TubeModel& tube, model::ModalSolver& solve
     res.alpha2 = q.c2 / res.original_q.c2 - 1.0;
     // The seed's base for α3: the original d31 and εT33 with the updated c1 + c2.
     try {
-      res.alpha3 = q.a / a_from_d31(original.d31, q.c1 + q.c2, original.eps_t33) - 1.0;
+      const double base = a_from_d31(original.d31, q.c1 + q.c2, original.eps_t33);
+      res.alpha3 = q.a / base - 1.0;
+      for (double& a : res.piezo_alpha_history) a = a / base - 1.0;
     } catch (const std::invalid_argument&) {
       res.alpha3 = NAN;
+      for (double& a : res.piezo_alpha_history) a = NAN;
     }
     res.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     return res;
+  };
+
+  // The iterates of each phase, for the histories (α of a phase is relative
+  // to its θ0; piezo iterates are kept as a until finish() knows the base).
+  auto record_elastic = [&](const CmcmPhase& ph, const CmcmResult& r) {
+    for (const auto& al : r.alpha_history)
+      res.elastic_alpha_history.push_back({ph.theta0[0] * (1.0 + al[0]) / res.original_q.c1 - 1.0,
+                                           ph.theta0[1] * (1.0 + al[1]) / res.original_q.c2 - 1.0});
+  };
+  auto record_piezo = [&](const CmcmPhase& ph, const CmcmResult& r) {
+    for (const auto& al : r.alpha_history) res.piezo_alpha_history.push_back(ph.theta0[0] * (1.0 + al[0]));
   };
 
   // Inexact block iterations: early sweeps need not be solved to the final
@@ -100,7 +114,7 @@ UpdateResult update_cmcm(const model::TubeModel& tube, model::ModalSolver& solve
   // iteration of phase 1 can diverge (tests/e2e: YE11 58 GPa, nu12 0.356,
   // d31 −197 pC/N, εT33 1394 ε0). If this start fails, the seed's base is kept.
   bool piezo_start = false;
-  {
+  if (!opt.seed_procedure) {
     const Coordinates q0 = q;
     try {
       q.eps_t33 = res.eps_t33_eq201;
@@ -118,6 +132,7 @@ UpdateResult update_cmcm(const model::TubeModel& tube, model::ModalSolver& solve
       CmcmOptions c0 = opt.cmcm;
       c0.tolerance = std::max(opt.cmcm.tolerance, 1e-3);
       const auto r0 = extended_cmcm(tube, solver, p0, c0);
+      record_piezo(p0, r0);
       res.iterations_piezo += r0.iterations;
       if (r0.ok()) {
         q.a = r0.theta[0];
@@ -127,11 +142,12 @@ UpdateResult update_cmcm(const model::TubeModel& tube, model::ModalSolver& solve
     }
     if (!piezo_start) q = q0;
   }
-  for (int sweep = 1; sweep <= opt.max_sweeps; ++sweep) {
+  const int max_sweeps = opt.seed_procedure ? 1 : opt.max_sweeps;
+  for (int sweep = 1; sweep <= max_sweeps; ++sweep) {
     const Coordinates q_prev = q;
     res.sweeps = sweep;
     CmcmOptions copt = opt.cmcm;
-    copt.tolerance = std::max(opt.cmcm.tolerance, 1e-3 * last_change);
+    if (!opt.seed_procedure) copt.tolerance = std::max(opt.cmcm.tolerance, 1e-3 * last_change);
     // Phase 1: c1, c2 from the resonances, short circuit.
     CmcmPhase p1;
     p1.name = "elastic (sweep " + std::to_string(sweep) + ")";
@@ -145,9 +161,17 @@ UpdateResult update_cmcm(const model::TubeModel& tube, model::ModalSolver& solve
       return material_of(c);
     };
     res.elastic = extended_cmcm(tube, solver, p1, copt);
+    record_elastic(p1, res.elastic);
     res.elastic_per_sweep.push_back(res.elastic.iterations);
     res.iterations_elastic += res.elastic.iterations;
-    if (!res.elastic.ok()) return finish(res.elastic.status, res.elastic.message);
+    if (!res.elastic.ok()) {
+      // The seed's procedure reports where its iteration stopped (its last iterate).
+      if (opt.seed_procedure && res.elastic.status == UpdateStatus::max_iterations) {
+        q.c1 = res.elastic.theta[0];
+        q.c2 = res.elastic.theta[1];
+      }
+      return finish(res.elastic.status, res.elastic.message);
+    }
     q.c1 = res.elastic.theta[0];
     q.c2 = res.elastic.theta[1];
 
@@ -174,14 +198,18 @@ UpdateResult update_cmcm(const model::TubeModel& tube, model::ModalSolver& solve
       return material_of(c);
     };
     res.piezo = extended_cmcm(tube, solver, p3, copt);
+    record_piezo(p3, res.piezo);
     res.piezo_per_sweep.push_back(res.piezo.iterations);
     res.iterations_piezo += res.piezo.iterations;
-    if (!res.piezo.ok()) return finish(res.piezo.status, res.piezo.message);
+    if (!res.piezo.ok()) {
+      if (opt.seed_procedure && res.piezo.status == UpdateStatus::max_iterations) q.a = res.piezo.theta[0];
+      return finish(res.piezo.status, res.piezo.message);
+    }
     q.a = res.piezo.theta[0];
 
     // Phase 2 against the FE model's own capacitance at f_L (fixed point on
     // εT33, C is nearly proportional to it).
-    if (opt.capacitance == CapacitanceModel::fe) {
+    if (opt.capacitance == CapacitanceModel::fe && !opt.seed_procedure) {
       for (int k = 0; k < 4; ++k) {
         double c_model = 0;
         try {
@@ -200,6 +228,10 @@ UpdateResult update_cmcm(const model::TubeModel& tube, model::ModalSolver& solve
     change = std::max(change, std::abs(q.eps_t33 / q_prev.eps_t33 - 1.0));
     change = std::max(change, std::abs(q.a / q_prev.a - 1.0));
     last_change = change;
+    if (opt.seed_procedure) {  // one pass: both phases converged (else returned above)
+      res.status = UpdateStatus::converged;
+      break;
+    }
     if (sweep > 1 && change < opt.sweep_tolerance) {
       res.status = UpdateStatus::converged;
       break;

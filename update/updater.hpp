@@ -15,6 +15,7 @@
 //    thin-wall formula eq. 200 (option `capacitance`, default FE); eq. 201's
 //    value is always reported as well.
 #include <chrono>
+#include <array>
 #include <string>
 #include <vector>
 
@@ -35,6 +36,13 @@ struct UpdateOptions {
   CapacitanceModel capacitance = CapacitanceModel::fe;
   int max_sweeps = 8;
   double sweep_tolerance = 1e-8;  // max relative change of (c1, c2, εT33, a) between sweeps
+  // The seed's own procedure (§7.1.1, Fig 34; issue 44 item 4) instead of ours:
+  // ONE pass — phase 1 (c1, c2 from the resonances) iterated to the CMCM
+  // tolerance, εT33 by eq. 201 alone, phase 3 (a from the anti-resonances)
+  // from the seed's base a (original d31 and εT33 with the updated c's) — with
+  // no piezo start, no outer sweeps and no FE capacitance fixed point. The
+  // caller sets cmcm.cross_modes for the seed's i ≠ j equations.
+  bool seed_procedure = false;
 };
 
 struct UpdateResult {
@@ -55,6 +63,11 @@ struct UpdateResult {
   std::vector<double> model_resonances_before_hz, model_antiresonances_before_hz;
   std::vector<double> model_resonances_hz, model_antiresonances_hz;  // updated model
   CmcmResult elastic, piezo;                                         // details of the last sweep
+  // Every CMCM iteration in order, across the piezo start and all sweeps (the
+  // seed's Figs 36-37): (α1, α2) relative to the original c1, c2, and α3
+  // relative to the seed's base a of the final c1 + c2 (as alpha3 above).
+  std::vector<std::array<double, 2>> elastic_alpha_history;
+  std::vector<double> piezo_alpha_history;
   double seconds = 0;
   bool ok() const { return status == UpdateStatus::converged; }
 };

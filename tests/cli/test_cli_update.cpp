@@ -119,3 +119,28 @@ TEST(CliUpdate, ChainTolerancesAreOptionsAndWidenTheSigmasTheyAlias) {
   EXPECT_LT(tight, loose / 5);
   EXPECT_EQ(run_cli("update " + cap + " --method oe --r1-tolerance -1").exit_code, 2);
 }
+
+TEST(CliUpdate, SeedProcedureHistoriesAndPlot) {
+  // Issue 44 item 4: --seed-procedure names itself, turns the i != j equations
+  // on and makes one pass; alpha_history holds one entry per CMCM iteration
+  // (capped here at 30, so the elastic phase stops unconverged: exit 1, with
+  // the result and its last iterate).
+  const std::string plot =
+      (std::filesystem::temp_directory_path() / ("pb-history-" + std::to_string(::getpid()) + ".png")).string();
+  const auto r = run_cli(kTable45 + "--seed-procedure --max-iterations 30 --history-plot " + plot + " --json");
+  ASSERT_EQ(r.exit_code, 1) << r.err;
+  const auto j = nlohmann::json::parse(r.out);
+  EXPECT_EQ(j["procedure"]["name"], "seed");
+  EXPECT_TRUE(j["procedure"]["cross_modes"].get<bool>());
+  EXPECT_EQ(j["iterations"]["sweeps"].get<int>(), 1);
+  ASSERT_EQ(j["alpha_history"]["elastic"].size(), 30u);
+  EXPECT_EQ(j["alpha_history"]["piezo"].size(), 0u);
+  EXPECT_DOUBLE_EQ(j["alpha_history"]["elastic"][29][0].get<double>(), j["alpha"]["alpha1"].get<double>());
+  EXPECT_GT(std::filesystem::file_size(plot), 1000u);
+  std::filesystem::remove(plot);
+  // The default procedure carries the same fields.
+  const auto d = nlohmann::json::parse(run_cli(kTable45 + "--json").out);
+  EXPECT_EQ(d["procedure"]["name"], "sweeps");
+  EXPECT_EQ(d["alpha_history"]["elastic"].size(), static_cast<std::size_t>(d["iterations"]["elastic"].get<int>()));
+  EXPECT_EQ(run_cli(kTable45 + "--method lm --seed-procedure").exit_code, 2);
+}

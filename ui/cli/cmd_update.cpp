@@ -1,6 +1,7 @@
 // `piezobench update [Z.csv | Z.s1p] [--resonances F,… --antiresonances F,… --low-z OHM@HZ]
 //      [--material M] [--isotropic] [--set YE11=…,nu12=…,d31=…,epsT33_rel=…]
-//      [--method cmcm|lm|both] [--overlay FILE.csv] [--damping F:ZETA,F:ZETA] [--json]`
+//      [--method cmcm|lm|both] [--overlay FILE.csv] [--damping F:ZETA,F:ZETA]
+//      [--cross-modes] [--seed-procedure] [--history-plot FILE.png|.svg] [--json]`
 // Multi-physics FE model updating of the tube (seed §6.3-6.4, docs/update-methods.md).
 // Explicit features override the ones found in the file. The CLI's room
 // (ui/cli): the work is jobs/update_features_job.hpp and, for a capture,
@@ -64,8 +65,9 @@ void run_update_features(Context& ctx, const UpdateArgs& a0, const std::string& 
     if (out.contains("alpha"))
       std::printf("  alpha1 %.5f  alpha2 %.5f  alpha3 %.5f\n", out["alpha"]["alpha1"].get<double>(),
                   out["alpha"]["alpha2"].get<double>(), out["alpha"]["alpha3"].get<double>());
-    std::printf("  iterations: elastic %d, piezo %d\n", out["iterations"]["elastic"].get<int>(),
-                out["iterations"]["piezo"].get<int>());
+    std::printf("  iterations: elastic %d, piezo %d%s\n", out["iterations"]["elastic"].get<int>(),
+                out["iterations"]["piezo"].get<int>(),
+                out.contains("procedure") && out["procedure"]["name"] == "seed" ? " (the seed's procedure)" : "");
     if (out.contains("lm"))
       std::printf("  LM: YE11 %.6g nu12 %.6g d31 %.6g epsT33_rel %.6g (%s)\n",
                   out["lm"]["updated"]["YE11"].get<double>(),
@@ -107,6 +109,11 @@ void register_update_command(CLI::App& app, Context& ctx) {
       ->capture_default_str();
   cmd->add_flag("--cross-modes", a->f.cross_modes,
                 "Include the i != j CMCM equations (seed-faithful, slow)");
+  cmd->add_flag("--seed-procedure", a->f.seed_procedure,
+                "The seed's own CMCM procedure (section 7.1.1): one pass, elastic then eq. 201 then piezo, "
+                "i != j equations on (Tables 4/5, Figs 36-37)");
+  cmd->add_option("--history-plot", a->f.history_plot,
+                  "Figs 36-37: the correction coefficients per CMCM iteration, PNG or SVG");
   cmd->add_option("--nr", a->f.n_radial, "Elements through the wall")->capture_default_str();
   cmd->add_option("--nz", a->f.n_axial, "Elements along the length")->capture_default_str();
   add_chain_tolerance_options(cmd, a->oe);
