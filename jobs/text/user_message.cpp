@@ -9,7 +9,7 @@ const std::vector<std::string_view>& internal_function_names() {
   static const std::vector<std::string_view> names = {
       "a_from_d31", "add_in_quadrature", "analytic_ring", "apply_channel2_response", "assess_impedance", "average_shots",
       "band_from_replicates", "band_from_sigma", "block_header", "bootstrap_over_shots",
-      "bvd_start_from_circle", "check_shots", "circuit_mode_figures", "cmcm_equations", "compute_stats",
+      "bvd_start_from_circle", "check_shots", "circuit_mode_figures", "circumferential_modes", "cmcm_equations", "compute_stats",
       "conductance_peak", "cross_spectra", "d_form_sensitivity", "d_param", "debye_network_fit",
       "debye_network_for_loss", "deskew_channel", "deskew_impedance", "deskew_record", "element_split",
       "eps_s33_from", "eps_t33_from_low_z", "estimate_noise_std", "extract_features", "find_features",
@@ -24,7 +24,7 @@ const std::vector<std::string_view>& internal_function_names() {
       "prony_ss", "rayleigh_fit", "rayleigh_from_damping", "rayleigh_from_two_modes", "read_impedance_file",
       "read_impedance_table", "recorded_transfer", "render_raster", "render_svg", "reported_impedance",
       "run_measurement", "scan_effects", "select_order", "select_shard", "sensitivity_params", "solve_tsvd",
-      "stabilization_chart", "to_d_form", "to_e_form", "to_e_form_unchecked", "update_cmcm",
+      "stabilization_chart", "to_d_form", "to_e_form", "to_e_form_unchecked", "torsion_frequency_hz", "update_cmcm",
       "update_lm", "vector_fit", "write_impedance_csv", "write_touchstone_s1p", "xcorr_delay"};
   return names;
 }

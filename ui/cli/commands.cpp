@@ -36,7 +36,9 @@ void register_builtin_commands(CommandRegistry& r) {
          "headless replay of recorded captures, one or thousands: results, reports, pass/fail, the lot report",
          register_replay_command});
   r.add({"replay-merge", "merges the results files of sharded replays", register_replay_merge_command});
-  r.add({"model", "the FE model: `materials`, `modal`, `impedance`, `sensitivity`, `mode-shape-cmcm`",
+  r.add({"model",
+         "the FE model: `materials`, `modal`, `impedance`, `sensitivity`, `mode-shape-cmcm`, "
+         "`three-d` (the 3-D tube by circumferential harmonics), `constrained` (Fig 19)",
          register_model_command});
   r.add({"instruments", "the driver families: roles, how each is chosen, its simulated twin",
          register_instruments_command});
