@@ -13,6 +13,7 @@
 #include <cstdio>
 #include <numbers>
 
+#include "dsp/fft.hpp"
 #include "dsp/prony_charge.hpp"
 #include "fe_charge.hpp"
 
@@ -143,4 +144,40 @@ TEST(PronyCharge, RecordedDriveDecomposed) {
   std::printf("measured (recorded drive): drive pole %.4g 1/s, max |Z| error %.3g dB\n",
               m.drive_fit->lambda[0].real(), e.max_db);
   EXPECT_LT(e.max_db, 0.1);
+}
+
+// Fig. 25's third curve: the direct FFT ratio of the same 1000 samples,
+// Z(f_k) = V_k/(j2πf_k Q_k), zero-padded to the 200 Hz grid (50 000 points).
+// A 100 µs record resolves 10 kHz, the mode pair is 3.1 kHz apart and with
+// β = 0 the charge does not decay, so the rectangular window's leakage rules
+// the ratio: the seed's "FFT worse" holds by orders of magnitude against
+// Prony-SS's 5e-11 dB above (the bound 1 dB is 1e10 times that).
+TEST(PronyCharge, Seed511FftRatioOfTheSameSamplesIsWorse) {
+  const auto& d = clean();
+  const study::StudyInput in = fe5::charge_study_input(d);
+  constexpr std::size_t n = 1000, nfft = 50000;  // fs / nfft = 200 Hz
+  std::vector<double> v(n);
+  for (std::size_t k = 0; k < n; ++k)
+    v[k] = d.drive.amplitude_v * std::exp(d.drive.pole_per_s * static_cast<double>(k) / d.sample_rate_hz);
+  dsp::RealFft fft(nfft);
+  std::vector<std::complex<double>> vk(fft.bins()), qk(fft.bins());
+  fft.forward(v.data(), n, vk.data());
+  fft.forward(d.q.data(), n, qk.data());
+  DbError e;
+  std::vector<double> all;
+  for (std::size_t k = 1; k < fft.bins(); ++k) {
+    const double f = static_cast<double>(k) * d.sample_rate_hz / static_cast<double>(nfft);
+    if (f > 120e3) break;
+    if (study::near_feature(in, f)) continue;
+    const std::complex<double> z = vk[k] / (std::complex<double>(0, 2 * std::numbers::pi * f) * qk[k]);
+    const double db = std::abs(20.0 * std::log10(std::abs(z) / std::abs(in.z_true(f))));
+    ++e.scored;
+    all.push_back(db);
+    if (db > e.max_db) e.max_db = db, e.f_at = f;
+  }
+  std::nth_element(all.begin(), all.begin() + static_cast<std::ptrdiff_t>(all.size() / 2), all.end());
+  std::printf("measured: FFT ratio of the first %zu samples, |Z| error away from the peaks: median %.3g dB, "
+              "max %.3g dB at %.1f kHz (%zu bins)\n", n, all[all.size() / 2], e.max_db, e.f_at / 1e3, e.scored);
+  EXPECT_GT(e.scored, 500u);
+  EXPECT_GT(e.max_db, 1.0);
 }
