@@ -6,6 +6,7 @@
 #include <complex>
 #include <ostream>
 #include <stdexcept>
+#include <string>
 
 #include "jobs/job_error.hpp"
 #include "jobs/report/plot_cairo.hpp"
@@ -87,6 +88,19 @@ std::vector<double> grid(double fmin, double fmax, double step) {
   }
 }
 
+// The 2-D code's first ten short- and open-circuit modes (sparse Lanczos).
+struct TwoD {
+  pm::ModalResult sc, oc;
+};
+TwoD two_d_modes(pm::ModalSolver& s, const pm::PiezoMaterialE& m, const char* command) {
+  pm::ModalOptions mo;
+  mo.n_modes = 10;
+  TwoD t{s.solve(m, pm::Electrodes::short_circuit, mo), s.solve(m, pm::Electrodes::open_circuit, mo)};
+  if (!t.sc.converged || !t.oc.converged)
+    throw std::runtime_error(std::string(command) + ": the 2-D modal solve did not converge");
+  return t;
+}
+
 pm::ModalPortModel port_2d(const pm::TubeModel& tm, const pm::PiezoMaterialE& m) {
   pm::ModalSolver s(tm);
   pm::ModalOptions o;
@@ -115,11 +129,8 @@ ThreeDResult run_three_d(ThreeDRequest a, const std::function<void(int, int)>& p
   // Table 3: the 2-D code (sparse Lanczos) and harmonic n = 0 of the 3-D model (dense, all modes).
   pm::TubeModel tm(geo, mesh);
   pm::ModalSolver s2(tm);
-  pm::ModalOptions mo;
-  mo.n_modes = 10;
-  const auto sc2 = s2.solve(r.material, pm::Electrodes::short_circuit, mo);
-  const auto oc2 = s2.solve(r.material, pm::Electrodes::open_circuit, mo);
-  if (!sc2.converged || !oc2.converged) throw std::runtime_error("model three-d: the 2-D modal solve did not converge");
+  const TwoD two = two_d_modes(s2, r.material, "model three-d");
+  const pm::ModalResult &sc2 = two.sc, &oc2 = two.oc;
   const auto sc3 = pm::circumferential_modes(geo, r.material,
                                              options(a.model, 0, pm::HarmonicFamily::cos_family,
                                                      pm::Electrodes::short_circuit, 0.0));
@@ -223,11 +234,8 @@ ConstrainedResult run_constrained(ConstrainedRequest a) {
   const pm::MeshOptions mesh{a.model.n_radial, a.model.n_axial};
   pm::TubeModel tm(geo, mesh);
   pm::ModalSolver s2(tm);
-  pm::ModalOptions mo;
-  mo.n_modes = 10;
-  const auto sc = s2.solve(r.material, pm::Electrodes::short_circuit, mo);
-  const auto oc = s2.solve(r.material, pm::Electrodes::open_circuit, mo);
-  if (!sc.converged || !oc.converged) throw std::runtime_error("model constrained: the 2-D modal solve did not converge");
+  const TwoD two = two_d_modes(s2, r.material, "model constrained");
+  const pm::ModalResult &sc = two.sc, &oc = two.oc;
   const auto csc = pm::circumferential_modes(
       geo, r.material, options(a.model, 0, pm::HarmonicFamily::cos_family, pm::Electrodes::short_circuit, 0.0, true));
   const auto coc = pm::circumferential_modes(

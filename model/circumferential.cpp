@@ -109,42 +109,24 @@ Blocks assemble(const TubeMesh& mesh, const Numbering& nb, const TubeGeometry& g
   Eigen::Matrix<double, 9, 9> kpp;
   for (int el = 0; el < mesh.num_elements(); ++el) {
     const auto& conn = mesh.element(el);
+    std::array<Node, kElemNodes> x;
+    for (int a = 0; a < kElemNodes; ++a) x[static_cast<std::size_t>(a)] = mesh.nodes()[static_cast<std::size_t>(conn[a])];
     km.setZero();
     kk.setZero();
     kup.setZero();
     kpp.setZero();
     for (int qz = 0; qz < gr.n; ++qz)
       for (int qr = 0; qr < gr.n; ++qr) {
-        const double xi = gr.x[qr], eta = gr.x[qz];
-        const auto lx = lagrange2(xi), ly = lagrange2(eta);
-        const auto dlx = lagrange2_deriv(xi), dly = lagrange2_deriv(eta);
-        std::array<double, 9> n{}, dxi{}, deta{};
-        for (int bb = 0; bb < 3; ++bb)
-          for (int a = 0; a < 3; ++a) {
-            n[3 * bb + a] = lx[a] * ly[bb];
-            dxi[3 * bb + a] = dlx[a] * ly[bb];
-            deta[3 * bb + a] = lx[a] * dly[bb];
-          }
-        Eigen::Matrix2d jac = Eigen::Matrix2d::Zero();
-        double r = 0;
-        for (int a = 0; a < 9; ++a) {
-          const Node& x = mesh.nodes()[static_cast<std::size_t>(conn[a])];
-          r += n[a] * x.r;
-          jac(0, 0) += dxi[a] * x.r;
-          jac(0, 1) += dxi[a] * x.z;
-          jac(1, 0) += deta[a] * x.r;
-          jac(1, 1) += deta[a] * x.z;
-        }
-        const double det = jac.determinant();
+        const Q2Point q = q2_point(x, gr.x[qr], gr.x[qz]);
+        const double r = q.r, det = q.det;
+        const auto& n = q.n;
         if (!(det > 0) || !(r > 0)) fail("degenerate or inverted element " + std::to_string(el));
-        const Eigen::Matrix2d ji = jac.inverse();
         const double dv = r * det * gr.w[qr] * gr.w[qz];  // the θ-weight is in cw, ew, epsw
         bu.setZero();
         bp.setZero();
         nu.setZero();
         for (int a = 0; a < 9; ++a) {
-          const double dr = ji(0, 0) * dxi[a] + ji(0, 1) * deta[a];
-          const double dz = ji(1, 0) * dxi[a] + ji(1, 1) * deta[a];
+          const double dr = q.dr[a], dz = q.dz[a];
           const int r_ = 3 * a, t_ = 3 * a + 1, z_ = 3 * a + 2;
           bu(0, z_) = dz;              // S1 = ∂U_z/∂z
           bu(1, r_) = n[a] / r;        // S2 = (U_r + m U_θ)/r

@@ -47,6 +47,36 @@ std::array<double, 3> lagrange2(double xi) {
 
 std::array<double, 3> lagrange2_deriv(double xi) { return {xi - 0.5, -2.0 * xi, xi + 0.5}; }
 
+Q2Point q2_point(const std::array<Node, kElemNodes>& x, double xi, double eta) {
+  const auto lx = lagrange2(xi), ly = lagrange2(eta);
+  const auto dlx = lagrange2_deriv(xi), dly = lagrange2_deriv(eta);
+  std::array<double, 9> dn_dxi{}, dn_deta{};
+  Q2Point q;
+  for (int b = 0; b < 3; ++b)
+    for (int a = 0; a < 3; ++a) {
+      q.n[3 * b + a] = lx[a] * ly[b];
+      dn_dxi[3 * b + a] = dlx[a] * ly[b];
+      dn_deta[3 * b + a] = lx[a] * dly[b];
+    }
+  // Isoparametric map (r, z)(ξ, η).
+  Eigen::Matrix2d jac = Eigen::Matrix2d::Zero();  // [[dr/dξ, dz/dξ], [dr/dη, dz/dη]]
+  for (int a = 0; a < 9; ++a) {
+    q.r += q.n[a] * x[a].r;
+    jac(0, 0) += dn_dxi[a] * x[a].r;
+    jac(0, 1) += dn_dxi[a] * x[a].z;
+    jac(1, 0) += dn_deta[a] * x[a].r;
+    jac(1, 1) += dn_deta[a] * x[a].z;
+  }
+  q.det = jac.determinant();
+  if (!(q.det > 0) || !(q.r > 0)) return q;
+  const Eigen::Matrix2d jinv = jac.inverse();
+  for (int a = 0; a < 9; ++a) {
+    q.dr[a] = jinv(0, 0) * dn_dxi[a] + jinv(0, 1) * dn_deta[a];
+    q.dz[a] = jinv(1, 0) * dn_dxi[a] + jinv(1, 1) * dn_deta[a];
+  }
+  return q;
+}
+
 void element_split(const std::array<Node, kElemNodes>& x, int gauss_points, ElementSplit& out) {
   const GaussRule g = gauss_legendre(gauss_points);
   for (auto& k : out.k) k.setZero();
@@ -74,36 +104,16 @@ void element_split(const std::array<Node, kElemNodes>& x, int gauss_points, Elem
   Eigen::Matrix<double, 2, 18> nu;
   for (int qz = 0; qz < g.n; ++qz)
     for (int qr = 0; qr < g.n; ++qr) {
-      const double xi = g.x[qr], eta = g.x[qz];
-      const auto lx = lagrange2(xi), ly = lagrange2(eta);
-      const auto dlx = lagrange2_deriv(xi), dly = lagrange2_deriv(eta);
-      std::array<double, 9> n{}, dn_dxi{}, dn_deta{};
-      for (int b = 0; b < 3; ++b)
-        for (int a = 0; a < 3; ++a) {
-          n[3 * b + a] = lx[a] * ly[b];
-          dn_dxi[3 * b + a] = dlx[a] * ly[b];
-          dn_deta[3 * b + a] = lx[a] * dly[b];
-        }
-      // Isoparametric map (r, z)(ξ, η).
-      Eigen::Matrix2d jac = Eigen::Matrix2d::Zero();  // [[dr/dξ, dz/dξ], [dr/dη, dz/dη]]
-      double r = 0;
-      for (int a = 0; a < 9; ++a) {
-        r += n[a] * x[a].r;
-        jac(0, 0) += dn_dxi[a] * x[a].r;
-        jac(0, 1) += dn_dxi[a] * x[a].z;
-        jac(1, 0) += dn_deta[a] * x[a].r;
-        jac(1, 1) += dn_deta[a] * x[a].z;
-      }
-      const double det = jac.determinant();
+      const Q2Point q = q2_point(x, g.x[qr], g.x[qz]);
+      const double r = q.r, det = q.det;
       if (!(det > 0) || !(r > 0))
         throw std::invalid_argument("element_split: degenerate or inverted element");
-      const Eigen::Matrix2d jinv = jac.inverse();
       const double dv = 2.0 * M_PI * r * det * g.w[qr] * g.w[qz];
       bu.setZero();
       nu.setZero();
+      const auto& n = q.n;
       for (int a = 0; a < 9; ++a) {
-        const double dr = jinv(0, 0) * dn_dxi[a] + jinv(0, 1) * dn_deta[a];
-        const double dz = jinv(1, 0) * dn_dxi[a] + jinv(1, 1) * dn_deta[a];
+        const double dr = q.dr[a], dz = q.dz[a];
         bu(0, 2 * a + 1) = dz;     // S_zz
         bu(1, 2 * a) = n[a] / r;   // S_θθ
         bu(2, 2 * a) = dr;         // S_rr

@@ -28,6 +28,14 @@ GaussRule gauss_legendre(int n);
 std::array<double, 3> lagrange2(double xi);
 std::array<double, 3> lagrange2_deriv(double xi);
 
+// The 9-node element at (ξ, η), mapped to (r, z): N_a, ∂N_a/∂r, ∂N_a/∂z, the
+// radius and the Jacobian determinant (callers refuse det ≤ 0 or r ≤ 0).
+struct Q2Point {
+  std::array<double, kElemNodes> n{}, dr{}, dz{};
+  double r = 0, det = 0;
+};
+Q2Point q2_point(const std::array<Node, kElemNodes>& x, double xi, double eta);
+
 // Per-parameter local matrices of one element (the split of eqs 234, 242, 245):
 //   k[c_ij]  = ∫ B_uᵀ ∂cE/∂c_ij B_u dV                        (eq. 74)
 //   k[e_k]   = ∫ B_uᵀ (∂e/∂e_k)ᵀ B_φ dV, placed in both uφ and φu blocks (eq. 75)

@@ -32,6 +32,15 @@ struct ConstrainedArgs {
   std::string plot;
 };
 
+// --json prints the JSON, --csv the curves; true when one of them did.
+bool printed_as_data(const Context& ctx, const nlohmann::json& j, const jobs::ImpedanceCurves& c, bool csv) {
+  if (ctx.json)
+    print_json(j);
+  else if (csv)
+    jobs::write_curves_csv(std::cout, c);
+  return ctx.json || csv;
+}
+
 void run_three_d(Context& ctx, const ThreeDArgs& a) {
   ProgressBar bar("three-d", !ctx.json && !a.csv);
   const auto r = jobs::run_three_d(a.req, [&](int done, int total) {
@@ -45,14 +54,7 @@ void run_three_d(Context& ctx, const ThreeDArgs& a) {
                   a.req.model.material.c_str(), a.req.beta);
     jobs::write_curves_plot(r.fig17, "Fig 17: |Z| of the 2-D and 3-D models", sub, a.plot);
   }
-  if (ctx.json) {
-    print_json(j);
-    return;
-  }
-  if (a.csv) {
-    jobs::write_curves_csv(std::cout, r.fig17);
-    return;
-  }
+  if (printed_as_data(ctx, j, r.fig17, a.csv)) return;
   std::printf("%s (%s class), mesh %d x %d: the 3-D tube by circumferential harmonics n = 0..%d\n",
               a.req.model.material.c_str(), j["model_class"].get<std::string>().c_str(), a.req.model.n_radial,
               a.req.model.n_axial, j["highest_harmonic"].get<int>());
@@ -94,14 +96,7 @@ void run_constrained(Context& ctx, const ConstrainedArgs& a) {
   if (!a.plot.empty())
     jobs::write_curves_plot(r.fig19, "Fig 19: constrained FE (u_z = 0) against the analytic ring",
                             a.req.model.material + ", free FE beside them", a.plot);
-  if (ctx.json) {
-    print_json(j);
-    return;
-  }
-  if (a.csv) {
-    jobs::write_curves_csv(std::cout, r.fig19);
-    return;
-  }
+  if (printed_as_data(ctx, j, r.fig19, a.csv)) return;
   std::printf("%s (%s class), mesh %d x %d: electrically active modes below %.0f Hz [Hz]\n",
               a.req.model.material.c_str(), j["model_class"].get<std::string>().c_str(), a.req.model.n_radial,
               a.req.model.n_axial, j["grid"]["fmax_hz"].get<double>());
