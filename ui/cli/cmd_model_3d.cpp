@@ -9,6 +9,7 @@
 // constrained_fe, ring) instead of the summary. Exit codes: 0 ok, 2 bad
 // input, 1 when a solve fails.
 #include <cstdio>
+#include <filesystem>
 #include <iostream>
 #include <memory>
 #include <string>
@@ -41,20 +42,7 @@ bool printed_as_data(const Context& ctx, const nlohmann::json& j, const jobs::Im
   return ctx.json || csv;
 }
 
-void run_three_d(Context& ctx, const ThreeDArgs& a) {
-  ProgressBar bar("three-d", !ctx.json && !a.csv);
-  const auto r = jobs::run_three_d(a.req, [&](int done, int total) {
-    bar.update(total > 0 ? static_cast<double>(done) / total : 0.0, "harmonic " + std::to_string(done - 1));
-  });
-  bar.finish();
-  const auto& j = r.json;
-  if (!a.plot.empty()) {
-    char sub[160];
-    std::snprintf(sub, sizeof sub, "%s, Rayleigh beta %g s; 3-D = harmonic 0 (n >= 1 carry no charge)",
-                  a.req.model.material.c_str(), a.req.beta);
-    jobs::write_curves_plot(r.fig17, "Fig 17: |Z| of the 2-D and 3-D models", sub, a.plot);
-  }
-  if (printed_as_data(ctx, j, r.fig17, a.csv)) return;
+void print_three_d(const ThreeDArgs& a, const nlohmann::json& j) {
   std::printf("%s (%s class), mesh %d x %d: the 3-D tube by circumferential harmonics n = 0..%d\n",
               a.req.model.material.c_str(), j["model_class"].get<std::string>().c_str(), a.req.model.n_radial,
               a.req.model.n_axial, j["highest_harmonic"].get<int>());
@@ -84,19 +72,38 @@ void run_three_d(Context& ctx, const ThreeDArgs& a) {
                 d["max_abs_db"].get<double>(), d["max_at_hz"].get<double>(), d["median_abs_db"].get<double>());
 }
 
+// A --plot name the writer will take, checked before the work.
+void check_plot_name(const std::string& plot) {
+  if (plot.empty()) return;
+  const std::string ext = std::filesystem::path(plot).extension().string();
+  if (ext != ".png" && ext != ".svg") throw InputError("--plot " + plot + ": give a .png or .svg file name");
+}
+
+void run_three_d(Context& ctx, const ThreeDArgs& a) {
+  check_plot_name(a.plot);
+  ProgressBar bar("three-d", !ctx.json && !a.csv);
+  const auto r = jobs::run_three_d(a.req, [&](int done, int total) {
+    bar.update(total > 0 ? static_cast<double>(done) / total : 0.0, "harmonic " + std::to_string(done - 1));
+  });
+  bar.finish();
+  const auto& j = r.json;
+  if (!printed_as_data(ctx, j, r.fig17, a.csv)) print_three_d(a, j);
+  // The plot after the numbers: a plot that cannot be written loses none of them.
+  if (!a.plot.empty()) {
+    char sub[160];
+    std::snprintf(sub, sizeof sub, "%s, Rayleigh beta %g s; 3-D = harmonic 0 (n >= 1 carry no charge)",
+                  a.req.model.material.c_str(), a.req.beta);
+    jobs::write_curves_plot(r.fig17, "Fig 17: |Z| of the 2-D and 3-D models", sub, a.plot);
+  }
+}
+
 void print_list(const char* name, const nlohmann::json& v) {
   std::printf("  %-16s", name);
   for (const auto& f : v) std::printf(" %.1f", f.get<double>());
   std::printf("\n");
 }
 
-void run_constrained(Context& ctx, const ConstrainedArgs& a) {
-  const auto r = jobs::run_constrained(a.req);
-  const auto& j = r.json;
-  if (!a.plot.empty())
-    jobs::write_curves_plot(r.fig19, "Fig 19: constrained FE (u_z = 0) against the analytic ring",
-                            a.req.model.material + ", free FE beside them", a.plot);
-  if (printed_as_data(ctx, j, r.fig19, a.csv)) return;
+void print_constrained(const ConstrainedArgs& a, const nlohmann::json& j) {
   std::printf("%s (%s class), mesh %d x %d: electrically active modes below %.0f Hz [Hz]\n",
               a.req.model.material.c_str(), j["model_class"].get<std::string>().c_str(), a.req.model.n_radial,
               a.req.model.n_axial, j["grid"]["fmax_hz"].get<double>());
@@ -112,6 +119,16 @@ void run_constrained(Context& ctx, const ConstrainedArgs& a) {
       std::printf("|Z| %s: median %.3g dB, max %.3g dB at %.0f Hz\n", k, d["median_abs_db"].get<double>(),
                   d["max_abs_db"].get<double>(), d["max_at_hz"].get<double>());
   }
+}
+
+void run_constrained(Context& ctx, const ConstrainedArgs& a) {
+  check_plot_name(a.plot);
+  const auto r = jobs::run_constrained(a.req);
+  const auto& j = r.json;
+  if (!printed_as_data(ctx, j, r.fig19, a.csv)) print_constrained(a, j);
+  if (!a.plot.empty())
+    jobs::write_curves_plot(r.fig19, "Fig 19: constrained FE (u_z = 0) against the analytic ring",
+                            a.req.model.material + ", free FE beside them", a.plot);
 }
 
 }  // namespace
