@@ -123,6 +123,10 @@ UpdateFeaturesResult run_update_features(const UpdateFeaturesRequest& a) {
   if (a.capacitance != "fe" && a.capacitance != "analytic")
     throw InputError("--capacitance must be fe or analytic");
   if (a.max_iterations < 1) throw InputError("--max-iterations must be >= 1");
+  if (!a.history_plot.empty()) {
+    const std::string ext = std::filesystem::path(a.history_plot).extension().string();
+    if (ext != ".png" && ext != ".svg") throw InputError("--history-plot " + a.history_plot + ": give a .png or .svg file name");
+  }
   const auto& preset = pm::find_preset(a.material.empty() ? "apc850" : a.material);
   pm::TubeGeometry geometry;
   geometry.density_kg_m3 = preset.density_kg_m3;
@@ -254,7 +258,16 @@ UpdateFeaturesResult run_update_features(const UpdateFeaturesRequest& a) {
       for (double h : r.piezo_alpha_history) pz.push_back(std::isfinite(h) ? nlohmann::json(h) : nlohmann::json());
       out["alpha_history"] = {{"elastic", el}, {"piezo", pz}};
     }
-    if (!a.history_plot.empty()) write_history_plot(r, a.seed_procedure, a.history_plot);
+    if (!a.history_plot.empty()) {
+      // A plot that cannot be written costs the plot, not the result.
+      try {
+        write_history_plot(r, a.seed_procedure, a.history_plot);
+        out["history_plot"] = a.history_plot;
+      } catch (const std::exception& e) {
+        out["history_plot_error"] = e.what();
+        if (a.warn) a.warn(std::string("--history-plot: ") + e.what() + "; the result is printed without it");
+      }
+    }
     out["iterations"] = {{"elastic", r.iterations_elastic},
                          {"piezo", r.iterations_piezo},
                          {"elastic_per_sweep", r.elastic_per_sweep},
