@@ -278,7 +278,9 @@ UpdateFeaturesResult run_update_features(const UpdateFeaturesRequest& a) {
     out["message"] = r.message;
     out["eps_t33_eq201_rel"] = r.eps_t33_eq201 / pm::kEps0;
     out["capacitance"] = {
-        {"model", a.capacitance}, {"measured_f", r.c_measured}, {"model_after_f", r.c_model_after}};
+        {"model", a.seed_procedure ? std::string("analytic") : a.capacitance},  // eq. 201 in the seed's procedure
+        {"measured_f", r.c_measured},
+        {"model_after_f", r.c_model_after}};
     out["model_before"] = {{"resonances_hz", r.model_resonances_before_hz},
                            {"antiresonances_hz", r.model_antiresonances_before_hz}};
     out["model_after"] = {{"resonances_hz", r.model_resonances_hz},

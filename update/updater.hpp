@@ -40,7 +40,8 @@ struct UpdateOptions {
   // ONE pass — phase 1 (c1, c2 from the resonances) iterated to the CMCM
   // tolerance, εT33 by eq. 201 alone, phase 3 (a from the anti-resonances)
   // from the seed's base a (original d31 and εT33 with the updated c's) — with
-  // no piezo start, no outer sweeps and no FE capacitance fixed point. The
+  // no piezo start, no outer sweeps and no FE capacitance fixed point (so
+  // `capacitance` is not used: eq. 201 alone). The
   // caller sets cmcm.cross_modes for the seed's i ≠ j equations.
   bool seed_procedure = false;
 };
