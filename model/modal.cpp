@@ -140,6 +140,23 @@ ModalSolver::ModalSolver(const TubeModel& model) : model_(&model), factor_(model
   std::iota(all_u_.begin(), all_u_.end(), 0);
 }
 
+ModalSolver::ModalSolver(const TubeModel& model, std::shared_ptr<const TubeModel> half) : ModalSolver(model) {
+  if (model.extent() != TubeExtent::whole) return;
+  half_tried_ = true;
+  half_model_ = std::move(half);
+  if (half_model_) half_solver_ = std::make_unique<ModalSolver>(*half_model_);
+}
+
+std::shared_ptr<const TubeModel> ModalSolver::half_model() {
+  if (model_->extent() != TubeExtent::whole) return nullptr;
+  if (!half_tried_) {
+    half_tried_ = true;
+    half_model_ = model_->upper_half();
+    if (half_model_) half_solver_ = std::make_unique<ModalSolver>(*half_model_);
+  }
+  return half_model_;
+}
+
 double ModalSolver::clamped_capacitance(const PiezoMaterialE& material, Eigen::VectorXd* g) {
   check(material, "ModalSolver::clamped_capacitance");
   Eigen::VectorXd x;
@@ -293,11 +310,7 @@ ModalPortModel ModalSolver::half_port_model(const PiezoMaterialE& material, cons
 ModalPortModel ModalSolver::port_model(const PiezoMaterialE& material, const ModalOptions& opt,
                                        ModalResult* sc_result) {
   if (opt.mirror_symmetry && !sc_result && model_->extent() == TubeExtent::whole) {
-    if (!half_tried_) {
-      half_tried_ = true;
-      half_model_ = model_->upper_half();
-      if (half_model_) half_solver_ = std::make_unique<ModalSolver>(*half_model_);
-    }
+    half_model();  // built on the first port model
     if (half_solver_) {
       check(material, "ModalSolver::port_model");
       half_solver_->physical_checks_ = physical_checks_;

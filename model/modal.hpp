@@ -90,6 +90,14 @@ struct ModalResult {
 class ModalSolver {
  public:
   explicit ModalSolver(const TubeModel& model);
+  // A solver on `model` whose port models use `half`, the upper half of
+  // `model` as model.upper_half() builds it (or nullptr: the whole tube), instead
+  // of building their own: a second solver for another thread shares its
+  // first's (a TubeModel is immutable once built; issue 43).
+  ModalSolver(const TubeModel& model, std::shared_ptr<const TubeModel> half);
+  // The upper half this solver's port models use (built on the first call), or
+  // nullptr when the mesh has no mid-plane row or the model is a half already.
+  std::shared_ptr<const TubeModel> half_model();
 
   ModalResult solve(const PiezoMaterialE& material, Electrodes electrodes,
                     const ModalOptions& options = {});
@@ -126,7 +134,7 @@ class ModalSolver {
 
   const TubeModel* model_;
   CoupledFactor factor_;
-  std::unique_ptr<TubeModel> half_model_;     // built on first use (mirror_symmetry)
+  std::shared_ptr<const TubeModel> half_model_;  // built on first use (mirror_symmetry), or shared
   std::unique_ptr<ModalSolver> half_solver_;
   bool half_tried_ = false;
   bool physical_checks_ = true;

@@ -46,7 +46,10 @@ Problem::Problem(const Problem& o, model::ModalSolver& solver)
       cache_(o.cache_), clock_(o.clock_) {}
 
 model::ModalSolver& Problem::second_solver() {
-  if (!solver2_) solver2_ = std::make_unique<model::ModalSolver>(solver_.model());
+  // (sharing the first solver's upper half: one model build less a fit)
+  if (!solver2_)
+    solver2_ = std::make_unique<model::ModalSolver>(solver_.model(),
+                                                    modal_.mirror_symmetry ? solver_.half_model() : nullptr);
   return *solver2_;
 }
 
