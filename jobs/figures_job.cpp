@@ -149,6 +149,10 @@ FiguresJobResult run_figures(const FiguresRequest& req) {
     ir.file = req.file;
     ir.method = oe ? "fft" : req.method;
     ir.uncertainty = "auto";
+    // The figures read the estimate, its σ and band only: the impedance command's
+    // Kramers-Kronig, per-shot validity and stabilization checks change none of
+    // them and are not run (a quarter of the command's time; issue 43).
+    ir.no_kk = ir.no_validity = ir.no_stabilization = true;
     const auto r = run_impedance(ir);
     out.source = "capture";
     out.format = r.z.method;
