@@ -42,6 +42,21 @@ SplitSystem::SplitSystem(const TubeMesh& mesh, const DofMap& dofs, double densit
   pattern_.setFromTriplets(trip.begin(), trip.end());
   pattern_.makeCompressed();
   const auto nnz = pattern_.nonZeros();
+  // 1b. Where each entry's mirror (col, row) sits: the pattern is symmetric, and
+  // walking the columns in order meets the entries of column i in row order.
+  {
+    const int* outer = pattern_.outerIndexPtr();
+    const int* inner = pattern_.innerIndexPtr();
+    std::vector<int> cursor(outer, outer + n);
+    transpose_.resize(static_cast<std::size_t>(nnz));
+    for (int j = 0; j < n; ++j)
+      for (int p = outer[j]; p < outer[j + 1]; ++p) {
+        const int q = cursor[static_cast<std::size_t>(inner[p])]++;
+        if (q >= outer[inner[p] + 1] || inner[q] != j)
+          throw std::logic_error("SplitSystem: the element pattern is not symmetric");
+        transpose_[static_cast<std::size_t>(p)] = q;
+      }
+  }
   for (auto& v : k_) v.setZero(nnz);
   m_.setZero(nnz);
 

@@ -8,6 +8,7 @@
 #include <array>
 #include <complex>
 #include <span>
+#include <vector>
 
 #include "model/material.hpp"
 #include "model/mesh.hpp"
@@ -49,6 +50,9 @@ class SplitSystem {
   SpMat end_mass() const;
   // Position of (row, col) in the value arrays; −1 if not in the pattern.
   int position(int row, int col) const;
+  // Position of the mirror (col, row) of the entry at position p (the pattern is
+  // symmetric): no search (constraining a DOF touches its whole row and column).
+  int transposed(int p) const { return transpose_[static_cast<std::size_t>(p)]; }
 
  private:
   SpMat with_values(const Eigen::VectorXd& v) const;
@@ -57,6 +61,7 @@ class SplitSystem {
   SpMat pattern_;
   std::array<Eigen::VectorXd, kNumMaterialParams> k_;
   Eigen::VectorXd m_, m_end_;
+  std::vector<int> transpose_;  // transposed(p)
 };
 
 }  // namespace piezo::model

@@ -1,5 +1,6 @@
 #include "model/coupled_solver.hpp"
 
+#include <algorithm>
 #include <stdexcept>
 
 namespace piezo::model {
@@ -13,18 +14,22 @@ void CoupledFactor::constrain(int dof, SpMat& m) const {
   const int* outer = m.outerIndexPtr();
   const int* inner = m.innerIndexPtr();
   double* val = m.valuePtr();
+  int diagonal = -1;
   for (int p = outer[dof]; p < outer[dof + 1]; ++p) {
-    const int i = inner[p];
-    val[p] = 0.0;                           // column dof
-    val[sys.position(dof, i)] = 0.0;        // row dof (symmetric pattern)
+    if (inner[p] == dof) diagonal = p;
+    val[p] = 0.0;                   // column dof
+    val[sys.transposed(p)] = 0.0;   // row dof (symmetric pattern)
   }
-  val[sys.position(dof, dof)] = 1.0;
+  val[diagonal] = 1.0;
 }
 
 bool CoupledFactor::factorize(const MaterialWeights& w, double sigma, Electrodes electrodes,
                               std::span<const int> clamped, double end_mass_fraction) {
   model_->system().combine(w, sigma, a_, end_mass_fraction);
-  ac_ = a_;
+  if (ac_.nonZeros() == a_.nonZeros() && ac_.rows() == a_.rows())  // the same pattern: the values only
+    std::copy(a_.valuePtr(), a_.valuePtr() + a_.nonZeros(), ac_.valuePtr());
+  else
+    ac_ = a_;
   if (electrodes == Electrodes::short_circuit) constrain(model_->dofs().electrode(), ac_);
   for (int d : clamped) constrain(d, ac_);
   if (!analysed_) {
