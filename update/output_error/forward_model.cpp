@@ -65,11 +65,30 @@ std::optional<Eigen::VectorXd> Problem::residual(const Eigen::VectorXd& x) {
   return residual_of(*t);
 }
 
+std::size_t Problem::spectrum_of(const std::vector<double>& record, std::size_t keep) {
+  for (std::size_t i = 0; i < spectra_.size(); ++i)
+    if (spectra_[i].record.size() == record.size() &&
+        std::equal(record.begin(), record.end(), spectra_[i].record.begin()))
+      return i;  // (the same FFT of the same samples: the same bins)
+  Spectrum fresh{record, std::vector<cd>(fft_.bins())};
+  fft_.forward(record.data(), n_, fresh.bins.data());
+  if (spectra_.size() < kSpectra) {
+    spectra_.push_back(std::move(fresh));
+    return spectra_.size() - 1;
+  }
+  if (spectra_next_ == keep) spectra_next_ = (spectra_next_ + 1) % kSpectra;
+  const std::size_t slot = spectra_next_;
+  spectra_next_ = (spectra_next_ + 1) % kSpectra;
+  spectra_[slot] = std::move(fresh);
+  return slot;
+}
+
 Eigen::VectorXd Problem::deviation(const std::vector<cd>& t, const std::vector<double>& d1,
                                    const std::vector<double>& d2) {
-  std::vector<cd> a(fft_.bins()), b(fft_.bins());
-  fft_.forward(d1.data(), n_, a.data());
-  fft_.forward(d2.data(), n_, b.data());
+  const std::size_t ia = spectrum_of(d1, kSpectra);
+  const std::size_t ib = spectrum_of(d2, ia);  // (never in d1's slot)
+  const std::vector<cd>& a = spectra_[ia].bins;
+  const std::vector<cd>& b = spectra_[ib].bins;
   for (std::size_t k = 0; k <= kmax_; ++k) spec_[k] = l_[k] * (t[k] * a[k] - b[k]);
   return invert();
 }
