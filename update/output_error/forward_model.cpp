@@ -65,30 +65,21 @@ std::optional<Eigen::VectorXd> Problem::residual(const Eigen::VectorXd& x) {
   return residual_of(*t);
 }
 
-std::size_t Problem::spectrum_of(const std::vector<double>& record, std::size_t keep) {
-  for (std::size_t i = 0; i < spectra_.size(); ++i)
-    if (spectra_[i].record.size() == record.size() &&
-        std::equal(record.begin(), record.end(), spectra_[i].record.begin()))
-      return i;  // (the same FFT of the same samples: the same bins)
-  Spectrum fresh{record, std::vector<cd>(fft_.bins())};
-  fft_.forward(record.data(), n_, fresh.bins.data());
-  if (spectra_.size() < kSpectra) {
-    spectra_.push_back(std::move(fresh));
-    return spectra_.size() - 1;
-  }
-  if (spectra_next_ == keep) spectra_next_ = (spectra_next_ + 1) % kSpectra;
-  const std::size_t slot = spectra_next_;
-  spectra_next_ = (spectra_next_ + 1) % kSpectra;
-  spectra_[slot] = std::move(fresh);
-  return slot;
+const std::vector<cd>& Problem::spectrum_of(const std::vector<double>& record, std::vector<cd>& scratch) {
+  const bool zero = std::all_of(record.begin(), record.begin() + static_cast<std::ptrdiff_t>(n_),
+                                [](double v) { return v == 0.0; });
+  if (zero && !zero_bins_.empty()) return zero_bins_;  // (the same FFT of the same samples: the same bins)
+  std::vector<cd>& out = zero ? zero_bins_ : scratch;
+  out.resize(fft_.bins());
+  fft_.forward(record.data(), n_, out.data());
+  return out;
 }
 
 Eigen::VectorXd Problem::deviation(const std::vector<cd>& t, const std::vector<double>& d1,
                                    const std::vector<double>& d2) {
-  const std::size_t ia = spectrum_of(d1, kSpectra);
-  const std::size_t ib = spectrum_of(d2, ia);  // (never in d1's slot)
-  const std::vector<cd>& a = spectra_[ia].bins;
-  const std::vector<cd>& b = spectra_[ib].bins;
+  std::vector<cd> sa, sb;
+  const std::vector<cd>& a = spectrum_of(d1, sa);
+  const std::vector<cd>& b = spectrum_of(d2, sb);
   for (std::size_t k = 0; k <= kmax_; ++k) spec_[k] = l_[k] * (t[k] * a[k] - b[k]);
   return invert();
 }
