@@ -8,7 +8,7 @@ namespace piezo::jobs {
 const std::vector<std::string_view>& internal_function_names() {
   static const std::vector<std::string_view> names = {
       "a_from_d31", "add_in_quadrature", "analytic_ring", "apply_channel2_response", "assess_impedance", "average_shots",
-      "band_from_replicates", "band_from_sigma", "block_header", "bootstrap_over_shots",
+      "band_from_replicates", "band_from_sigma", "bar_vibrator", "block_header", "bootstrap_over_shots",
       "bvd_start_from_circle", "check_shots", "circuit_mode_figures", "circumferential_modes", "cmcm_equations", "compute_stats",
       "conductance_peak", "cross_spectra", "d_form_sensitivity", "d_param", "debye_network_fit",
       "debye_network_for_loss", "deskew_channel", "deskew_impedance", "deskew_record", "element_split",

@@ -124,3 +124,26 @@ TEST(CmdModel, ConstrainedCsvAndBadPlotName) {
   EXPECT_EQ(run("model constrained --fmin 1000 --fmax 3000 --step 1000 --plot fig19.txt").code, 2);
   EXPECT_EQ(run("model three-d --max-n 99").code, 2);
 }
+
+// Appendix A (`model bar`): IEEE Std 176 reads the material's coupling back
+// from the first free-free pair, the 31 bar resonates at c/(2L), a fixed-free
+// bar at a quarter wave; bad input is exit code 2.
+TEST(CmdModel, BarAppendixA) {
+  auto r = run("model bar --mode 31 --length 0.02 --json");
+  ASSERT_EQ(r.code, 0) << r.out;
+  auto j = nlohmann::json::parse(r.out);
+  ASSERT_GE(j["pairs"].size(), 1u);
+  EXPECT_NEAR(j["ieee176_k"].get<double>() / j["k_material"].get<double>(), 1.0, 1e-8);
+  const double c = j["wave_speed_m_s"].get<double>();
+  EXPECT_NEAR(j["pairs"][0]["resonance_hz"].get<double>() / (c / 0.04), 1.0, 1e-10);
+  r = run("model bar --mode 33 --ends fixed-mass --length 0.02 --json");
+  ASSERT_EQ(r.code, 0) << r.out;
+  j = nlohmann::json::parse(r.out);
+  EXPECT_NEAR(j["pairs"][0]["antiresonance_hz"].get<double>() / (j["wave_speed_m_s"].get<double>() / 0.08), 1.0,
+              1e-10);
+  EXPECT_FALSE(j.contains("ieee176_k"));
+  EXPECT_EQ(run("model bar --mode 44").code, 2);
+  EXPECT_EQ(run("model bar --material nosuch").code, 2);
+  EXPECT_EQ(run("model bar --length 0").code, 2);
+  EXPECT_EQ(run("model bar --end-mass 0.001").code, 2);  // free-free has no end mass
+}

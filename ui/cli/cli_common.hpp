@@ -82,6 +82,8 @@ void register_mode_shape_command(CLI::App* model, Context& ctx);
 // `add_model_options` adds the tube's options (--material, --nr, …).
 void register_model_3d_commands(CLI::App* model, Context& ctx,
                                 const std::function<void(CLI::App*, jobs::ModelRequest&)>& add_model_options);
+// `model bar` (cmd_model_bar.cpp), under `model`: the seed's Appendix A.
+void register_model_bar_command(CLI::App* model, Context& ctx);
 void register_impedance_command(CLI::App& app, Context& ctx);
 void register_update_command(CLI::App& app, Context& ctx);
 void register_replay_command(CLI::App& app, Context& ctx);

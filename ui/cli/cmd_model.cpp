@@ -6,6 +6,7 @@
 //                                                            (Appendix C, model/sensitivity.hpp)
 //   model mode-shape-cmcm [--json] …                         (Appendix D, cmd_model_mode_shape.cpp)
 //   model three-d | constrained …                            (Table 3 3-D, Figs 17, 19: cmd_model_3d.cpp)
+//   model bar [--mode 31|33] [--ends free-free|fixed-mass] … (Appendix A: cmd_model_bar.cpp)
 // Exit codes: 0 ok, 2 bad input (unknown material, bad --set), 1 non-convergence
 // or internal failure. The CLI's room (ui/cli): options and printing; the
 // model work is jobs/model_job.hpp.
@@ -212,6 +213,7 @@ void register_model_command(CLI::App& app, Context& ctx) {
 
   register_mode_shape_command(model, ctx);
   register_model_3d_commands(model, ctx, add_model_options);
+  register_model_bar_command(model, ctx);
 }
 
 }  // namespace piezo::cli

@@ -38,7 +38,8 @@ void register_builtin_commands(CommandRegistry& r) {
   r.add({"replay-merge", "merges the results files of sharded replays", register_replay_merge_command});
   r.add({"model",
          "the FE model: `materials`, `modal`, `impedance`, `sensitivity`, `mode-shape-cmcm`, "
-         "`three-d` (the 3-D tube by circumferential harmonics), `constrained` (Fig 19)",
+         "`three-d` (the 3-D tube by circumferential harmonics), `constrained` (Fig 19), `bar` (Appendix A's "
+         "33- and 31-mode bar vibrators)",
          register_model_command});
   r.add({"instruments", "the driver families: roles, how each is chosen, its simulated twin",
          register_instruments_command});
