@@ -20,6 +20,7 @@ void CoupledFactor::constrain(int dof, SpMat& m) const {
     val[p] = 0.0;                   // column dof
     val[sys.transposed(p)] = 0.0;   // row dof (symmetric pattern)
   }
+  if (diagonal < 0) throw std::logic_error("CoupledFactor: the pattern has no diagonal entry for a DOF");
   val[diagonal] = 1.0;
 }
 
