@@ -9,61 +9,36 @@
 #include "dsp/cross_spectra.hpp"
 #include "dsp/fft_ratio.hpp"
 #include "dsp/prony_impedance.hpp"
+#include "dsp/truth_comparison.hpp"
 
 namespace piezo::study {
 
 namespace {
 using clk = std::chrono::steady_clock;
-constexpr double kInf = std::numeric_limits<double>::infinity();
 
-// The study compares |Z| extrema (what every method can report) with the true
-// extrema: per true feature, the nearest found one within ±3 %. `ambiguous`
-// counts the true features with more than one candidate there (noisy curves):
-// picking the nearest then uses the truth, so those errors are optimistic.
-std::vector<double> match(const std::vector<double>& truth, const std::vector<dsp::Feature>& found,
-                          std::size_t& ambiguous) {
-  std::vector<double> out;
-  for (double t : truth) {
-    double best = std::numeric_limits<double>::quiet_NaN(), dist = 0.03 * t;
-    std::size_t candidates = 0;
-    for (const auto& f : found) {
-      if (std::abs(f.extremum_hz - t) < 0.03 * t) ++candidates;
-      if (std::abs(f.extremum_hz - t) < dist) {
-        dist = std::abs(f.extremum_hz - t);
-        best = (f.extremum_hz - t) / t;
-      }
-    }
-    ambiguous += candidates > 1;
-    out.push_back(best);
-  }
-  return out;
+// The scores are dsp/truth_comparison.hpp's (the same as `piezobench model charge`).
+dsp::ImpedanceTruth truth_of(const StudyInput& in) {
+  dsp::ImpedanceTruth t;
+  t.z = in.z_true;
+  t.resonances_hz = in.true_resonances_hz;
+  t.antiresonances_hz = in.true_antiresonances_hz;
+  t.f_lo_hz = in.f_lo_hz;
+  t.f_hi_hz = in.f_hi_hz;
+  t.peak_exclusion_rel = in.peak_exclusion_rel;
+  return t;
 }
 
 void score(const StudyInput& in, const dsp::ImpedanceResult& r, StudyRow& row) {
   row.f_hz.assign(r.f_hz.data(), r.f_hz.data() + r.f_hz.size());
   row.z_ohm.assign(r.z_ohm.data(), r.z_ohm.data() + r.z_ohm.size());
-  row.ambiguous = 0;
-  row.res_err_rel = match(in.true_resonances_hz, r.features.resonances, row.ambiguous);
-  row.anti_err_rel = match(in.true_antiresonances_hz, r.features.antiresonances, row.ambiguous);
-  row.max_feature_err_rel = 0;
-  for (const auto* v : {&row.res_err_rel, &row.anti_err_rel})
-    for (double e : *v)
-      row.max_feature_err_rel =
-          std::isfinite(e) ? std::max(row.max_feature_err_rel, std::abs(e)) : kInf;
-  std::vector<double> err;
-  for (Eigen::Index k = 0; k < r.f_hz.size(); ++k) {
-    const double f = r.f_hz[k];
-    if (f < in.f_lo_hz || f > in.f_hi_hz) continue;
-    if (near_feature(in, f)) continue;
-    err.push_back(std::abs(20.0 * std::log10(std::abs(r.z_ohm[k]) / std::abs(in.z_true(f)))));
-    if (err.back() > row.max_db_err) {
-      row.max_db_err = err.back();
-      row.f_max_db_err = f;
-    }
-  }
-  if (err.empty()) return;
-  std::nth_element(err.begin(), err.begin() + err.size() / 2, err.end());
-  row.median_db_err = err[err.size() / 2];
+  const dsp::TruthComparison c = dsp::compare_to_truth(truth_of(in), r);
+  row.ambiguous = c.ambiguous;
+  row.res_err_rel = c.res_err_rel;
+  row.anti_err_rel = c.anti_err_rel;
+  row.max_feature_err_rel = c.max_feature_err_rel;
+  row.max_db_err = c.max_db_err;
+  row.f_max_db_err = c.f_max_db_err;
+  row.median_db_err = c.median_db_err;
 }
 
 dsp::DividerRecord record(const StudyInput& in, std::size_t k) {
@@ -80,12 +55,7 @@ StudyRow study_result(const StudyInput& in, const dsp::ImpedanceResult& r, const
   return row;
 }
 
-bool near_feature(const StudyInput& in, double f) {
-  for (const auto* v : {&in.true_resonances_hz, &in.true_antiresonances_hz})
-    for (double t : *v)
-      if (std::abs(f - t) <= in.peak_exclusion_rel * t) return true;
-  return false;
-}
+bool near_feature(const StudyInput& in, double f) { return dsp::near_true_feature(truth_of(in), f); }
 
 StudyRow study_prony(const StudyInput& in, std::size_t samples, dsp::PronyOptions prony) {
   StudyRow row;

@@ -84,6 +84,9 @@ void register_model_3d_commands(CLI::App* model, Context& ctx,
                                 const std::function<void(CLI::App*, jobs::ModelRequest&)>& add_model_options);
 // `model bar` (cmd_model_bar.cpp), under `model`: the seed's Appendix A.
 void register_model_bar_command(CLI::App* model, Context& ctx);
+// `model charge` (cmd_model_charge.cpp), under `model`: the seed's §5.1 study (Figs 24–29).
+void register_model_charge_command(CLI::App* model, Context& ctx,
+                                   const std::function<void(CLI::App*, jobs::ModelRequest&)>& add_model_options);
 void register_impedance_command(CLI::App& app, Context& ctx);
 void register_update_command(CLI::App& app, Context& ctx);
 void register_replay_command(CLI::App& app, Context& ctx);

@@ -214,6 +214,7 @@ void register_model_command(CLI::App& app, Context& ctx) {
   register_mode_shape_command(model, ctx);
   register_model_3d_commands(model, ctx, add_model_options);
   register_model_bar_command(model, ctx);
+  register_model_charge_command(model, ctx, add_model_options);
 }
 
 }  // namespace piezo::cli

@@ -39,7 +39,7 @@ void register_builtin_commands(CommandRegistry& r) {
   r.add({"model",
          "the FE model: `materials`, `modal`, `impedance`, `sensitivity`, `mode-shape-cmcm`, "
          "`three-d` (the 3-D tube by circumferential harmonics), `constrained` (Fig 19), `bar` (Appendix A's "
-         "33- and 31-mode bar vibrators)",
+         "33- and 31-mode bar vibrators), `charge` (§5.1: |Z| from the tube's charge, Figs 24-29)",
          register_model_command});
   r.add({"instruments", "the driver families: roles, how each is chosen, its simulated twin",
          register_instruments_command});
