@@ -98,6 +98,12 @@ std::vector<double> first_difference(const std::vector<double>& x) {
   return d;
 }
 
+// The estimate's name: its CSV column without "_abs_ohm", and its JSON "name".
+std::string name_of(const Estimate& e) {
+  if (e.method == "xspec") return "xspec_h1_" + std::to_string(e.records) + "x" + std::to_string(e.samples);
+  return e.method + (e.method == "prony" ? "_" + e.rule : "") + "_" + std::to_string(e.samples);
+}
+
 const char* colour_of(const Estimate& e) {
   if (e.method == "prony") return e.rule == "largest_drop" ? (e.samples <= 1000 ? "#2ca02c" : "#9467bd") : "#8c564b";
   if (e.method == "xspec") return "#d62728";
@@ -391,7 +397,8 @@ nlohmann::json run_charge_study(const ChargeStudyRequest& request) {
                 {"peak_exclusion_rel", truth.peak_exclusion_rel}};
   j["estimates"] = nlohmann::json::array();
   for (const auto& e : est) {
-    nlohmann::json x = {{"method", e.method},
+    nlohmann::json x = {{"name", name_of(e)},
+                        {"method", e.method},
                         {"label", e.label},
                         {"samples", e.samples},
                         {"median_db", e.score.median_db_err},
@@ -429,11 +436,7 @@ nlohmann::json run_charge_study(const ChargeStudyRequest& request) {
     std::ofstream os(a.csv);
     if (!os) throw InputError("--csv " + a.csv + ": cannot write the file (check the directory and permissions)");
     os << "f_hz,true_abs_ohm";
-    for (const auto& e : est) {
-      std::string name = e.method + (e.method == "prony" ? "_" + e.rule : "") + "_" + std::to_string(e.samples);
-      if (e.method == "xspec") name = "xspec_h1_" + std::to_string(e.records) + "x" + std::to_string(e.samples);
-      os << ',' << name << "_abs_ohm";
-    }
+    for (const auto& e : est) os << ',' << name_of(e) << "_abs_ohm";
     os << '\n';
     char buf[32];
     for (Eigen::Index k = 0; k < grid.size(); ++k) {
