@@ -2,9 +2,12 @@
 #include "jobs/model_job.hpp"
 
 #include <cmath>
+#include <filesystem>
 #include <stdexcept>
 
 #include "jobs/job_error.hpp"
+#include "jobs/report/mode_shapes_plot.hpp"
+#include "jobs/report/plot_cairo.hpp"
 #include "model/harmonic.hpp"
 #include "model/material_presets.hpp"
 #include "model/material_spec.hpp"
@@ -80,9 +83,12 @@ nlohmann::json materials_json() {
   return j;
 }
 
-ModalJobResult run_modal(ModelRequest a, int modes) {
+ModalJobResult run_modal(ModelRequest a, int modes, const std::string& shapes_plot) {
   const auto r = resolve(a);
   if (modes < 1 || modes > 200) throw InputError("--modes must be in 1..200");
+  const std::filesystem::path plot(shapes_plot);
+  if (!shapes_plot.empty() && plot.extension() != ".png" && plot.extension() != ".svg")
+    throw InputError("--plot-shapes " + shapes_plot + ": give a .png or .svg file name");
   pm::TubeModel tm(a.geometry, {a.n_radial, a.n_axial});
   pm::ModalSolver solver(tm);
   pm::ModalOptions o;
@@ -104,6 +110,16 @@ ModalJobResult run_modal(ModelRequest a, int modes) {
   j["c_clamped_f"] = sc.c_clamped;
   j["c_static_f"] = solver.static_capacitance(r.material);
   j["converged"] = sc.converged && oc.converged;
+  if (!shapes_plot.empty()) {
+    const auto fig = report::mode_shapes_figure(
+        tm.mesh(), sc, oc, a.material + " (" + r.model_class + " class), mesh " + std::to_string(a.n_radial) + " x " +
+                               std::to_string(a.n_axial) + " nine-node elements");
+    if (plot.extension() == ".png")
+      report::write_png(fig, plot);
+    else
+      report::write_svg(fig, plot);
+    j["shapes_plot"] = shapes_plot;
+  }
   ModalJobResult out;
   out.json = std::move(j);
   out.model_class = r.model_class;

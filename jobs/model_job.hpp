@@ -45,8 +45,10 @@ struct ModalJobResult {
   bool converged = false;
   std::string message;      // why not, when not converged
 };
-// Throws std::invalid_argument (unknown preset, bad override), InputError (modes outside 1..200).
-ModalJobResult run_modal(ModelRequest req, int modes);
+// Throws std::invalid_argument (unknown preset, bad override), InputError (modes outside 1..200,
+// a plot name that is not .png or .svg). `shapes_plot` non-empty: the mode shapes drawn there
+// (seed Figs 7, 12, 13; jobs/report/mode_shapes_plot.hpp).
+ModalJobResult run_modal(ModelRequest req, int modes, const std::string& shapes_plot = "");
 
 struct SweepRequest {
   double fmin = 0, fmax = 0, step = 0, alpha = 0, beta = 0;

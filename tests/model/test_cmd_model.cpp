@@ -226,3 +226,19 @@ TEST(CmdModel, ChargeSeed512) {
   EXPECT_EQ(run("model charge --plot-format bmp").code, 2);
   EXPECT_EQ(run("model charge --material nosuch").code, 2);
 }
+
+// `model modal --plot-shapes` (seed Figs 7, 12, 13): the figure is written, and
+// the JSON names it; a name that is not .png or .svg is bad input.
+TEST(CmdModel, ModalPlotShapes) {
+  const std::string file = std::string(PIEZO_BINARY_DIR) + "/test-model-shapes.svg";
+  std::remove(file.c_str());
+  auto r = run("model modal --plot-shapes " + file + " --json");
+  ASSERT_EQ(r.code, 0) << r.out;
+  EXPECT_EQ(nlohmann::json::parse(r.out)["shapes_plot"].get<std::string>(), file);
+  FILE* fp = std::fopen(file.c_str(), "rb");
+  ASSERT_NE(fp, nullptr);
+  std::fseek(fp, 0, SEEK_END);
+  EXPECT_GT(std::ftell(fp), 10000);
+  std::fclose(fp);
+  EXPECT_EQ(run("model modal --plot-shapes shapes.bmp").code, 2);
+}

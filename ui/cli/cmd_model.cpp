@@ -1,6 +1,6 @@
 // `piezobench model …`: the FE tube model from the command line.
 //   model materials                      presets and their sources
-//   model modal     --material M [--isotropic] [--set k=v,…] [--modes N] [--json]
+//   model modal     --material M [--isotropic] [--set k=v,…] [--modes N] [--plot-shapes F] [--json]
 //   model impedance --material M --fmin HZ --fmax HZ --step HZ [--rayleigh-beta S] [--csv|--json]
 //   model sensitivity [--material M] [--band HZ] [--form d|engineering|e] [--seed-protocol] [--json]
 //                                                            (Appendix C, model/sensitivity.hpp)
@@ -46,11 +46,12 @@ struct SweepArgs {
 struct ModalArgs {
   ModelRequest model;
   int modes = 10;
+  std::string plot_shapes;
 };
 
 void run_modal(Context& ctx, const ModalArgs& args) {
   const ModelRequest& a = args.model;
-  const auto r = jobs::run_modal(a, args.modes);
+  const auto r = jobs::run_modal(a, args.modes, args.plot_shapes);
   const auto& j = r.json;
   if (ctx.json) {
     print_json(j);
@@ -165,6 +166,8 @@ void register_model_command(CLI::App& app, Context& ctx) {
   auto* modal = model->add_subcommand("modal", "Short- and open-circuit modal analysis");
   add_model_options(modal, margs->model);
   modal->add_option("--modes", margs->modes, "Number of modes per circuit")->capture_default_str();
+  modal->add_option("--plot-shapes", margs->plot_shapes,
+                    "Draw the mode shapes (seed Figs 7, 12, 13) as PNG or SVG (by the extension)");
   add_json_flag(modal, ctx);
   modal->callback([&ctx, margs] {
     ctx.exit_code = run_command(ctx, [&] { run_modal(ctx, *margs); });
