@@ -123,6 +123,8 @@ UpdateFeaturesResult run_update_features(const UpdateFeaturesRequest& a) {
   if (a.capacitance != "fe" && a.capacitance != "analytic")
     throw InputError("--capacitance must be fe or analytic");
   if (a.max_iterations < 1) throw InputError("--max-iterations must be >= 1");
+  if (!(a.min_cross > 0.0 && a.min_cross < 1.0))
+    throw InputError("--min-cross must be in (0, 1) (default 1e-3: pairs below it carry round-off only)");
   if (!a.history_plot.empty()) {
     const std::string ext = std::filesystem::path(a.history_plot).extension().string();
     if (ext != ".png" && ext != ".svg") throw InputError("--history-plot " + a.history_plot + ": give a .png or .svg file name");
@@ -187,6 +189,7 @@ UpdateFeaturesResult run_update_features(const UpdateFeaturesRequest& a) {
 
   pu::UpdateOptions uo;
   uo.cmcm.max_iterations = a.max_iterations;
+  uo.cmcm.min_cross = a.min_cross;
   uo.cmcm.cross_modes = a.cross_modes || a.seed_procedure;
   uo.seed_procedure = a.seed_procedure;
   if (a.seed_procedure && a.method == "lm") throw InputError("--seed-procedure is a CMCM procedure: use --method cmcm or both");

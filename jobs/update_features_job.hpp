@@ -25,6 +25,9 @@ struct UpdateFeaturesRequest {
   bool seed_procedure = false;
   std::string history_plot;  // --history-plot: Figs 36-37 (α per CMCM iteration) as PNG/SVG
   int max_iterations = update::CmcmOptions{}.max_iterations;
+  // --min-cross: i != j pairs with |Φ_iᵀMΦ*_j| below this share of the norms are left out
+  // (update::CmcmOptions::min_cross); the seed's Fig 37 cycle depends on it (docs/update-methods.md).
+  double min_cross = update::CmcmOptions{}.min_cross;
   int n_radial = model::MeshOptions{}.n_radial, n_axial = model::MeshOptions{}.n_axial;
   // Said at once: a damping fit from --damping that cannot be used.
   std::function<void(const std::string&)> warn;

@@ -107,6 +107,9 @@ void register_update_command(CLI::App& app, Context& ctx) {
       ->capture_default_str();
   cmd->add_option("--max-iterations", a->f.max_iterations, "CMCM iteration cap per phase")
       ->capture_default_str();
+  cmd->add_option("--min-cross", a->f.min_cross,
+                  "i != j CMCM pairs with |Phi_i' M Phi*_j| below this share of their norms are left out")
+      ->capture_default_str();
   cmd->add_flag("--cross-modes", a->f.cross_modes,
                 "Include the i != j CMCM equations (seed-faithful, slow)");
   cmd->add_flag("--seed-procedure", a->f.seed_procedure,
