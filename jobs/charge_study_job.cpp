@@ -16,7 +16,7 @@
 #include "dsp/features.hpp"
 #include "dsp/fft.hpp"
 #include "dsp/prony_charge.hpp"
-#include "dsp/truth_comparison.hpp"
+#include "dsp/reference_comparison.hpp"
 #include "jobs/job_error.hpp"
 #include "jobs/report/plot_cairo.hpp"
 #include "model/modal.hpp"

@@ -15,7 +15,7 @@
 //   whole record (Figs 25, 26);
 // - the averaged cross spectra of `records` independent noisy records, H1 =
 //   G_vq/G_vv (Fig 26; H1 because the drive is noise-free, so H1 is unbiased).
-// Scored by dsp/truth_comparison.hpp (|Z| error away from the peaks, feature
+// Scored by dsp/reference_comparison.hpp (|Z| error away from the peaks, feature
 // errors). Plots: the signals (Fig 24), |Z| and its error (Figs 25/26/28/29),
 // the singular values (Fig 27).
 #include <cstdint>

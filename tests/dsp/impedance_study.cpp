@@ -9,14 +9,14 @@
 #include "dsp/cross_spectra.hpp"
 #include "dsp/fft_ratio.hpp"
 #include "dsp/prony_impedance.hpp"
-#include "dsp/truth_comparison.hpp"
+#include "dsp/reference_comparison.hpp"
 
 namespace piezo::study {
 
 namespace {
 using clk = std::chrono::steady_clock;
 
-// The scores are dsp/truth_comparison.hpp's (the same as `piezobench model charge`).
+// The scores are dsp/reference_comparison.hpp's (the same as `piezobench model charge`).
 dsp::ImpedanceTruth truth_of(const StudyInput& in) {
   dsp::ImpedanceTruth t;
   t.z = in.z_true;

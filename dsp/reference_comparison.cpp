@@ -1,4 +1,4 @@
-#include "dsp/truth_comparison.hpp"
+#include "dsp/reference_comparison.hpp"
 
 #include <algorithm>
 #include <cmath>
