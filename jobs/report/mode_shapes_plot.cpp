@@ -60,11 +60,14 @@ Panel shape_panel(const pm::TubeMesh& mesh, const Eigen::VectorXd& phi, const st
 
 std::string title_of(const pm::Mode& m, pm::Electrodes e) {
   char buf[200];
-  std::snprintf(buf, sizeof buf, "%s circuit, %s: %.1f Hz%s", e == pm::Electrodes::short_circuit ? "short" : "open",
-                pm::to_string(m.symmetry), m.frequency_hz,
-                m.electrically_active ? (", active, coupling " + std::to_string(m.coupling).substr(0, 6)).c_str()
-                                      : "");
-  return buf;
+  std::snprintf(buf, sizeof buf, "%s circuit, %s: %.1f Hz", e == pm::Electrodes::short_circuit ? "short" : "open",
+                pm::to_string(m.symmetry), m.frequency_hz);
+  std::string t = buf;
+  if (m.electrically_active) {
+    std::snprintf(buf, sizeof buf, ", active, coupling %.3g", m.coupling);
+    t += buf;
+  }
+  return t;
 }
 
 }  // namespace
