@@ -1,6 +1,7 @@
 #include "numerics/levenberg_marquardt.hpp"
 
 #include <algorithm>
+#include <cmath>
 #include <stdexcept>
 
 namespace piezo::numerics {
@@ -9,6 +10,13 @@ namespace {
 
 double max_abs(const Eigen::VectorXd& v) { return v.size() ? v.cwiseAbs().maxCoeff() : 0.0; }
 
+// max_p |step_p| / cap_p with LmSettings::max_step_each's caps (> 1: outside the trust region).
+double over_caps(const Eigen::VectorXd& step, const Eigen::VectorXd& caps) {
+  double k = 0;
+  for (Eigen::Index p = 0; p < step.size(); ++p) k = std::max(k, std::abs(step[p]) / caps[p]);
+  return k;
+}
+
 }  // namespace
 
 LmRun levenberg_marquardt(const LmProblem& pb, Eigen::VectorXd x, const LmSettings& s) {
@@ -16,6 +24,9 @@ LmRun levenberg_marquardt(const LmProblem& pb, Eigen::VectorXd x, const LmSettin
     throw std::invalid_argument("levenberg_marquardt: the problem needs a residual and a Jacobian");
   if (!(s.max_tries > 0) || !(s.mu0 > 0) || !(s.mu_down >= 1) || !(s.mu_up > 1))
     throw std::invalid_argument("levenberg_marquardt: tries, mu0 > 0, mu_down >= 1 and mu_up > 1 required");
+  const bool per_coordinate = s.max_step_each.size() != 0;
+  if (per_coordinate && (s.max_step_each.size() != x.size() || !(s.max_step_each.array() > 0).all()))
+    throw std::invalid_argument("levenberg_marquardt: max_step_each needs one positive cap per coordinate");
   LmRun o;
   auto eval = [&](const Eigen::VectorXd& xt) {
     ++o.residuals;
@@ -71,8 +82,13 @@ LmRun levenberg_marquardt(const LmProblem& pb, Eigen::VectorXd x, const LmSettin
       Eigen::MatrixXd a = jtj;
       for (Eigen::Index p = 0; p < a.rows(); ++p) a(p, p) += mu * std::max(jtj(p, p), s.diag_floor);
       Eigen::VectorXd step = a.ldlt().solve(-g);
-      const double big = max_abs(step);
-      if (big > s.max_step) step *= s.max_step / big;
+      if (per_coordinate) {
+        const double over = over_caps(step, s.max_step_each);
+        if (over > 1) step /= over;
+      } else {
+        const double big = max_abs(step);
+        if (big > s.max_step) step *= s.max_step / big;
+      }
       Eigen::VectorXd trial = x + step;
       if (pb.project) pb.project(trial);
       if (screened(x, trial) >= cost) {
@@ -94,7 +110,7 @@ LmRun levenberg_marquardt(const LmProblem& pb, Eigen::VectorXd x, const LmSettin
         Eigen::VectorXd ext = step;
         for (int d = 0; d < s.extend_steps && mu < s.extend_below_mu; ++d) {
           ext *= 2.0;
-          if (max_abs(ext) > s.max_step) break;
+          if (per_coordinate ? over_caps(ext, s.max_step_each) > 1 : max_abs(ext) > s.max_step) break;
           Eigen::VectorXd xe = x_old + ext;
           if (pb.project) pb.project(xe);
           if (screened(x, xe) >= c_new) break;

@@ -39,6 +39,11 @@ struct LmSettings {
   double mu_up = 4.0;           // μ ← μ · mu_up after a rejected trial
   double diag_floor = 1e-300;   // A = JᵀJ + μ·diag(max((JᵀJ)_pp, diag_floor))
   double max_step = std::numeric_limits<double>::infinity();  // trust region: largest |Δx_p| of a step
+  // … per coordinate instead, when not empty (its size x's): a step is scaled
+  // down, its direction kept, until every |Δx_p| ≤ max_step_each[p] (∞: no
+  // bound on that coordinate). For coordinates of different kinds, e.g. the
+  // logs of material constants beside an effect counted in typical sizes.
+  Eigen::VectorXd max_step_each;
   bool accept_equal = false;    // accept a trial that leaves the cost unchanged (≤ instead of <)
   // Convergence after an accepted step: its largest |Δx_p| below step_tolerance,
   // or the cost's drop below cost_tolerance, or drop/cost below

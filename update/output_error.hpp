@@ -108,6 +108,13 @@ struct OeOptions {
   double grid_span_ye11 = 0.08, grid_span_nu12 = 0.10;
   int refine = 3;
   int max_iterations = 40;
+  // The LM trust region of a scanned effect's coordinate, in typical sizes
+  // per step (the constants' logs keep their 0.3; μ still damps the step).
+  // The constants' 0.3 on it made the scan crawl: 0.3 of a typical size an
+  // iteration, 20–30 iterations (an FE port model each) to reach an effect of
+  // 6–9 typical sizes (refsim 01), and stop short where the drop per
+  // iteration fell under cost_tolerance (docs/benchmarks.md).
+  double effect_max_step = std::numeric_limits<double>::infinity();
   double step_tolerance = 1e-6;  // converged when max |Δθ| < this …
   double cost_tolerance = 1e-2;  // … or ½χ² dropped by less than this (the answer within ~0.15 sigma)
   double identifiable_rel_sigma = 0.05;

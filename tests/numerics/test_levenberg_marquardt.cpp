@@ -6,7 +6,9 @@
 
 #include <gtest/gtest.h>
 
+#include <limits>
 #include <random>
+#include <stdexcept>
 
 using namespace piezo::numerics;
 
@@ -208,4 +210,42 @@ TEST(LevenbergMarquardt, ForwardDifferencesMatchTheAnalyticJacobian) {
   pb.jacobian(x, *pb.residual(x), ja, {});
   ASSERT_TRUE(forward_difference_jacobian(pb.residual, x, *pb.residual(x), Eigen::VectorXd::Constant(2, 1e-7), jf));
   EXPECT_LT((ja - jf).cwiseAbs().maxCoeff(), 1e-5);
+}
+
+// LmSettings::max_step_each: a linear problem whose answer is 0.1 in its first
+// coordinate and 8 in its second. With one cap of 0.3 on both, every step is
+// scaled to 0.3 in the second and the run takes ⌈8/0.3⌉ iterations (the old
+// output-error effect scan); with the second uncapped and the first at 0.3
+// (not binding on the first, whose whole way is 0.1) one step reaches the
+// normal equations' answer. A cap binds per coordinate: with the first
+// capped at 0.01 the first step moves it by exactly 0.01, the direction kept.
+TEST(LevenbergMarquardt, PerCoordinateTrustRegionBindsOnlyItsCoordinate) {
+  Eigen::MatrixXd a(3, 2);
+  a << 1.0, 0.0, 0.0, 1.0, 1.0, 1.0;
+  Eigen::VectorXd y(3);
+  y << 0.1, 8.0, 8.1;  // x = (0.1, 8) fits exactly
+  LmSettings s;
+  s.step_tolerance = 1e-12;
+  s.mu0 = 1e-12;  // a Gauss-Newton step, so the caps alone limit it
+  s.max_step = 0.3;
+  const auto one_cap = levenberg_marquardt(linear_problem(a, y), Eigen::VectorXd::Zero(2), s);
+  ASSERT_TRUE(one_cap.converged);
+  EXPECT_GE(one_cap.iterations, 27);
+  s.max_step_each = Eigen::Vector2d(0.3, std::numeric_limits<double>::infinity());
+  const auto each = levenberg_marquardt(linear_problem(a, y), Eigen::VectorXd::Zero(2), s);
+  ASSERT_TRUE(each.converged);
+  EXPECT_LE(each.iterations, 3);  // the step to the answer, then the ones that find nothing lower
+  EXPECT_NEAR(each.x[0], 0.1, 1e-12);
+  EXPECT_NEAR(each.x[1], 8.0, 1e-12);
+  // The first coordinate's cap binds: the step is scaled as a whole.
+  s.max_step_each = Eigen::Vector2d(0.01, std::numeric_limits<double>::infinity());
+  s.max_iterations = 1;
+  const auto first = levenberg_marquardt(linear_problem(a, y), Eigen::VectorXd::Zero(2), s);
+  EXPECT_NEAR(first.x[0], 0.01, 1e-12);
+  EXPECT_NEAR(first.x[1], 0.8, 1e-9);
+  // One cap per coordinate, each positive.
+  s.max_step_each = Eigen::Vector3d(0.3, 0.3, 0.3);
+  EXPECT_THROW(levenberg_marquardt(linear_problem(a, y), Eigen::VectorXd::Zero(2), s), std::invalid_argument);
+  s.max_step_each = Eigen::Vector2d(0.3, 0.0);
+  EXPECT_THROW(levenberg_marquardt(linear_problem(a, y), Eigen::VectorXd::Zero(2), s), std::invalid_argument);
 }

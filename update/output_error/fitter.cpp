@@ -116,6 +116,10 @@ LmOutcome Fitter::levenberg_marquardt(Eigen::VectorXd x, const LmOutcome* lead,
   ls.max_iterations = opt.max_iterations;
   ls.max_tries = 14;
   ls.max_step = 0.3;  // trust region: no constant moves by more than 30 % in one step
+  if (x.size() > kParams) {  // an effect scanned (a sixth coordinate, in typical sizes): its own bound
+    ls.max_step_each = Eigen::VectorXd::Constant(x.size(), ls.max_step);
+    ls.max_step_each.tail(x.size() - kParams).setConstant(opt.effect_max_step);
+  }
   // The cost is ½χ²: a decrease below 1e-2 leaves the estimate within ~0.15
   // of its sigma of the optimum.
   ls.step_tolerance = opt.step_tolerance;
