@@ -11,7 +11,9 @@
 // it kept the spectrum of a zero record it filters again; 2026-11-28 afternoon).
 // The diagnosis then 522, 1, 2381 (593 and 2857 before a scanned effect's
 // coordinate got its own LM trust region, OeOptions::effect_max_step; 2026-11-28
-// evening): the bounds below are those counts.
+// evening): the bounds below are those counts. refsim-v1/01 with its hold-out
+// 704, 1, 2368 (921 and 2997 before that change: its bound, 845, catches the
+// scan's crawl of 0.3 typical sizes an iteration, which 07's alone would not).
 #include <gtest/gtest.h>
 #include <unistd.h>
 
@@ -75,6 +77,16 @@ TEST(WorkCounters, DiagnosisWithItsHoldout) {
                                       (kCorpus / "07" / "holdout.h5").string() + " --json");
   ASSERT_EQ(r.exit_code, 0) << r.err;
   expect_work(nlohmann::json::parse(r.out)["work"], 522, 1, 2381);
+}
+
+TEST(WorkCounters, DiagnosisWhoseEffectsLieManyTypicalSizesAway) {
+  // refsim 01: the scanned DAQ input resistance, dielectric loss and channel
+  // skew end 6–9 typical sizes from none.
+  if (!fs::exists(kCorpus / "01" / "fit.h5")) GTEST_SKIP() << "no corpus at " << kCorpus;
+  const auto r = piezo::test::run_cli("diagnose " + (kCorpus / "01" / "fit.h5").string() + " --holdout " +
+                                      (kCorpus / "01" / "holdout.h5").string() + " --json");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  expect_work(nlohmann::json::parse(r.out)["work"], 704, 1, 2368);
 }
 
 }  // namespace
