@@ -117,6 +117,9 @@ struct OeOptions {
   double effect_max_step = std::numeric_limits<double>::infinity();
   double step_tolerance = 1e-6;  // converged when max |Δθ| < this …
   double cost_tolerance = 1e-2;  // … or ½χ² dropped by less than this (the answer within ~0.15 sigma)
+  // (with the full Jacobian; a scanned effect's run with the constants' columns
+  // frozen is a chord method and can stop further off: two settings of its trust
+  // region ended up to 2.3 apart in χ², refsim 08's mechanical damping.)
   double identifiable_rel_sigma = 0.05;
   // Systematic (type B) uncertainties of the measurement chain that the
   // samples cannot separate from the constants — R1 and a capacitance across
