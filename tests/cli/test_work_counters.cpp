@@ -71,22 +71,24 @@ TEST(WorkCounters, ReplayOfOneCorpusCapture) {
   fs::remove_all(dir);
 }
 
+// `diagnose` of a corpus capture with its hold-out, its work against the counts.
+void expect_diagnosis_work(const std::string& capture, long modal, long prony, long ffts) {
+  const auto r = piezo::test::run_cli("diagnose " + (kCorpus / capture / "fit.h5").string() + " --holdout " +
+                                      (kCorpus / capture / "holdout.h5").string() + " --json");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  expect_work(nlohmann::json::parse(r.out)["work"], modal, prony, ffts);
+}
+
 TEST(WorkCounters, DiagnosisWithItsHoldout) {
   if (!fs::exists(kCorpus / "07" / "fit.h5")) GTEST_SKIP() << "no corpus at " << kCorpus;
-  const auto r = piezo::test::run_cli("diagnose " + (kCorpus / "07" / "fit.h5").string() + " --holdout " +
-                                      (kCorpus / "07" / "holdout.h5").string() + " --json");
-  ASSERT_EQ(r.exit_code, 0) << r.err;
-  expect_work(nlohmann::json::parse(r.out)["work"], 522, 1, 2381);
+  expect_diagnosis_work("07", 522, 1, 2381);
 }
 
 TEST(WorkCounters, DiagnosisWhoseEffectsLieManyTypicalSizesAway) {
   // refsim 01: the scanned DAQ input resistance, dielectric loss and channel
   // skew end 6–9 typical sizes from none.
   if (!fs::exists(kCorpus / "01" / "fit.h5")) GTEST_SKIP() << "no corpus at " << kCorpus;
-  const auto r = piezo::test::run_cli("diagnose " + (kCorpus / "01" / "fit.h5").string() + " --holdout " +
-                                      (kCorpus / "01" / "holdout.h5").string() + " --json");
-  ASSERT_EQ(r.exit_code, 0) << r.err;
-  expect_work(nlohmann::json::parse(r.out)["work"], 704, 1, 2368);
+  expect_diagnosis_work("01", 704, 1, 2368);
 }
 
 }  // namespace
