@@ -55,6 +55,27 @@ void RealFft::inverse(const std::complex<double>* in, double* out, std::size_t c
   std::memcpy(out, rbuf_, std::min(count, n_) * sizeof(double));
 }
 
+ComplexFft::ComplexFft(std::size_t n) : n_(n) {
+  if (n < 1) throw std::invalid_argument("ComplexFft: size must be >= 1");
+  std::lock_guard<std::mutex> lock(planner_mutex());
+  auto* c = fftw_alloc_complex(n);
+  if (!c) throw std::bad_alloc();
+  buf_ = reinterpret_cast<std::complex<double>*>(c);  // the layouts agree (FFTW's manual, §4.1.1)
+  fwd_ = fftw_plan_dft_1d(static_cast<int>(n), c, c, FFTW_FORWARD, FFTW_ESTIMATE);
+  inv_ = fftw_plan_dft_1d(static_cast<int>(n), c, c, FFTW_BACKWARD, FFTW_ESTIMATE);
+  if (!fwd_ || !inv_) throw std::runtime_error("ComplexFft: FFTW planning failed");
+}
+
+ComplexFft::~ComplexFft() {
+  std::lock_guard<std::mutex> lock(planner_mutex());
+  if (fwd_) fftw_destroy_plan(static_cast<fftw_plan>(fwd_));
+  if (inv_) fftw_destroy_plan(static_cast<fftw_plan>(inv_));
+  fftw_free(buf_);
+}
+
+void ComplexFft::forward() { fftw_execute(static_cast<fftw_plan>(fwd_)); }
+void ComplexFft::inverse() { fftw_execute(static_cast<fftw_plan>(inv_)); }
+
 std::size_t good_fft_size(std::size_t n) {
   if (n <= 2) return 2;
   for (std::size_t m = n;; ++m) {

@@ -30,6 +30,26 @@ class RealFft {
   void* inv_ = nullptr;
 };
 
+// FFTW3's complex transform of size n, in place on its own buffer (data()).
+class ComplexFft {
+ public:
+  explicit ComplexFft(std::size_t n);
+  ~ComplexFft();
+  ComplexFft(const ComplexFft&) = delete;
+  ComplexFft& operator=(const ComplexFft&) = delete;
+
+  std::size_t size() const { return n_; }
+  std::complex<double>* data() { return buf_; }
+  void forward();  // X[k] = Σ x[n] e^{−j2πkn/N}
+  void inverse();  // x[n] = Σ X[k] e^{+j2πkn/N} (unnormalised)
+
+ private:
+  std::size_t n_;
+  std::complex<double>* buf_ = nullptr;
+  void* fwd_ = nullptr;
+  void* inv_ = nullptr;
+};
+
 // Smallest n' >= n whose prime factors are 2, 3, 5, 7 (fast FFTW sizes).
 std::size_t good_fft_size(std::size_t n);
 

@@ -42,8 +42,9 @@ Problem::Problem(model::ModalSolver& solver, const MaterialClass& cls, const Coo
   }
   decim_ = std::max<std::size_t>(1, static_cast<std::size_t>(fs_ / (2.0 * band_hz)));
   for (std::size_t i = 0; i < n_; i += decim_) idx_.push_back(i);
-  spec_.assign(fft_.bins(), cd(0.0, 0.0));
-  buf_.resize(n_);
+  spec_.assign(kmax_ + 1, cd(0.0, 0.0));
+  dinv_.emplace(nfft_, kmax_, decim_, idx_.size());
+  buf_.resize(idx_.size());
   cache_.reserve(kCache);
 }
 
@@ -157,11 +158,14 @@ std::vector<cd> Problem::transfer_of(const model::ModalPortModel& port, double b
 }
 
 Eigen::VectorXd Problem::invert() {
-  for (std::size_t k = kmax_ + 1; k < spec_.size(); ++k) spec_[k] = 0.0;
-  fft_.inverse(spec_.data(), buf_.data(), n_);
+  // Only the kept samples idx_ = 0, decim_, 2·decim_, … of the nfft_-point
+  // inverse (a chirp-z transform of the kmax_ + 1 bins: dsp/decimated_inverse.hpp;
+  // the full real inverse of nfft_ points, every sample but these dropped, was
+  // a quarter of a replay's time).
+  (*dinv_)(spec_.data(), buf_.data());
   Eigen::VectorXd r(static_cast<Eigen::Index>(idx_.size()));
   const double scale = 1.0 / double(nfft_);
-  for (std::size_t i = 0; i < idx_.size(); ++i) r[static_cast<Eigen::Index>(i)] = buf_[idx_[i]] * scale;
+  for (std::size_t i = 0; i < idx_.size(); ++i) r[static_cast<Eigen::Index>(i)] = buf_[i] * scale;
   return r;
 }
 

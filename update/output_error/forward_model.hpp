@@ -17,6 +17,7 @@
 #include <utility>
 #include <vector>
 
+#include "dsp/decimated_inverse.hpp"
 #include "dsp/fft.hpp"
 #include "model/effects.hpp"
 #include "model/modal.hpp"
@@ -208,8 +209,9 @@ class Problem {
   dsp::RealFft fft_;
   std::size_t kmax_ = 0, decim_ = 1;
   std::vector<cd> l_, lv1_, ly_, spec_;
-  std::vector<double> buf_;
+  std::vector<double> buf_;  // invert's decimated samples
   std::vector<std::size_t> idx_;
+  std::optional<dsp::DecimatedInverse> dinv_;  // the inverse DFT at idx_ only (invert)
   std::atomic<int> evaluations_{0};
   // Every model a fit builds stays (least recently used out beyond this): with
   // 16, a diagnosis with its effect scan rebuilt 38 of its 566 models (refsim
