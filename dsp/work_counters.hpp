@@ -1,7 +1,9 @@
 #pragma once
 // Process-wide counters of dsp/'s expensive work (issue 43; see
 // model/work_counters.hpp): Prony-SS decompositions (one Hankel SVD each,
-// at any order or replicate) and FFTs executed (RealFft, forward or inverse).
+// at any order or replicate) and FFTs executed (RealFft, forward or inverse;
+// a DecimatedInverse, one inverse DFT evaluated at every d-th sample by two
+// shorter complex FFTs, counts as one).
 #include <atomic>
 
 namespace piezo::dsp {
