@@ -34,7 +34,7 @@ std::size_t convolution_length(std::size_t k_max, std::size_t count) {
 }  // namespace
 
 DecimatedInverse::DecimatedInverse(std::size_t n, std::size_t k_max, std::size_t d, std::size_t count)
-    : n_(n), k_max_(k_max), d_(d), count_(count), fft_(convolution_length(k_max, count)) {
+    : n_(n), k_max_(k_max), count_(count), fft_(convolution_length(k_max, count)) {
   if (n < 2 || d < 1 || count < 1 || k_max > n / 2)
     throw std::invalid_argument("DecimatedInverse: needs N >= 2, d >= 1, count >= 1 and k_max <= N/2 (N " +
                                 std::to_string(n) + ", k_max " + std::to_string(k_max) + ", d " +
@@ -53,7 +53,7 @@ DecimatedInverse::DecimatedInverse(std::size_t n, std::size_t k_max, std::size_t
 }
 
 DecimatedInverse::DecimatedInverse(const DecimatedInverse& o)
-    : n_(o.n_), k_max_(o.k_max_), d_(o.d_), count_(o.count_), chirp_(o.chirp_), kernel_(o.kernel_),
+    : n_(o.n_), k_max_(o.k_max_), count_(o.count_), chirp_(o.chirp_), kernel_(o.kernel_),
       fft_(o.fft_.size()) {}
 
 void DecimatedInverse::operator()(const std::complex<double>* bins, double* out) {

@@ -30,7 +30,7 @@ class DecimatedInverse {
   void operator()(const std::complex<double>* bins, double* out);
 
  private:
-  std::size_t n_, k_max_, d_, count_;
+  std::size_t n_, k_max_, count_;
   std::vector<std::complex<double>> chirp_;   // c(j) = e^{jπ d j²/N}, j ≤ max(k_max, count)
   std::vector<std::complex<double>> kernel_;  // FFT of conj c(j), j = −k_max … count−1, / L
   ComplexFft fft_;                            // length L ≥ k_max + count
