@@ -7,14 +7,21 @@
 // Prony cases on the chapter-5 study's data: the FE tube's divider transient
 // (APC850, β = 1e-7, 500 V exp_decay, 10 % noise per channel as the seed defines
 // it; tests/dsp/fe_chapter5.hpp builds the same records).
+// BM_ResidualInverse: the output-error residual's inverse DFT at the corpus's
+// two shapes (a 20 000-sample capture and a 50 000-sample held-out chirp, both
+// padded to 4n, decimation 33), the full real inverse against the decimated one
+// (dsp/decimated_inverse, issue 43).
 #include <benchmark/benchmark.h>
 
 #include <cmath>
+#include <complex>
 #include <numbers>
 #include <random>
 #include <vector>
 
 #include "dsp/cross_spectra.hpp"
+#include "dsp/decimated_inverse.hpp"
+#include "dsp/fft.hpp"
 #include "dsp/fft_ratio.hpp"
 #include "dsp/prony_impedance.hpp"
 #include "model/material_spec.hpp"
@@ -147,6 +154,39 @@ void BM_FftRatio(benchmark::State& st) {
   }
 }
 BENCHMARK(BM_FftRatio)->Arg(1000000)->Unit(benchmark::kMillisecond);
+
+// Arg 0: the record's length n (nfft = 4n, decim 33, kmax = 1.25·nfft/33, as
+// the fit's Problem); arg 1: 0 = RealFft::inverse of all nfft points, 1 =
+// DecimatedInverse of the n/33 kept samples.
+void BM_ResidualInverse(benchmark::State& st) {
+  const std::size_t n = static_cast<std::size_t>(st.range(0)), nfft = 4 * n, decim = 33;
+  const std::size_t kmax = nfft * 5 / (4 * decim), count = (n + decim - 1) / decim;
+  std::mt19937 rng(1);
+  std::normal_distribution<double> n01;
+  std::vector<std::complex<double>> bins(nfft / 2 + 1, 0.0);
+  for (std::size_t k = 0; k <= kmax; ++k) bins[k] = {n01(rng), n01(rng)};
+  if (st.range(1) == 0) {
+    dsp::RealFft fft(nfft);
+    std::vector<double> out(n);
+    for (auto _ : st) {
+      fft.inverse(bins.data(), out.data(), n);
+      benchmark::DoNotOptimize(out.data());
+    }
+  } else {
+    dsp::DecimatedInverse dinv(nfft, kmax, decim, count);
+    std::vector<double> out(count);
+    for (auto _ : st) {
+      dinv(bins.data(), out.data());
+      benchmark::DoNotOptimize(out.data());
+    }
+  }
+}
+BENCHMARK(BM_ResidualInverse)
+    ->Args({20000, 0})
+    ->Args({20000, 1})
+    ->Args({50000, 0})
+    ->Args({50000, 1})
+    ->Unit(benchmark::kMicrosecond);
 
 // 1e6 samples as 20 records of 5e4 (the seed's cross-spectra set-up), and as
 // one record in Welch segments of 5e4 with 50 % overlap.
