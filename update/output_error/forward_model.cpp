@@ -17,7 +17,7 @@ Problem::Problem(model::ModalSolver& solver, const MaterialClass& cls, const Coo
                  const Averaged& rec, const OeData& data, double band_hz,
                  const model::ModalOptions& modal)
     : solver_(solver), cls_(cls), co_(co), modal_(modal), r1_(data.circuit.r1_ohm),
-      fs_(data.sample_rate_hz), n_(rec.v1.size()),
+      fs_(data.sample_rate_hz), band_hz_(band_hz), n_(rec.v1.size()),
       nfft_(dsp::good_fft_size(std::max<std::size_t>(4 * n_, 1u << 14))), fft_(nfft_) {
   fx_.series_resistance_ohm = data.circuit.r_lead_ohm;
   fx_.parallel_capacitance_f = data.circuit.c_parallel_f;

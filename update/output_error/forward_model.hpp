@@ -60,6 +60,12 @@ class Problem {
   std::size_t samples() const { return idx_.size(); }
   int evaluations() const { return evaluations_; }  // FE port models built
   double sample_rate_hz() const { return fs_; }
+  // What the filtered, decimated residual's shape depends on besides θ: the
+  // low-pass's band, the record's padding and the decimation (with the rate
+  // and samples() above).
+  double band_hz() const { return band_hz_; }
+  std::size_t padded_length() const { return nfft_; }
+  std::size_t decimation() const { return decim_; }
   double transfer_bin_hz() const { return fs_ / double(nfft_); }  // spacing of T(f_k)'s bins
 
   // The FE port model of the material part of x (θ without β) with an end
@@ -204,7 +210,7 @@ class Problem {
   double r1_;
   model::EffectSet fx_;
   std::function<void(model::EffectSet&, double)> free_;
-  double fs_;
+  double fs_, band_hz_;
   std::size_t n_, nfft_;
   dsp::RealFft fft_;
   std::size_t kmax_ = 0, decim_ = 1;

@@ -1,0 +1,144 @@
+// The output-error fit's baseline columns (update/output_error/baseline.hpp):
+// L ∗ b at the kept samples for each slow basis function b, kept once per
+// process and record shape. Checked against the same filter applied directly
+// (Problem::deviation of the polynomial and the hum written out here): the
+// columns do not depend on the transfer T, a second record of the same shape
+// (other samples) gets the same columns, and a record filtered with another
+// band gets its own.
+#include <gtest/gtest.h>
+
+#include <Eigen/Core>
+#include <cmath>
+#include <complex>
+#include <numbers>
+#include <random>
+#include <vector>
+
+#include "model/material_presets.hpp"
+#include "model/material_spec.hpp"
+#include "model/modal.hpp"
+#include "model/tube_model.hpp"
+#include "update/output_error/baseline.hpp"
+#include "update/output_error/forward_model.hpp"
+
+namespace {
+using namespace piezo;
+using cd = std::complex<double>;
+
+constexpr double kFs = 1e6;        // 40 ms records: three hum harmonics fit
+constexpr std::size_t kN = 40000;
+
+update::oe::Averaged record(unsigned seed) {
+  std::mt19937 rng(seed);
+  std::normal_distribution<double> n01;
+  update::oe::Averaged rec;
+  rec.v1.resize(kN);
+  rec.v2.resize(kN);
+  for (std::size_t i = 0; i < kN; ++i) {
+    rec.v1[i] = std::exp(-3000.0 * double(i) / kFs) + 0.01 * n01(rng);
+    rec.v2[i] = 0.5 * rec.v1[i] + 0.01 * n01(rng);
+  }
+  rec.shots = 1;
+  return rec;
+}
+
+// P0..P3 on [−1, 1] and cos/sin(2π·h·f·t): the basis the columns filter.
+std::vector<std::vector<double>> basis(double mains_hz) {
+  std::vector<std::vector<double>> out;
+  for (int k = 0; k <= 3; ++k) {
+    std::vector<double> b(kN);
+    for (std::size_t i = 0; i < kN; ++i) {
+      const double x = 2.0 * double(i) / double(kN - 1) - 1.0;
+      b[i] = k == 0 ? 1.0 : k == 1 ? x : k == 2 ? 0.5 * (3 * x * x - 1) : 0.5 * (5 * x * x * x - 3 * x);
+    }
+    out.push_back(b);
+  }
+  for (int h = 1; h <= 3; ++h) {
+    std::vector<double> c(kN), s(kN);
+    for (std::size_t i = 0; i < kN; ++i) {
+      const double ph = 2.0 * std::numbers::pi * h * mains_hz * double(i) / kFs;
+      c[i] = std::cos(ph);
+      s[i] = std::sin(ph);
+    }
+    out.push_back(c);
+    out.push_back(s);
+  }
+  return out;
+}
+
+// The columns the filter gives, one deviation each (−b on v2, nothing on v1).
+Eigen::MatrixXd direct(update::oe::Problem& prob, const std::vector<cd>& t, double mains_hz) {
+  const auto b = basis(mains_hz);
+  const std::vector<double> zero(kN, 0.0);
+  Eigen::MatrixXd cols(static_cast<Eigen::Index>(prob.samples()), static_cast<Eigen::Index>(b.size()));
+  for (std::size_t c = 0; c < b.size(); ++c) {
+    std::vector<double> neg(kN);
+    for (std::size_t i = 0; i < kN; ++i) neg[i] = -b[c][i];
+    cols.col(static_cast<Eigen::Index>(c)) = prob.deviation(t, zero, neg);
+  }
+  return cols;
+}
+
+class BaselineColumns : public ::testing::Test {
+ protected:
+  model::TubeModel tube{model::TubeGeometry{}};
+  model::ModalSolver solver{tube};
+  update::MaterialClass cls = update::MaterialClass::isotropic();
+  update::TubeParams nominal = model::isotropic_params(model::resolve_material({"apc850", true, ""}).d);
+  update::OeData data() const {
+    update::OeData d;
+    d.sample_rate_hz = kFs;
+    d.circuit.r1_ohm = 3140.0;
+    return d;
+  }
+  update::oe::Coordinates5 co() const { return {nominal, 1e-7, update::OeDamping::rayleigh}; }
+};
+
+// The columns against the filter applied directly, to rounding (the
+// polynomial is written out here, not taken from baseline.cpp).
+void expect_columns(const Eigen::MatrixXd& got, const Eigen::MatrixXd& want) {
+  ASSERT_EQ(got.rows(), want.rows());
+  ASSERT_EQ(got.cols(), want.cols());
+  for (Eigen::Index c = 0; c < want.cols(); ++c) {
+    const double scale = want.col(c).cwiseAbs().maxCoeff();
+    ASSERT_GT(scale, 0.0);
+    EXPECT_LT((got.col(c) - want.col(c)).cwiseAbs().maxCoeff(), 1e-12 * scale) << "column " << c;
+  }
+}
+
+}  // namespace
+
+TEST_F(BaselineColumns, DoNotDependOnTheTransferNorOnTheSamplesAndFollowTheBand) {
+  const auto rec = record(1);
+  const auto d = data();
+  update::oe::Problem prob(solver, cls, co(), rec, d, 100e3, {});
+  const Eigen::VectorXd x0 = Eigen::VectorXd::Zero(update::oe::kParams);
+  const auto t1 = prob.transfer(x0);
+  ASSERT_TRUE(t1.has_value());
+  std::vector<cd> t2 = *t1;  // another transfer: the columns must not see it
+  for (auto& v : t2) v *= cd(0.7, 0.2);
+  const int h = update::oe::hum_harmonics(50.0, double(kN) / kFs);
+  ASSERT_EQ(h, 3);
+
+  const Eigen::MatrixXd first = update::oe::baseline_columns(prob, rec, *t1, 3, 50.0, h);
+  expect_columns(first, direct(prob, *t1, 50.0));
+  const Eigen::MatrixXd again = update::oe::baseline_columns(prob, rec, t2, 3, 50.0, h);
+  EXPECT_EQ(again, first);
+  EXPECT_EQ(update::oe::baseline_columns(prob, rec, t2, 0, 0.0, 0), first.leftCols(1));
+
+  // Another record of the same shape (other samples): the same columns.
+  const auto rec2 = record(2);
+  update::oe::Problem prob2(solver, cls, co(), rec2, d, 100e3, {});
+  EXPECT_EQ(update::oe::baseline_columns(prob2, rec2, t2, 3, 50.0, h), first);
+
+  // The same record under another low-pass of the same decimation (5): its
+  // own columns, not the first's.
+  update::oe::Problem prob3(solver, cls, co(), rec, d, 90e3, {});
+  ASSERT_EQ(prob3.decimation(), prob.decimation());
+  const auto t3 = prob3.transfer(x0);
+  ASSERT_TRUE(t3.has_value());
+  const Eigen::MatrixXd other = update::oe::baseline_columns(prob3, rec, *t3, 3, 50.0, h);
+  expect_columns(other, direct(prob3, *t3, 50.0));
+  ASSERT_EQ(other.rows(), first.rows());
+  EXPECT_GT((other - first).cwiseAbs().maxCoeff(), 1e-3 * first.cwiseAbs().maxCoeff());
+}
