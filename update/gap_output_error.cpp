@@ -321,6 +321,8 @@ GapDiagnosis gap_from_output_error(const OeResult& r, const std::string& fit_des
   // the second with its own solver on the same tube: the same numbers.
   std::vector<const OeEffect*> candidates;
   for (const auto& e : r.effects) candidates.push_back(&e);
+  // (one held-out record, one band: the predictions share its baseline columns)
+  const std::shared_ptr<OeRecordShare> shared = make_record_share();
   std::optional<OePrediction> base;
   std::exception_ptr base_error;
   std::vector<std::optional<OePrediction>> with(candidates.size());
@@ -328,7 +330,7 @@ GapDiagnosis gap_from_output_error(const OeResult& r, const std::string& fit_des
   auto predict_base = [&](model::ModalSolver& s) {
     try {
       base = predict_output_error(s, cls, r.updated, r.loss(), r.effect_set, heldout.data, r.band_hz, options,
-                                  r.covariance_rel);
+                                  r.covariance_rel, "", shared);
     } catch (...) {
       base_error = std::current_exception();
     }
@@ -337,7 +339,7 @@ GapDiagnosis gap_from_output_error(const OeResult& r, const std::string& fit_des
     const OeEffect& e = *candidates[i];
     try {
       with[i] = predict_output_error(s, cls, e.material, e.loss(), e.effect_set, heldout.data, r.band_hz, options,
-                                     e.covariance_rel, e.name);
+                                     e.covariance_rel, e.name, shared);
     } catch (const std::exception& ex) {
       // not simulable with it (an end mass the FE model refuses, a value that
       // makes the divider singular): no held-out number for it

@@ -39,6 +39,7 @@
 #include <limits>
 #include <optional>
 #include <span>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -389,6 +390,14 @@ struct OePrediction {
 // over the fit's coordinates (and the effect's, `effect`), to first order
 // rᵀ(σ²I + J·C·Jᵀ)⁻¹r — a held-out record far richer than the fit's (a chirp)
 // sees the fit's constants' sigmas, which are no gap.
+// What predictions on one held-out record may share (predict_output_error's
+// `shared`, one per diagnosis: gap_output_error): the filtered baseline
+// columns of its slow disturbances, which depend on the record's shape and the
+// band alone, computed once for all of them whichever thread asks first. A
+// prediction on a record of another shape or band keeps its own.
+struct OeRecordShare;
+std::shared_ptr<OeRecordShare> make_record_share();
+
 OePrediction predict_output_error(model::ModalSolver& solver, const MaterialClass& cls, const TubeParams& params,
                                   double beta_s, const model::EffectSet& effects, const OeData& data,
                                   double band_hz, const OeOptions& options = {},
@@ -401,6 +410,7 @@ OePrediction predict_output_error(model::ModalSolver& solver, const MaterialClas
                                   const model::EffectSet& effects, const OeData& data,
                                   double band_hz, const OeOptions& options = {},
                                   const Eigen::MatrixXd& covariance_rel = {},
-                                  const std::string& effect = "");
+                                  const std::string& effect = "",
+                                  const std::shared_ptr<OeRecordShare>& shared = nullptr);
 
 }  // namespace piezo::update

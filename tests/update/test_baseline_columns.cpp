@@ -1,10 +1,12 @@
 // The output-error fit's baseline columns (update/output_error/baseline.hpp):
 // L ∗ b at the kept samples for each slow basis function b, kept once per
-// process and record shape. Checked against the same filter applied directly
-// (Problem::deviation of the polynomial and the hum written out here): the
-// columns do not depend on the transfer T, a second record of the same shape
-// (other samples) gets the same columns, and a record filtered with another
-// band gets its own.
+// problem (Problem::kept_column). Checked against the same filter applied
+// directly (Problem::deviation of the polynomial and the hum written out
+// here): the columns do not depend on the transfer T (a second call with
+// another T returns the same, and so does a fork of the problem), a second
+// record of the same shape (other samples) gets the same columns, problems
+// sharing a record's columns compute them once, and a record filtered with
+// another band gets its own.
 #include <gtest/gtest.h>
 
 #include <Eigen/Core>
@@ -14,6 +16,7 @@
 #include <random>
 #include <vector>
 
+#include "dsp/work_counters.hpp"
 #include "model/material_presets.hpp"
 #include "model/material_spec.hpp"
 #include "model/modal.hpp"
@@ -122,19 +125,38 @@ TEST_F(BaselineColumns, DoNotDependOnTheTransferNorOnTheSamplesAndFollowTheBand)
 
   const Eigen::MatrixXd first = update::oe::baseline_columns(prob, rec, *t1, 3, 50.0, h);
   expect_columns(first, direct(prob, *t1, 50.0));
+  const long ffts = dsp::ffts();  // (the kept columns: no transform again)
   const Eigen::MatrixXd again = update::oe::baseline_columns(prob, rec, t2, 3, 50.0, h);
   EXPECT_EQ(again, first);
   EXPECT_EQ(update::oe::baseline_columns(prob, rec, t2, 0, 0.0, 0), first.leftCols(1));
+
+  // A fork of the problem (another thread's) shares what it kept.
+  model::ModalSolver other_solver{tube};
+  update::oe::Problem fork(prob, other_solver);
+  EXPECT_EQ(update::oe::baseline_columns(fork, rec, t2, 3, 50.0, h), first);
+  EXPECT_EQ(dsp::ffts(), ffts);
 
   // Another record of the same shape (other samples): the same columns.
   const auto rec2 = record(2);
   update::oe::Problem prob2(solver, cls, co(), rec2, d, 100e3, {});
   EXPECT_EQ(update::oe::baseline_columns(prob2, rec2, t2, 3, 50.0, h), first);
 
+  // Problems that share one record's columns (the held-out predictions of a
+  // diagnosis): the second computes none; one under another band keeps its own.
+  const auto share = update::make_record_share();
+  update::oe::Problem a(solver, cls, co(), rec, d, 100e3, {});
+  a.share_columns(share);
+  EXPECT_EQ(update::oe::baseline_columns(a, rec, t2, 3, 50.0, h), first);
+  update::oe::Problem b(solver, cls, co(), rec2, d, 100e3, {});
+  b.share_columns(share);
+  const long before_b = dsp::ffts();
+  EXPECT_EQ(update::oe::baseline_columns(b, rec2, t2, 3, 50.0, h), first);
+  EXPECT_EQ(dsp::ffts(), before_b);
+
   // The same record under another low-pass of the same decimation (5): its
-  // own columns, not the first's.
+  // own columns (also when offered the share).
   update::oe::Problem prob3(solver, cls, co(), rec, d, 90e3, {});
-  ASSERT_EQ(prob3.decimation(), prob.decimation());
+  prob3.share_columns(share);
   const auto t3 = prob3.transfer(x0);
   ASSERT_TRUE(t3.has_value());
   const Eigen::MatrixXd other = update::oe::baseline_columns(prob3, rec, *t3, 3, 50.0, h);

@@ -4,12 +4,9 @@
 #include <Eigen/Dense>
 #include <algorithm>
 #include <cmath>
-#include <compare>
 #include <limits>
 #include <map>
 #include <memory>
-#include <mutex>
-#include <optional>
 #include <vector>
 
 #include "dsp/fft.hpp"
@@ -77,97 +74,41 @@ int hum_harmonics(double mains_hz, double seconds) {
   return n;
 }
 
-namespace {
-
-// One baseline column's identity: the basis function (a Legendre polynomial
-// of order k, or the cosine or sine of harmonic h of the mains) and all the
-// column depends on besides it — the record's length and rate and the fit's
-// low-pass (band, padding, decimation). T does not enter (deviation's v1
-// side is zero: T·0 − b is −b exactly), so the fit, its refits and every
-// held-out prediction on a record of one shape share the same columns.
-struct ColumnKey {
-  double fs, band;
-  std::size_t n, nfft, decim;
-  int kind;  // 0 Legendre, 1 cosine, 2 sine
-  int order;
-  double hz;
-  auto operator<=>(const ColumnKey&) const = default;
-};
-
-// The columns computed so far in this process (a pure function of the key:
-// any thread may fill or read it). A replay's records come in a few shapes;
-// past kMaxColumns (a few MB) it starts again.
-class ColumnMemo {
- public:
-  std::optional<Eigen::VectorXd> find(const ColumnKey& k) {
-    std::lock_guard<std::mutex> lock(mutex_);
-    const auto it = columns_.find(k);
-    if (it == columns_.end()) return std::nullopt;
-    return it->second;
-  }
-  void keep(const ColumnKey& k, const Eigen::VectorXd& c) {
-    std::lock_guard<std::mutex> lock(mutex_);
-    if (columns_.size() >= kMaxColumns) columns_.clear();
-    columns_.emplace(k, c);
-  }
-
- private:
-  static constexpr std::size_t kMaxColumns = 512;
-  std::mutex mutex_;
-  std::map<ColumnKey, Eigen::VectorXd> columns_;
-};
-
-ColumnMemo& column_memo() {
-  static ColumnMemo memo;
-  return memo;
-}
-
-}  // namespace
-
 Eigen::MatrixXd baseline_columns(Problem& prob, const Averaged& rec, const std::vector<cd>& t, int degree,
                                  double mains_hz, int harmonics) {
   const std::size_t n = rec.v1.size();
   const double fs = prob.sample_rate_hz();
   const double seconds = double(n) / fs;
-  const ColumnKey shape{fs, prob.band_hz(), n, prob.padded_length(), prob.decimation(), 0, 0, 0.0};
-  std::vector<ColumnKey> keys;
-  for (int k = 0; k <= degree; ++k) {
-    ColumnKey key = shape;
-    key.order = k;
-    keys.push_back(key);
-  }
+  // Each column by its basis function: (0, k, 0) Legendre P_k, (1, h, f) and
+  // (2, h, f) the cosine and sine of harmonic h of the mains f.
+  std::vector<Problem::ColumnKey> keys;
+  for (int k = 0; k <= degree; ++k) keys.emplace_back(0, k, 0.0);
   if (mains_hz > 0 && harmonics > 0)
     for (int h = 1; h <= 3; ++h) {
       if (!(h * mains_hz * seconds >= 0.5)) continue;
-      for (int kind : {1, 2}) {
-        ColumnKey key = shape;
-        key.kind = kind;
-        key.order = h;
-        key.hz = mains_hz;
-        keys.push_back(key);
-      }
+      keys.emplace_back(1, h, mains_hz);
+      keys.emplace_back(2, h, mains_hz);
     }
-  const std::vector<double> zero(n, 0.0);
   Eigen::MatrixXd cols(static_cast<Eigen::Index>(prob.samples()), static_cast<Eigen::Index>(keys.size()));
   // L ∗ (T ∗ 0 − (−b)) = L ∗ b: the residual of a baseline b on v1 (T ≈ 1 at
-  // its frequencies), the negative of one on v2.
-  std::vector<double> neg(n);
+  // its frequencies), the negative of one on v2. T·0 − (−b) is b exactly:
+  // the columns do not depend on t, and the problem keeps each (the
+  // disturbance test, its mains frequencies and the whitening ask for the
+  // same ones again).
   for (std::size_t c = 0; c < keys.size(); ++c) {
-    const ColumnKey& key = keys[c];
-    if (auto kept = column_memo().find(key)) {
-      cols.col(static_cast<Eigen::Index>(c)) = *kept;
-      continue;
-    }
-    for (std::size_t i = 0; i < n; ++i) {
-      if (key.kind == 0) {
-        neg[i] = -legendre(key.order, n > 1 ? 2.0 * double(i) / double(n - 1) - 1.0 : 0.0);
-      } else {
-        const double ph = kTwoPi * key.order * key.hz * double(i) / fs;
-        neg[i] = -(key.kind == 1 ? std::cos(ph) : std::sin(ph));
+    const auto [kind, order, hz] = keys[c];
+    cols.col(static_cast<Eigen::Index>(c)) = prob.kept_column(keys[c], [&, kind = kind, order = order, hz = hz] {
+      std::vector<double> neg(n);
+      for (std::size_t i = 0; i < n; ++i) {
+        if (kind == 0) {
+          neg[i] = -legendre(order, n > 1 ? 2.0 * double(i) / double(n - 1) - 1.0 : 0.0);
+        } else {
+          const double ph = kTwoPi * order * hz * double(i) / fs;
+          neg[i] = -(kind == 1 ? std::cos(ph) : std::sin(ph));
+        }
       }
-    }
-    cols.col(static_cast<Eigen::Index>(c)) = prob.deviation(t, zero, neg);
-    column_memo().keep(key, cols.col(static_cast<Eigen::Index>(c)));
+      return Eigen::VectorXd(prob.deviation(t, std::vector<double>(n, 0.0), neg));
+    });
   }
   return cols;
 }

@@ -157,6 +157,21 @@ std::vector<cd> Problem::transfer_of(const model::ModalPortModel& port, double b
   return t;
 }
 
+void Problem::share_columns(const std::shared_ptr<OeRecordShare>& share) {
+  if (!share) return;
+  const std::array<double, 5> mine{double(n_), fs_, double(nfft_), band_hz_, double(decim_)};
+  std::lock_guard<std::mutex> lock(share->mutex);
+  if (!share->shape) share->shape = mine;
+  if (*share->shape == mine) columns_ = share;
+}
+
+Eigen::VectorXd Problem::kept_column(const ColumnKey& key, const std::function<Eigen::VectorXd()>& make) {
+  std::lock_guard<std::mutex> lock(columns_->mutex);
+  auto it = columns_->columns.find(key);
+  if (it == columns_->columns.end()) it = columns_->columns.emplace(key, make()).first;
+  return it->second;
+}
+
 Eigen::VectorXd Problem::invert() {
   // Only the kept samples idx_ = 0, decim_, 2·decim_, … of the nfft_-point
   // inverse (a chirp-z transform of the kmax_ + 1 bins: dsp/decimated_inverse.hpp;

@@ -12,8 +12,11 @@
 #include <cmath>
 #include <cstddef>
 #include <functional>
+#include <map>
 #include <memory>
+#include <mutex>
 #include <optional>
+#include <tuple>
 #include <utility>
 #include <vector>
 
@@ -25,6 +28,21 @@
 #include "update/output_error/common.hpp"
 #include "update/output_error/shot_average.hpp"
 #include "update/residual_regions.hpp"
+
+namespace piezo::update {
+
+// The baseline columns a problem keeps (Problem::kept_column), shared by its
+// forks and, through predict_output_error's `shared`, by the predictions on
+// one held-out record: the first problem that joins fixes the shape (record
+// length, rate, padding, band, decimation) the others must have.
+struct OeRecordShare {
+  using ColumnKey = std::tuple<int, int, double>;
+  std::mutex mutex;
+  std::optional<std::array<double, 5>> shape;
+  std::map<ColumnKey, Eigen::VectorXd> columns;
+};
+
+}  // namespace piezo::update
 
 namespace piezo::update::oe {
 
@@ -60,12 +78,16 @@ class Problem {
   std::size_t samples() const { return idx_.size(); }
   int evaluations() const { return evaluations_; }  // FE port models built
   double sample_rate_hz() const { return fs_; }
-  // What the filtered, decimated residual's shape depends on besides θ: the
-  // low-pass's band, the record's padding and the decimation (with the rate
-  // and samples() above).
-  double band_hz() const { return band_hz_; }
-  std::size_t padded_length() const { return nfft_; }
-  std::size_t decimation() const { return decim_; }
+  // A column of this record's filtered samples that does not depend on θ,
+  // under the caller's key (baseline.cpp's baseline columns: a slow basis
+  // function's L ∗ b): `make` runs once per key, under a lock this problem's
+  // forks share (so the work is done and counted once, whichever thread asks
+  // first), and later calls return the kept column.
+  using ColumnKey = OeRecordShare::ColumnKey;
+  Eigen::VectorXd kept_column(const ColumnKey& key, const std::function<Eigen::VectorXd()>& make);
+  // Keep them in `share` instead, if it is empty or holds this problem's shape
+  // (else this problem keeps its own).
+  void share_columns(const std::shared_ptr<OeRecordShare>& share);
   double transfer_bin_hz() const { return fs_ / double(nfft_); }  // spacing of T(f_k)'s bins
 
   // The FE port model of the material part of x (θ without β) with an end
@@ -218,6 +240,7 @@ class Problem {
   std::vector<double> buf_;  // invert's decimated samples
   std::vector<std::size_t> idx_;
   std::optional<dsp::DecimatedInverse> dinv_;  // the inverse DFT at idx_ only (invert)
+  std::shared_ptr<OeRecordShare> columns_ = std::make_shared<OeRecordShare>();  // kept_column's (shared with the forks)
   std::atomic<int> evaluations_{0};
   // Every model a fit builds stays (least recently used out beyond this): with
   // 16, a diagnosis with its effect scan rebuilt 38 of its 566 models (refsim

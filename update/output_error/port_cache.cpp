@@ -42,7 +42,7 @@ void Problem::prefetch(const std::vector<std::pair<Eigen::VectorXd, double>>& po
 Problem::Problem(const Problem& o, model::ModalSolver& solver)
     : solver_(solver), cls_(o.cls_), co_(o.co_), modal_(o.modal_), r1_(o.r1_), fx_(o.fx_), free_(o.free_),
       fs_(o.fs_), band_hz_(o.band_hz_), n_(o.n_), nfft_(o.nfft_), fft_(o.nfft_), kmax_(o.kmax_), decim_(o.decim_), l_(o.l_),
-      lv1_(o.lv1_), ly_(o.ly_), spec_(o.spec_), buf_(o.buf_), idx_(o.idx_), dinv_(o.dinv_),
+      lv1_(o.lv1_), ly_(o.ly_), spec_(o.spec_), buf_(o.buf_), idx_(o.idx_), dinv_(o.dinv_), columns_(o.columns_),
       tangent_(o.tangent_),
       cache_(o.cache_), clock_(o.clock_) {}
 

@@ -20,6 +20,8 @@
 
 namespace piezo::update {
 
+std::shared_ptr<OeRecordShare> make_record_share() { return std::make_shared<OeRecordShare>(); }
+
 OePrediction predict_output_error(model::ModalSolver& solver, const MaterialClass& cls, const TubeParams& params,
                                   double beta_s, const model::EffectSet& effects, const OeData& data,
                                   double band_hz, const OeOptions& opt, const Eigen::MatrixXd& covariance_rel,
@@ -33,7 +35,7 @@ OePrediction predict_output_error(model::ModalSolver& solver, const MaterialClas
                                   const model::EffectSet& effects, const OeData& data,
                                   double band_hz, const OeOptions& opt,
                                   const Eigen::MatrixXd& covariance_rel,
-                                  const std::string& effect) {
+                                  const std::string& effect, const std::shared_ptr<OeRecordShare>& shared) {
   using namespace oe;
   const double fs = data.sample_rate_hz;
   if (!(fs > 0) || !std::isfinite(fs)) fail("sample rate must be positive");
@@ -44,6 +46,7 @@ OePrediction predict_output_error(model::ModalSolver& solver, const MaterialClas
   const Coordinates5 co{params, loss.model == OeDamping::complex_constants ? loss.eta : loss.beta_s,
                         loss.model};
   Problem prob(solver, cls, co, rec, data, band_hz, opt.modal);
+  prob.share_columns(shared);
   const Eigen::VectorXd x = Eigen::VectorXd::Zero(kParams);
   const auto t = prob.transfer(x, effects);
   if (!t) throw std::runtime_error("predict_output_error: the model cannot be simulated");
