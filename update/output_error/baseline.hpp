@@ -76,7 +76,8 @@ struct DisturbanceModel {
 // The baseline's filtered columns (volts per unit coefficient) for a record:
 // L ∗ {P0..P_degree, cos/sin(2π·h·mains·t), h ≤ harmonics}. They do not
 // depend on t (a baseline on v2 does not pass through T): each is computed
-// once per problem (Problem::kept_column) and reused by its later calls.
+// once per problem (Problem::kept_column), shared by its forks and by the
+// held-out predictions of one diagnosis (OeRecordShare).
 Eigen::MatrixXd baseline_columns(Problem& prob, const Averaged& rec, const std::vector<cd>& t, int degree,
                                  double mains_hz, int harmonics);
 // Hum harmonics a record of `seconds` can hold apart from the polynomial
