@@ -37,9 +37,9 @@
 #include <Eigen/Core>
 #include <functional>
 #include <limits>
+#include <memory>
 #include <optional>
 #include <span>
-#include <memory>
 #include <string>
 #include <vector>
 
@@ -382,14 +382,6 @@ struct OePrediction {
   OeBaseline baseline;  // the held-out capture's own slow disturbances
 };
 
-// Throws std::invalid_argument for unusable data (as fit_output_error) and
-// std::runtime_error when the model cannot be simulated.
-//
-// With `covariance_rel` (OeResult/OeEffect::covariance_rel) the prediction's
-// own uncertainty counts as noise: χ² = min_θ ‖r(θ)/σ‖² + (θ − θ̂)ᵀC⁻¹(θ − θ̂)
-// over the fit's coordinates (and the effect's, `effect`), to first order
-// rᵀ(σ²I + J·C·Jᵀ)⁻¹r — a held-out record far richer than the fit's (a chirp)
-// sees the fit's constants' sigmas, which are no gap.
 // What predictions on one held-out record may share (predict_output_error's
 // `shared`, one per diagnosis: gap_output_error): the filtered baseline
 // columns of its slow disturbances, which depend on the record's shape and the
@@ -398,6 +390,14 @@ struct OePrediction {
 struct OeRecordShare;
 std::shared_ptr<OeRecordShare> make_record_share();
 
+// Throws std::invalid_argument for unusable data (as fit_output_error) and
+// std::runtime_error when the model cannot be simulated.
+//
+// With `covariance_rel` (OeResult/OeEffect::covariance_rel) the prediction's
+// own uncertainty counts as noise: χ² = min_θ ‖r(θ)/σ‖² + (θ − θ̂)ᵀC⁻¹(θ − θ̂)
+// over the fit's coordinates (and the effect's, `effect`), to first order
+// rᵀ(σ²I + J·C·Jᵀ)⁻¹r — a held-out record far richer than the fit's (a chirp)
+// sees the fit's constants' sigmas, which are no gap.
 OePrediction predict_output_error(model::ModalSolver& solver, const MaterialClass& cls, const TubeParams& params,
                                   double beta_s, const model::EffectSet& effects, const OeData& data,
                                   double band_hz, const OeOptions& options = {},
