@@ -187,6 +187,7 @@ double ModalSolver::clamped_capacitance(const PiezoMaterialE& material, Eigen::V
   Eigen::VectorXd x;
   const double c0 = factor_.charge_for_unit_voltage(weights(material), all_u_, &x);
   if (g) *g = (factor_.matrix() * x).head(model_->n_u());  // g = K_UΦ [Φ_int; 1]
+  if (keep_clamped_) clamped_x_ = std::move(x);  // (own_port_vectors)
   return c0;
 }
 
@@ -319,16 +320,7 @@ ModalPortModel ModalSolver::half_port_model(const PiezoMaterialE& material, cons
   ho.n_modes = opt.n_modes / 2 + 1;
   ho.ncv = opt.ncv > 0 ? std::max(ho.n_modes + 1, opt.ncv / 2) : 0;
   ModalPortModel p = half_solver_->port_model(material, ho);
-  // Whole tube = two mirrored halves in parallel: every charge doubles, so C0,
-  // C_static and the residual static share double, and a mode normalised on
-  // the whole tube (φᵀMφ = 1 = 2·φ_halfᵀM_halfφ_half) has p² = 2·p_half²;
-  // ω and κ = φᵀK_UUφ/φᵀMφ are the half's, and so is the radiation damping:
-  // the whole tube's outer surface is the half's and its mirror image, so
-  // φᵀC_aφ = 2·(φ_half/√2)ᵀC_a,half(φ_half/√2) = φ_halfᵀC_a,halfφ_half.
-  p.c_clamped *= 2.0;
-  p.c_static *= 2.0;
-  p.c_residual *= 2.0;
-  for (auto& m : p.modes) m.participation *= std::sqrt(2.0);
+  half_to_whole(p);
   return p;
 }
 
@@ -352,7 +344,6 @@ ModalPortModel ModalSolver::port_model(const PiezoMaterialE& material, const Mod
   const SpMat& m_uu = mass(opt.end_mass_fraction);
   Eigen::VectorXd us;
   p.c_static = static_solve(material, m_uu, &us);
-  double sum1 = 0, sum2 = 0, omega_max = 0;
   const double rigid_omega = 2.0 * M_PI * 1e-3 * opt.shift_hz;
   for (std::size_t j = 0; j < sc.modes.size(); ++j) {
     const Mode& m = sc.modes[j];
@@ -363,28 +354,71 @@ ModalPortModel ModalSolver::port_model(const PiezoMaterialE& material, const Mod
           opt.outer_surface_impedance *
           outer_surface_modal_damping(model_->mesh(), model_->dofs(),
                                       sc.shapes.col(static_cast<Eigen::Index>(j)));
-    const double p2w2 = m.participation * m.participation / (m.omega * m.omega);
-    sum1 += p2w2;
-    sum2 += p2w2 / (m.omega * m.omega);
-    omega_max = std::max(omega_max, m.omega);
   }
   // Residual pseudo-mode from the two moments of the truncated modes (port_model.hpp).
-  const double r1 = p.c_static - p.c_clamped - sum1;
-  const double r2 = us.dot(m_uu * us) - sum2;
-  p.c_residual = r1;
-  if (r1 > 0 && r2 > 0 && r1 / r2 > omega_max * omega_max) {
-    const double wr = std::sqrt(r1 / r2);
-    PortMode res;
-    res.omega = wr;
-    res.participation = std::sqrt(r1) * wr;
-    res.kappa = wr * wr;  // K_UU ≈ K_sc for the high modes it stands for
-    res.symmetric = true;
-    res.residual = true;  // no radiation damping: it stands for modes whose shapes are not computed
-    p.modes.push_back(res);
-    p.c_residual = 0.0;
-  }
+  add_residual_mode(p, us.dot(m_uu * us));
   if (sc_result) *sc_result = std::move(sc);
   return p;
+}
+
+std::optional<PortVectors> ModalSolver::port_vectors(const PiezoMaterialE& material,
+                                                     const ModalOptions& opt) {
+  if (!opt.mirror_symmetry || opt.outer_surface_impedance > 0 || model_->extent() != TubeExtent::whole)
+    return std::nullopt;
+  half_model();
+  if (!half_solver_) return std::nullopt;
+  check(material, "ModalSolver::port_vectors");
+  half_solver_->physical_checks_ = physical_checks_;
+  opt.validate();
+  ModalOptions ho = opt;  // as half_port_model
+  ho.n_modes = opt.n_modes / 2 + 1;
+  ho.ncv = opt.ncv > 0 ? std::max(ho.n_modes + 1, opt.ncv / 2) : 0;
+  auto v = half_solver_->own_port_vectors(material, ho);
+  if (v) {
+    v->model = half_model_;
+    v->end_mass_fraction = opt.end_mass_fraction;
+  }
+  return v;
+}
+
+std::optional<PortVectors> ModalSolver::own_port_vectors(const PiezoMaterialE& material,
+                                                         const ModalOptions& opt) {
+  keep_clamped_ = true;  // (solve's clamped solution: the clamped potentials below)
+  ModalResult sc;
+  try {
+    sc = solve(material, Electrodes::short_circuit, opt);
+  } catch (...) {
+    keep_clamped_ = false;
+    throw;
+  }
+  keep_clamped_ = false;
+  if (!sc.converged) return std::nullopt;
+  const int nu = model_->n_u(), nt = model_->dofs().n_total(), np = nt - nu - 1;
+  const std::vector<int>& plane = model_->symmetry_plane_dofs();
+  const auto k = static_cast<Eigen::Index>(sc.modes.size());
+  PortVectors v;
+  v.u.resize(nu, k + 1);
+  v.phi.resize(np, k + 2);
+  // The factor holds K − σM(f) of the Lanczos run: (K − σM)[y; Φ] = [Mφ; 0]
+  // gives y = φ/(ω² − σ) and the interior potentials Φ that go with it.
+  const SpMat& m_uu = mass(opt.end_mass_fraction);
+  Eigen::VectorXd rhs = Eigen::VectorXd::Zero(nt), y;
+  for (Eigen::Index j = 0; j < k; ++j) {
+    Eigen::VectorXd phi = sc.shapes.col(j);
+    for (int d : plane) phi[d] = 0.0;  // (a Lanczos vector keeps a trace of the start there)
+    v.u.col(j) = phi;
+    rhs.head(nu) = m_uu * phi;
+    for (int d : plane) rhs[d] = 0.0;
+    factor_.solve(rhs, y);
+    v.phi.col(j) = y.segment(nu, np);
+  }
+  const auto w = weights(material);
+  Eigen::VectorXd x;
+  factor_.charge_for_unit_voltage(w, plane, &x);  // static: U free but the mid-plane's u_z
+  v.u.col(k) = x.head(nu);
+  v.phi.col(k) = x.segment(nu, np);
+  v.phi.col(k + 1) = clamped_x_.segment(nu, np);  // clamped
+  return v;
 }
 
 }  // namespace piezo::model

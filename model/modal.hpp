@@ -10,6 +10,7 @@
 // electrical participation p_k = gᵀφ_k (whether it shows up in the impedance).
 #include <Eigen/Core>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -85,6 +86,19 @@ struct ModalResult {
   std::vector<double> active_frequencies_hz() const;
 };
 
+// What a reduced port model (model/reduced_port.hpp) is built from: at one
+// material, the upper half's short-circuit mode shapes and its static shape
+// (V = 1) in `u`, and in `phi` the interior potentials Φ_int that go with
+// each mode, with the static solution and with the clamped one (U = 0, V = 1)
+// — the full coupled solutions, so that a Galerkin projection of the coupled
+// system on them condenses Φ as the exact solver does.
+struct PortVectors {
+  std::shared_ptr<const TubeModel> model;  // the upper half they live on
+  double end_mass_fraction = 0;            // the end mass they were solved with
+  Eigen::MatrixXd u;    // n_u × (modes + 1), zero on the mid-plane's u_z
+  Eigen::MatrixXd phi;  // (n_phi − 1) × (modes + 2): the electrode's V excluded
+};
+
 // Holds the symbolic factorisation: construct once per TubeModel and call for
 // as many materials as needed. Not thread-safe (one solver per thread).
 class ModalSolver {
@@ -113,6 +127,13 @@ class ModalSolver {
   ModalPortModel port_model(const PiezoMaterialE& material, const ModalOptions& options = {},
                             ModalResult* sc_result = nullptr);
 
+  // The vectors of the port model at `material` (options as port_model's:
+  // the half's n_modes/2 + 1 modes), for a reduced port model; nullopt when
+  // port_model would not compute on the upper half (mirror_symmetry off, no
+  // mid-plane node row, an outer-surface load) or the modal solve did not
+  // converge. One modal solve and two static ones.
+  std::optional<PortVectors> port_vectors(const PiezoMaterialE& material, const ModalOptions& options);
+
   const TubeModel& model() const { return *model_; }
 
   // Off: a material outside the physical domain (cE not positive definite,
@@ -129,6 +150,8 @@ class ModalSolver {
   // M-orthogonal to the rigid mode for the given mass matrix.
   double static_solve(const PiezoMaterialE& material, const SpMat& mass, Eigen::VectorXd* u_static);
 
+  // port_vectors on this solver's own model (the upper half).
+  std::optional<PortVectors> own_port_vectors(const PiezoMaterialE& material, const ModalOptions& opt);
   // Port model of the upper half (TubeExtent::upper_half), scaled to the whole tube.
   ModalPortModel half_port_model(const PiezoMaterialE& material, const ModalOptions& opt);
 
@@ -142,6 +165,8 @@ class ModalSolver {
   SpMat m_loaded_;
   double m_loaded_fraction_ = -1.0;
   std::vector<int> all_u_;  // DOF list to clamp U for C0
+  bool keep_clamped_ = false;      // clamped_capacitance keeps its solution in clamped_x_
+  Eigen::VectorXd clamped_x_;
 };
 
 }  // namespace piezo::model

@@ -1,5 +1,6 @@
 #include "model/port_model.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <stdexcept>
 
@@ -39,6 +40,43 @@ std::complex<double> ModalPortModel::charge_per_volt(double omega, const Rayleig
     q += m.participation * m.participation / den;
   }
   return q;
+}
+
+void add_residual_mode(ModalPortModel& p, double shape_mass) {
+  double sum1 = 0, sum2 = 0, omega_max = 0;
+  for (const auto& m : p.modes) {
+    const double p2w2 = m.participation * m.participation / (m.omega * m.omega);
+    sum1 += p2w2;
+    sum2 += p2w2 / (m.omega * m.omega);
+    omega_max = std::max(omega_max, m.omega);
+  }
+  const double r1 = p.c_static - p.c_clamped - sum1;
+  const double r2 = shape_mass - sum2;
+  p.c_residual = r1;
+  if (r1 > 0 && r2 > 0 && r1 / r2 > omega_max * omega_max) {
+    const double wr = std::sqrt(r1 / r2);
+    PortMode res;
+    res.omega = wr;
+    res.participation = std::sqrt(r1) * wr;
+    res.kappa = wr * wr;  // K_UU ≈ K_sc for the high modes it stands for
+    res.symmetric = true;
+    res.residual = true;  // no radiation damping: it stands for modes whose shapes are not computed
+    p.modes.push_back(res);
+    p.c_residual = 0.0;
+  }
+}
+
+void half_to_whole(ModalPortModel& p) {
+  // Whole tube = two mirrored halves in parallel: every charge doubles, so C0,
+  // C_static and the residual static share double, and a mode normalised on
+  // the whole tube (φᵀMφ = 1 = 2·φ_halfᵀM_halfφ_half) has p² = 2·p_half²;
+  // ω and κ = φᵀK_UUφ/φᵀMφ are the half's, and so is the radiation damping:
+  // the whole tube's outer surface is the half's and its mirror image, so
+  // φᵀC_aφ = 2·(φ_half/√2)ᵀC_a,half(φ_half/√2) = φ_halfᵀC_a,halfφ_half.
+  p.c_clamped *= 2.0;
+  p.c_static *= 2.0;
+  p.c_residual *= 2.0;
+  for (auto& m : p.modes) m.participation *= std::sqrt(2.0);
 }
 
 }  // namespace piezo::model

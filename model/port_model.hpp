@@ -50,6 +50,7 @@ struct ModalPortModel {
   double c_residual = 0;  // static share of truncated modes NOT carried by a residual mode (F)
   std::vector<PortMode> modes;  // elastic short-circuit modes, ascending (+ residual mode last)
   bool converged = true;        // the modal solve behind it converged
+  bool reduced_basis = false;   // from a reduced basis (model/reduced_port.hpp), not a modal solve
   double end_mass_fraction = 0;  // end-face mass loading of the modes (model/end_mass.hpp)
   // εT33/εS33 of the material: a loss of the FREE permittivity (the ceramic's
   // tanδ as datasheets quote it, εT33 → εT33·(1 − j·tanδ)) reaches the clamped
@@ -63,5 +64,14 @@ struct ModalPortModel {
   std::complex<double> charge_per_volt(double omega, const RayleighDamping& d,
                                        const MaterialLosses& l = {}) const;
 };
+
+// The residual pseudo-mode (above) appended to p, whose elastic modes,
+// c_clamped and c_static are set: from C_static − C0 − Σ p_k²/ω_k² and
+// shape_mass = U_sᵀ M U_s − Σ p_k²/ω_k⁴; c_residual keeps the static share
+// when the two moments do not make a mode above the computed ones.
+void add_residual_mode(ModalPortModel& p, double shape_mass);
+// A port model of the upper half (TubeExtent::upper_half) as the whole tube's:
+// two mirrored halves in parallel (model/modal.cpp, ModalSolver::port_model).
+void half_to_whole(ModalPortModel& p);
 
 }  // namespace piezo::model

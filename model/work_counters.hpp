@@ -15,4 +15,10 @@ inline std::atomic<long> g_modal_solves{0};
 
 inline long modal_solves() { return g_modal_solves.load(std::memory_order_relaxed); }
 
+// ReducedPort::port_model calls (model/reduced_port.hpp): a port model from a
+// reduced basis, a small dense eigenproblem in place of a modal solve.
+inline std::atomic<long> g_reduced_port_models{0};
+
+inline long reduced_port_models() { return g_reduced_port_models.load(std::memory_order_relaxed); }
+
 }  // namespace piezo::model

@@ -95,11 +95,13 @@ nlohmann::json report_json(const PipelineResult& r) {
                         {"modal_solves", p.work.modal_solves},
                         {"prony_decompositions", p.work.prony_decompositions},
                         {"ffts", p.work.ffts},
+                        {"reduced_port_models", p.work.reduced_port_models},
                         {"seconds", p.seconds}});
     }
     j["work"] = {{"modal_solves", t.modal_solves},
                  {"prony_decompositions", t.prony_decompositions},
                  {"ffts", t.ffts},
+                 {"reduced_port_models", t.reduced_port_models},
                  {"phases", phases}};
   }
   j["verdict"] = r.verdict;

@@ -9,11 +9,12 @@
 namespace piezo::jobs {
 
 WorkCounts work_now() {
-  return {model::modal_solves(), dsp::prony_decompositions(), dsp::ffts()};
+  return {model::modal_solves(), dsp::prony_decompositions(), dsp::ffts(), model::reduced_port_models()};
 }
 
 WorkCounts work_since(const WorkCounts& a, const WorkCounts& b) {
-  return {a.modal_solves - b.modal_solves, a.prony_decompositions - b.prony_decompositions, a.ffts - b.ffts};
+  return {a.modal_solves - b.modal_solves, a.prony_decompositions - b.prony_decompositions, a.ffts - b.ffts,
+          a.reduced_port_models - b.reduced_port_models};
 }
 
 namespace {

@@ -14,10 +14,12 @@ struct WorkCounts {
   long modal_solves = 0;          // ModalSolver::solve calls (a port model: two)
   long prony_decompositions = 0;  // Hankel SVDs (any order, bootstrap replicate or stabilization row)
   long ffts = 0;                  // real FFTs executed
+  long reduced_port_models = 0;   // port models from a reduced basis (model/reduced_port.hpp), no modal solve
   WorkCounts& operator+=(const WorkCounts& o) {
     modal_solves += o.modal_solves;
     prony_decompositions += o.prony_decompositions;
     ffts += o.ffts;
+    reduced_port_models += o.reduced_port_models;
     return *this;
   }
 };

@@ -238,12 +238,26 @@ Scanned scan_one(const ScanInputs& in, Problem& p, Fitter& f, const std::string&
     }
   }
   Refit rf{0, apply, info, std::move(run)};
+  // The runs above went on the surrogate (Problem::set_surrogate): the one
+  // kept is evaluated on exact models where it ended, and fill() gives it a
+  // Gauss–Newton step on the exact Jacobian there.
+  const bool surrogate = p.surrogate();
+  if (surrogate) {
+    p.set_surrogate(false);
+    if (const auto r = f.weighted(rf.run.x)) {
+      rf.run.r = *r;
+      rf.run.cost = 0.5 * r->squaredNorm();
+    } else {  // (the exact model cannot be built there: the run from the optimum, exactly)
+      rf.run = f.levenberg_marquardt(x0, nullptr);
+    }
+  }
   if (e.law == "constant-phase")
     rf.apply = [apply](model::EffectSet& fx, double x) {
       apply(fx, x);
       fx.dielectric_constant_phase = true;
     };
   fill(in, p, f, e, rf);
+  if (surrogate) p.set_surrogate(true);
   e.fe_models = p.evaluations() - models_before;
   s.e = std::move(e);
   s.rf = std::move(rf);
@@ -328,6 +342,14 @@ int scan_effects(const FitAnswer& answer, Fitter& fitter, const Coordinates5& co
         throw std::invalid_argument("scan_effects: no effect '" + name + "' in the catalogue");
       if (effect_coordinate(name)) scan_names.push_back(name);  // (else in the catalogue, not in this model)
     }
+  // The scan's runs on the surrogate (Problem::set_surrogate: port models
+  // from reduced bases about the optimum and along each run), each then
+  // polished on exact models (scan_one); the forks below share the
+  // optimum's basis.
+  if (!scan_names.empty()) {
+    prob.use_reduced(best.x, prob.effects().mass_loading);
+    prob.set_surrogate(true);
+  }
   {
     std::vector<Scanned> scanned(scan_names.size());
     // The longest first: an end mass (up to three LM runs, an FE model per
@@ -350,6 +372,7 @@ int scan_effects(const FitAnswer& answer, Fitter& fitter, const Coordinates5& co
       out.effects.push_back(std::move(s.e));
     }
   }
+  prob.drop_reduced();
   if (out.lack_of_fit) models_elsewhere += regrid_effects(in, fitter, refits, out);
   prob.free_effect({});
   std::sort(out.effects.begin(), out.effects.end(),

@@ -24,6 +24,7 @@
 #include "dsp/fft.hpp"
 #include "model/effects.hpp"
 #include "model/modal.hpp"
+#include "model/reduced_port.hpp"
 #include "update/output_error.hpp"
 #include "update/output_error/common.hpp"
 #include "update/output_error/shot_average.hpp"
@@ -102,6 +103,34 @@ class Problem {
   // its key alone (each solve starts from Spectra's fixed initial vector), so
   // the answers do not depend on the thread count.
   void prefetch(const std::vector<std::pair<Eigen::VectorXd, double>>& points);
+
+  // The effect scan's surrogate (issue 43 item 2): with set_surrogate(true)
+  // a port model not cached comes from a reduced basis
+  // (model/reduced_port.hpp) — the exact solutions at a centre and at its
+  // plus-points (centre + h·e_c in the constants and the end mass), a small
+  // dense eigenproblem per model in place of a modal solve — where one
+  // reaches it (kReducedReach in every constant's coordinate,
+  // kReducedMassReach in the end mass; the nearest) and that basis's own
+  // error estimate is below the surrogate's tolerances; else from a modal
+  // solve. The bases: one about `centre` (the optimum), built on first use,
+  // once for this problem and its forks, its content — and so every answer
+  // and count — the same whatever thread builds it; and one about each
+  // point where an exact Jacobian is asked for (prefetch: its plus-points
+  // cost what the columns would, and a run crawling along a valley takes
+  // its next iterates and their Jacobians from it), this problem's own
+  // until the next restore() (each task of the scan starts from the
+  // optimum's state). With set_surrogate(false) the surrogate's cached
+  // models are not used: a run that ended on the surrogate is evaluated
+  // again on exact models and given one Gauss–Newton step on the exact
+  // Jacobian (effect_scan.cpp), so that its answer is the exact model's.
+  void use_reduced(const Eigen::VectorXd& centre, double end_mass);
+  void set_surrogate(bool on);
+  bool surrogate() const { return surrogate_; }
+  void drop_reduced() {
+    reduced_.reset();
+    local_.clear();
+    surrogate_ = false;
+  }
   void set_threads(int n) { threads_ = std::max(1, n); }
   int threads() const { return threads_; }
 
@@ -208,10 +237,16 @@ class Problem {
   Eigen::VectorXd invert();
 
   using Key = Eigen::Matrix<double, 5, 1>;  // the constants' coordinates, the end mass
+  using Basis = std::shared_ptr<const model::ReducedPort>;
   struct Cached {
     Key key;
     std::optional<model::ModalPortModel> port;
     unsigned long used = 0;
+    Basis basis;  // the reduced basis it came from (null: a modal solve)
+  };
+  struct Built {
+    std::optional<model::ModalPortModel> port;
+    Basis basis;
   };
   static Key key_of(const Eigen::VectorXd& x, double end_mass) {
     Key key;
@@ -220,8 +255,8 @@ class Problem {
   }
   Cached* cached(const Key& key);
   // One FE port model (counted; thread-safe for distinct solvers).
-  std::optional<model::ModalPortModel> build(model::ModalSolver& solver, const Key& key);
-  const model::ModalPortModel* insert(const Key& key, std::optional<model::ModalPortModel> port);
+  Built build(model::ModalSolver& solver, const Key& key);
+  const model::ModalPortModel* insert(const Key& key, Built built);
 
   model::ModalSolver& solver_;
   std::unique_ptr<model::ModalSolver> solver2_;  // prefetch's second thread (built on first use)
@@ -241,6 +276,44 @@ class Problem {
   std::vector<std::size_t> idx_;
   std::optional<dsp::DecimatedInverse> dinv_;  // the inverse DFT at idx_ only (invert)
   std::shared_ptr<OeRecordShare> columns_ = std::make_shared<OeRecordShare>();  // kept_column's (shared with the forks)
+  struct Reduced {
+    Key centre;  // the constants' coordinates and the end mass
+    std::mutex mutex;
+    bool tried = false;
+    Basis basis;  // immutable once built (tried); null if it could not be
+    std::shared_ptr<const model::ReducedPortSpace> space;  // every basis's (made with the first)
+  };
+  // The reduced bases' shared pieces (made on first use, under the lock).
+  std::shared_ptr<const model::ReducedPortSpace> reduced_space();
+  std::shared_ptr<Reduced> reduced_;  // use_reduced's (shared with the forks)
+  std::vector<std::pair<Key, Basis>> local_;  // the Jacobians' bases (centre, basis), this problem's
+  bool surrogate_ = false;
+  // The basis a key within kSameSource of a cached model must take: that
+  // model's (null: a modal solve), or nullopt when there is no such model.
+  // (Read only: prefetch's threads call it at once.) A difference quotient
+  // over 1e-6 of one model exact and the other reduced would be the reduced
+  // model's error over 1e-6: a forward difference's point, a tangent's
+  // plus-point, takes the source of the model it differs from.
+  std::optional<Basis> same_source(const Key& key) const;
+  // A basis of the exact solutions at `centre` and its plus-points (with
+  // `mass`, one in the end mass too), on
+  // `solver`, or on this problem's two solvers with two_threads; null when
+  // it cannot be built.
+  Basis make_basis(const Key& centre, bool mass, bool two_threads, model::ModalSolver& solver);
+  // The surrogate's model at key (above); empty outside surrogate mode.
+  Built reduced_model(model::ModalSolver& solver, const Key& key);
+  Built reduced_model_at(model::ModalSolver& solver, const Key& key, const model::PiezoMaterialE& m);
+  std::vector<model::ReducedPort::Point> basis_points(const Key& centre, bool mass) const;  // (throws outside the domain)
+  model::PiezoMaterialE material_at(const Key& key) const;
+  static constexpr double kReducedReach = 0.05;      // the constants' coordinates
+  static constexpr double kReducedMassReach = 0.02;  // the end mass (its fraction of the tube's)
+  static constexpr double kReducedStep = 3e-3;  // the plus-points' (tests/model/test_reduced_port.cpp)
+  static constexpr double kSameSource = 1e-5;
+  // The surrogate's tolerances on a basis's error estimates (ReducedPort::
+  // Bound, 1e2–1e4 above the errors measured): loose, since the runs are
+  // polished on exact models; they refuse a point past a veering.
+  static constexpr double kSurrogateOmega = 1e-5;
+  static constexpr double kSurrogateParticipation = 0.1;
   std::atomic<int> evaluations_{0};
   // Every model a fit builds stays (least recently used out beyond this): with
   // 16, a diagnosis with its effect scan rebuilt 38 of its 566 models (refsim
@@ -286,6 +359,7 @@ class Problem {
     cache_ = s.cache;
     tangent_ = s.tangent;
     clock_ = s.clock;
+    local_.clear();
   }
 };
 

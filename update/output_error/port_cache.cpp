@@ -24,7 +24,40 @@ void Problem::prefetch(const std::vector<std::pair<Eigen::VectorXd, double>>& po
     if (!cached(key) && std::find(todo.begin(), todo.end(), key) == todo.end()) todo.push_back(key);
   }
   if (todo.empty()) return;
-  std::vector<std::optional<model::ModalPortModel>> built(todo.size());
+  // On the surrogate, an exact Jacobian's columns about a modal solve's
+  // point: a basis there instead (its plus-points cost what the columns
+  // would), the columns and the run's next iterates from it.
+  if (surrogate_ && todo.size() >= 3) {
+    const Cached* base = nullptr;
+    for (const auto& c : cache_)
+      if (c.port && !c.basis && (c.key - todo[0]).cwiseAbs().maxCoeff() <= kSameSource) base = &c;
+    bool all_near = base != nullptr;
+    for (const auto& k : todo) all_near = all_near && (k - base->key).cwiseAbs().maxCoeff() <= kSameSource;
+    if (all_near) {
+      const Key centre = base->key;
+      bool mass = false;  // (a plus-point in the end mass when the Jacobian has a column in it)
+      for (const auto& k : todo) mass = mass || k[4] != centre[4];
+      if (Basis b = make_basis(centre, mass, threads_ > 1, solver_)) {
+        local_.emplace_back(centre, b);
+        for (const auto& k : todo) {
+          Built one;
+          try {
+            auto p = b->port_model(material_at(k), k[4]);
+            if (p.converged) one = {std::move(p), b};
+          } catch (const std::exception&) {
+          }
+          if (one.port) {
+            ++evaluations_;
+            insert(k, std::move(one));
+          } else {
+            insert(k, build(solver_, k));
+          }
+        }
+        return;
+      }
+    }
+  }
+  std::vector<Built> built(todo.size());
   if (threads_ > 1 && todo.size() > 1) {
     model::ModalSolver& second = second_solver();
     // The second thread takes the odd points (one FE model each, equal work).
@@ -43,7 +76,7 @@ Problem::Problem(const Problem& o, model::ModalSolver& solver)
     : solver_(solver), cls_(o.cls_), co_(o.co_), modal_(o.modal_), r1_(o.r1_), fx_(o.fx_), free_(o.free_),
       fs_(o.fs_), band_hz_(o.band_hz_), n_(o.n_), nfft_(o.nfft_), fft_(o.nfft_), kmax_(o.kmax_), decim_(o.decim_), l_(o.l_),
       lv1_(o.lv1_), ly_(o.ly_), spec_(o.spec_), buf_(o.buf_), idx_(o.idx_), dinv_(o.dinv_), columns_(o.columns_),
-      tangent_(o.tangent_),
+      reduced_(o.reduced_), local_(o.local_), surrogate_(o.surrogate_), tangent_(o.tangent_),
       cache_(o.cache_), clock_(o.clock_) {}
 
 model::ModalSolver& Problem::second_solver() {
@@ -157,37 +190,190 @@ void Problem::shift(model::ModalPortModel& p, const model::ModalPortModel& plus,
 Problem::Cached* Problem::cached(const Key& key) {
   for (auto& c : cache_)
     if (c.key == key) {
+      if (c.basis && !surrogate_) return nullptr;  // (a surrogate's model: solved again, exactly)
       c.used = ++clock_;
       return &c;
     }
   return nullptr;
 }
 
-std::optional<model::ModalPortModel> Problem::build(model::ModalSolver& solver, const Key& key) {
-  ++evaluations_;
-  try {
-    model::ModalOptions mo = modal_;
-    mo.end_mass_fraction = key[4];
-    Eigen::VectorXd x = Eigen::VectorXd::Zero(kParams);
-    x.head<4>() = key.head<4>();
-    auto port = solver.port_model(cls_.e_form(co_.params(x)), mo);
-    if (port.converged) return port;
-  } catch (const std::exception&) {
-  }
+void Problem::use_reduced(const Eigen::VectorXd& centre, double end_mass) {
+  reduced_ = std::make_shared<Reduced>();
+  reduced_->centre = key_of(centre, end_mass);
+  local_.clear();
+}
+
+void Problem::set_surrogate(bool on) {
+  if (on && !reduced_) throw std::logic_error("Problem::set_surrogate: use_reduced first");
+  surrogate_ = on;
+}
+
+model::PiezoMaterialE Problem::material_at(const Key& key) const {
+  Eigen::VectorXd x = Eigen::VectorXd::Zero(kParams);
+  x.head<4>() = key.head<4>();
+  return cls_.e_form(co_.params(x));
+}
+
+std::optional<Problem::Basis> Problem::same_source(const Key& key) const {
+  for (const auto& c : cache_)
+    if (c.port && (c.key - key).cwiseAbs().maxCoeff() <= kSameSource) return c.basis;
   return std::nullopt;
 }
 
-const model::ModalPortModel* Problem::insert(const Key& key,
-                                             std::optional<model::ModalPortModel> port) {
+std::vector<model::ReducedPort::Point> Problem::basis_points(const Key& centre, bool mass) const {
+  // The centre, its plus-points in the four constants and (mass) in the end mass.
+  std::vector<model::ReducedPort::Point> points{{material_at(centre), centre[4]}};
+  for (int c = 0; c < (mass ? 5 : 4); ++c) {
+    Key k = centre;
+    k[c] += kReducedStep;
+    points.push_back({material_at(k), k[4]});
+  }
+  return points;
+}
+
+std::shared_ptr<const model::ReducedPortSpace> Problem::reduced_space() {
+  const std::lock_guard<std::mutex> lock(reduced_->mutex);
+  if (!reduced_->space) {
+    const auto half = solver_.half_model();  // (built with the fit's first port model)
+    try {
+      if (half) reduced_->space = std::make_shared<const model::ReducedPortSpace>(half, material_at(reduced_->centre));
+    } catch (const std::exception&) {
+    }
+  }
+  return reduced_->space;
+}
+
+Problem::Basis Problem::make_basis(const Key& centre, bool mass, bool two_threads, model::ModalSolver& solver) {
+  std::vector<model::ReducedPort::Point> points;
+  try {
+    points = basis_points(centre, mass);
+  } catch (const std::exception&) {
+    return nullptr;  // (a plus-point outside the physical domain)
+  }
+  // The snapshots, the odd ones on the second solver with two_threads.
+  std::vector<std::optional<model::PortVectors>> v(points.size());
+  auto take = [&](model::ModalSolver& s, std::size_t first, std::size_t stride) {
+    for (std::size_t i = first; i < points.size(); i += stride) {
+      model::ModalOptions o = modal_;
+      o.end_mass_fraction = points[i].end_mass_fraction;
+      try {
+        v[i] = s.port_vectors(points[i].material, o);
+      } catch (const std::exception&) {
+        v[i].reset();  // (a snapshot outside the physical domain)
+      }
+    }
+  };
+  if (two_threads) {
+    model::ModalSolver& second = second_solver();
+    std::thread other([&] { take(second, 1, 2); });
+    take(solver_, 0, 2);
+    other.join();
+  } else {
+    take(solver, 0, 1);
+  }
+  std::vector<model::PortVectors> snaps;
+  for (auto& x : v) {
+    if (!x) return nullptr;
+    snaps.push_back(std::move(*x));
+  }
+  model::ModalOptions o = modal_;
+  o.end_mass_fraction = centre[4];
+  try {
+    auto b = model::ReducedPort::build(snaps, points[0].material, o, reduced_space());
+    if (b) return std::make_shared<const model::ReducedPort>(std::move(*b));
+  } catch (const std::exception&) {
+  }
+  return nullptr;
+}
+
+Problem::Built Problem::reduced_model(model::ModalSolver& solver, const Key& key) {
+  if (!reduced_ || !surrogate_) return {};
+  try {
+    return reduced_model_at(solver, key, material_at(key));
+  } catch (const std::exception&) {
+    return {};  // (outside the physical domain: the modal solve says so)
+  }
+}
+
+Problem::Built Problem::reduced_model_at(model::ModalSolver& solver, const Key& key, const model::PiezoMaterialE& m) {
+  const std::shared_ptr<Reduced> rd = reduced_;
+  if (const auto same = same_source(key)) {
+    if (!*same) return {};  // next to a modal solve's
+    try {
+      auto port = (*same)->port_model(m, key[4]);
+      if (port.converged) return {std::move(port), *same};
+    } catch (const std::exception&) {
+    }
+    return {};
+  }
+  auto reaches = [&](const Key& centre) {
+    return (key.head<4>() - centre.head<4>()).cwiseAbs().maxCoeff() <= kReducedReach &&
+           std::abs(key[4] - centre[4]) <= kReducedMassReach;
+  };
+  // The nearest basis that reaches the key (the optimum's on a tie).
+  Basis best;
+  double best_d = INFINITY;
+  if (reaches(rd->centre)) {
+    const auto space = reduced_space();
+    {
+      const std::lock_guard<std::mutex> lock(rd->mutex);
+      if (!rd->tried) {
+        rd->tried = true;
+        try {
+          if (auto b = model::ReducedPort::build(solver, basis_points(rd->centre, false), modal_, space))
+            rd->basis = std::make_shared<const model::ReducedPort>(std::move(*b));
+        } catch (const std::exception&) {
+        }
+      }
+    }
+    if (rd->basis) {
+      best = rd->basis;
+      best_d = (key - rd->centre).cwiseAbs().maxCoeff();
+    }
+  }
+  for (const auto& [centre, b] : local_) {
+    const double d = (key - centre).cwiseAbs().maxCoeff();
+    if (reaches(centre) && d < best_d) best = b, best_d = d;
+  }
+  if (best) {
+    try {
+      model::ReducedPort::Bound bound;
+      auto port = best->port_model(m, key[4], &bound);
+      if (port.converged && bound.omega <= kSurrogateOmega && bound.participation <= kSurrogateParticipation)
+        return {std::move(port), best};
+    } catch (const std::exception&) {
+    }
+  }
+  return {};  // none reaches it: a modal solve (a basis about it if a Jacobian follows: prefetch)
+}
+
+Problem::Built Problem::build(model::ModalSolver& solver, const Key& key) {
+  ++evaluations_;
+  if (Built r = reduced_model(solver, key); r.port) return r;
+  try {
+    model::ModalOptions mo = modal_;
+    mo.end_mass_fraction = key[4];
+    auto port = solver.port_model(material_at(key), mo);
+    if (port.converged) return {std::move(port), nullptr};
+  } catch (const std::exception&) {
+  }
+  return {};
+}
+
+const model::ModalPortModel* Problem::insert(const Key& key, Built built) {
   Cached* slot = nullptr;
-  if (cache_.size() < kCache) {
+  for (auto& c : cache_)
+    if (c.key == key) slot = &c;  // (a surrogate's model, solved again exactly)
+  if (slot) {
+  } else if (cache_.size() < kCache) {
     slot = &cache_.emplace_back();
   } else {
     slot = &*std::min_element(cache_.begin(), cache_.end(),
                               [](const Cached& a, const Cached& b) { return a.used < b.used; });
   }
   slot->key = key;
-  slot->port = std::move(port);
+  slot->port = std::move(built.port);
+  slot->basis = std::move(built.basis);
   slot->used = ++clock_;
   return slot->port ? &*slot->port : nullptr;
 }
