@@ -309,11 +309,6 @@ class Problem {
   static constexpr double kReducedMassReach = 0.02;  // the end mass (its fraction of the tube's)
   static constexpr double kReducedStep = 3e-3;  // the plus-points' (tests/model/test_reduced_port.cpp)
   static constexpr double kSameSource = 1e-5;
-  // The surrogate's tolerances on a basis's error estimates (ReducedPort::
-  // Bound, 1e2–1e4 above the errors measured): loose, since the runs are
-  // polished on exact models; they refuse a point past a veering.
-  static constexpr double kSurrogateOmega = 1e-5;
-  static constexpr double kSurrogateParticipation = 0.1;
   std::atomic<int> evaluations_{0};
   // Every model a fit builds stays (least recently used out beyond this): with
   // 16, a diagnosis with its effect scan rebuilt 38 of its 566 models (refsim

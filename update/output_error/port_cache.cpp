@@ -336,11 +336,14 @@ Problem::Built Problem::reduced_model_at(model::ModalSolver& solver, const Key& 
     if (reaches(centre) && d < best_d) best = b, best_d = d;
   }
   if (best) {
+    // No error estimate here (it costs a quarter of a modal solve, the
+    // reduced model a sixteenth): the runs end on exact models, and a
+    // surrogate within reach of its basis is within 1e-5 of them (tests/
+    // model/test_reduced_port.cpp: 5e-2 in the constants, 2e-2 in the mass,
+    // past a veering included).
     try {
-      model::ReducedPort::Bound bound;
-      auto port = best->port_model(m, key[4], &bound);
-      if (port.converged && bound.omega <= kSurrogateOmega && bound.participation <= kSurrogateParticipation)
-        return {std::move(port), best};
+      auto port = best->port_model(m, key[4]);
+      if (port.converged) return {std::move(port), best};
     } catch (const std::exception&) {
     }
   }
