@@ -346,7 +346,7 @@ int scan_effects(const FitAnswer& answer, Fitter& fitter, const Coordinates5& co
   // from reduced bases about the optimum and along each run), each then
   // polished on exact models (scan_one); the forks below share the
   // optimum's basis.
-  if (!scan_names.empty()) {
+  if (!scan_names.empty() && opt.scan_surrogate) {
     prob.use_reduced(best.x, prob.effects().mass_loading);
     prob.set_surrogate(true);
   }
