@@ -6,10 +6,12 @@
 #include <benchmark/benchmark.h>
 
 #include <string>
+#include <vector>
 
 #include "model/harmonic.hpp"
 #include "model/material_presets.hpp"
 #include "model/modal.hpp"
+#include "model/reduced_port.hpp"
 #include "model/transient.hpp"
 
 namespace {
@@ -52,6 +54,45 @@ void BM_PortModel20(benchmark::State& state) {
   state.SetLabel("end mass " + std::to_string(state.range(0)) + " %");
 }
 BENCHMARK(BM_PortModel20)->Arg(0)->Arg(2)->Unit(benchmark::kMillisecond);
+
+// The reduced-basis port model (model/reduced_port.hpp) of the same tube:
+// Arg 0 its basis (five snapshots' vectors — ModalSolver::port_vectors —
+// and their projection, ReducedPortSpace made once), Arg 1 a port model from
+// it 1 % off the centre, Arg 2 the same with its error estimates.
+void BM_ReducedPort20(benchmark::State& state) {
+  TubeModel tm(TubeGeometry{}, MeshOptions{});
+  ModalSolver s(tm);
+  const auto m = material();
+  ModalOptions o;
+  o.n_modes = 20;
+  std::vector<ReducedPort::Point> points{{m, 0.0}};
+  for (int c = 0; c < 4; ++c) {
+    PiezoMaterialE p = m;
+    double* v[4] = {&p.c_e11, &p.c_e12, &p.e31, &p.eps_s33};
+    *v[c] *= 1.003;
+    points.push_back({p, 0.0});
+  }
+  auto rp = ReducedPort::build(s, points, o);
+  if (!rp) {
+    state.SkipWithError("no reduced basis");
+    return;
+  }
+  PiezoMaterialE near = m;
+  near.c_e11 *= 1.01;
+  near.eps_s33 *= 0.99;
+  ReducedPort::Bound b;
+  for (auto _ : state) {
+    if (state.range(0) == 0) {
+      std::vector<PortVectors> v;
+      for (const auto& p : points) v.push_back(*s.port_vectors(p.material, o));
+      benchmark::DoNotOptimize(ReducedPort::build(v, m, o, rp->space()).has_value());
+    } else {
+      benchmark::DoNotOptimize(rp->port_model(near, 0.0, state.range(0) == 2 ? &b : nullptr).modes.size());
+    }
+  }
+  state.SetLabel(state.range(0) == 0 ? "basis (5 snapshots)" : state.range(0) == 1 ? "port model" : "port model + estimates");
+}
+BENCHMARK(BM_ReducedPort20)->Arg(0)->Arg(1)->Arg(2)->Unit(benchmark::kMicrosecond);
 
 void BM_ImpedanceSweep600(benchmark::State& state) {
   TubeModel tm(TubeGeometry{}, MeshOptions{});

@@ -80,7 +80,8 @@ ReducedPortSpace::ReducedPortSpace(std::shared_ptr<const TubeModel> half, const 
 }
 
 std::optional<ReducedPort> ReducedPort::build(std::span<const PortVectors> snaps, const PiezoMaterialE& centre,
-                                              const ModalOptions& opt, std::shared_ptr<const ReducedPortSpace> space) {
+                                              const ModalOptions& opt, std::shared_ptr<const ReducedPortSpace> space,
+                                              bool estimates) {
   if (snaps.empty() || !snaps[0].model) return std::nullopt;
   const auto& model = snaps[0].model;
   Eigen::Index nu_cols = 0, np_cols = 0;
@@ -117,27 +118,37 @@ std::optional<ReducedPort> ReducedPort::build(std::span<const PortVectors> snaps
   rp.v_p_(np, rp.q_) = 1.0;
   // The blocks, projected (each split matrix lives in one block of K).
   for (std::size_t k = 0; k < 5; ++k) {
-    rp.kuu_v_[k] = sp.k_uu[k] * rp.v_u_;
-    rp.kuu_[k] = symmetric(rp.v_u_.transpose() * rp.kuu_v_[k]);
+    Eigen::MatrixXd kv = sp.k_uu[k] * rp.v_u_;
+    rp.kuu_[k] = symmetric(rp.v_u_.transpose() * kv);
+    if (estimates) rp.kuu_v_[k] = std::move(kv);
   }
   for (std::size_t k = 0; k < 3; ++k) {
-    rp.kup_v_[k] = sp.k_up[k] * rp.v_p_;
-    rp.kpu_v_[k] = sp.k_pu[k] * rp.v_u_;
-    rp.kup_[k] = rp.v_u_.transpose() * rp.kup_v_[k];
+    Eigen::MatrixXd kv = sp.k_up[k] * rp.v_p_;
+    rp.kup_[k] = rp.v_u_.transpose() * kv;
+    if (estimates) {
+      rp.kup_v_[k] = std::move(kv);
+      rp.kpu_v_[k] = sp.k_pu[k] * rp.v_u_;
+    }
   }
   for (std::size_t k = 0; k < 2; ++k) {
-    rp.kpp_v_[k] = sp.k_pp[k] * rp.v_p_;
-    rp.kpp_[k] = symmetric(rp.v_p_.transpose() * rp.kpp_v_[k]);
+    Eigen::MatrixXd kv = sp.k_pp[k] * rp.v_p_;
+    rp.kpp_[k] = symmetric(rp.v_p_.transpose() * kv);
+    if (estimates) rp.kpp_v_[k] = std::move(kv);
   }
-  rp.mv_ = sp.m * rp.v_u_;
-  rp.dmv_ = sp.dm * rp.v_u_;
-  rp.m0_ = symmetric(rp.v_u_.transpose() * rp.mv_);
-  rp.dm_ = symmetric(rp.v_u_.transpose() * rp.dmv_);
+  Eigen::MatrixXd mv = sp.m * rp.v_u_, dmv = sp.dm * rp.v_u_;
+  rp.m0_ = symmetric(rp.v_u_.transpose() * mv);
+  rp.dm_ = symmetric(rp.v_u_.transpose() * dmv);
+  if (estimates) {
+    rp.mv_ = std::move(mv);
+    rp.dmv_ = std::move(dmv);
+  }
+  rp.estimates_ = estimates;
   return rp;
 }
 
 std::optional<ReducedPort> ReducedPort::build(ModalSolver& solver, std::span<const Point> points,
-                                              const ModalOptions& opt, std::shared_ptr<const ReducedPortSpace> space) {
+                                              const ModalOptions& opt, std::shared_ptr<const ReducedPortSpace> space,
+                                              bool estimates) {
   if (points.empty()) return std::nullopt;
   std::vector<PortVectors> snaps;
   snaps.reserve(points.size());
@@ -150,7 +161,7 @@ std::optional<ReducedPort> ReducedPort::build(ModalSolver& solver, std::span<con
   }
   ModalOptions o = opt;
   o.end_mass_fraction = points[0].end_mass_fraction;
-  return build(snaps, points[0].material, o, std::move(space));
+  return build(snaps, points[0].material, o, std::move(space), estimates);
 }
 
 ModalPortModel ReducedPort::port_model(const PiezoMaterialE& material, double end_mass_fraction,
@@ -206,7 +217,7 @@ ModalPortModel ReducedPort::port_model(const PiezoMaterialE& material, double en
   // Static: K_sc u_s = −g, C_static = C0 + gᵀK_sc⁻¹g.
   const Eigen::VectorXd u_s = kf.solve(-g);
   out.c_static = out.c_clamped - g.dot(u_s);
-  if (bound) *bound = check(w, df, x, g, es.eigenvectors(), es.eigenvalues(), out);
+  if (bound) *bound = estimates_ ? check(w, df, x, g, es.eigenvectors(), es.eigenvalues(), out) : Bound{INFINITY, INFINITY};
   add_residual_mode(out, u_s.dot(m_r * u_s));
   half_to_whole(out);
   (void)r;

@@ -255,7 +255,9 @@ class Problem {
   }
   Cached* cached(const Key& key);
   // One FE port model (counted; thread-safe for distinct solvers).
-  Built build(model::ModalSolver& solver, const Key& key);
+  // (armed: the surrogate may answer, decided by the caller: armed().)
+  Built build(model::ModalSolver& solver, const Key& key, bool armed);
+  bool armed() const { return surrogate_ && reduced_ && exact_since_ >= kSurrogateAfter; }
   const model::ModalPortModel* insert(const Key& key, Built built);
 
   model::ModalSolver& solver_;
@@ -288,6 +290,11 @@ class Problem {
   std::shared_ptr<Reduced> reduced_;  // use_reduced's (shared with the forks)
   std::vector<std::pair<Key, Basis>> local_;  // the Jacobians' bases (centre, basis), this problem's
   bool surrogate_ = false;
+  // Modal solves since use_reduced() or restore(): the surrogate starts after
+  // kSurrogateAfter of them — a short run (most of a capture without lack of
+  // fit) never pays for a basis, and ends as it would without it.
+  std::atomic<int> exact_since_{0};
+  static constexpr int kSurrogateAfter = 6;
   // The basis a key within kSameSource of a cached model must take: that
   // model's (null: a modal solve), or nullopt when there is no such model.
   // (Read only: prefetch's threads call it at once.) A difference quotient
@@ -300,7 +307,7 @@ class Problem {
   // `solver`, or on this problem's two solvers with two_threads; null when
   // it cannot be built.
   Basis make_basis(const Key& centre, bool mass, bool two_threads, model::ModalSolver& solver);
-  // The surrogate's model at key (above); empty outside surrogate mode.
+  // The surrogate's model at key (above).
   Built reduced_model(model::ModalSolver& solver, const Key& key);
   Built reduced_model_at(model::ModalSolver& solver, const Key& key, const model::PiezoMaterialE& m);
   std::vector<model::ReducedPort::Point> basis_points(const Key& centre, bool mass) const;  // (throws outside the domain)
@@ -355,6 +362,7 @@ class Problem {
     tangent_ = s.tangent;
     clock_ = s.clock;
     local_.clear();
+    exact_since_ = 0;
   }
 };
 

@@ -14,7 +14,7 @@ namespace piezo::update::oe {
 const model::ModalPortModel* Problem::port_of(const Eigen::VectorXd& x, double end_mass) {
   const Key key = key_of(x, end_mass);
   if (Cached* c = cached(key)) return c->port ? &*c->port : nullptr;
-  return insert(key, build(solver_, key));
+  return insert(key, build(solver_, key, armed()));
 }
 
 void Problem::prefetch(const std::vector<std::pair<Eigen::VectorXd, double>>& points) {
@@ -27,7 +27,7 @@ void Problem::prefetch(const std::vector<std::pair<Eigen::VectorXd, double>>& po
   // On the surrogate, an exact Jacobian's columns about a modal solve's
   // point: a basis there instead (its plus-points cost what the columns
   // would), the columns and the run's next iterates from it.
-  if (surrogate_ && todo.size() >= 3) {
+  if (armed() && todo.size() >= 3) {
     const Cached* base = nullptr;
     for (const auto& c : cache_)
       if (c.port && !c.basis && (c.key - todo[0]).cwiseAbs().maxCoeff() <= kSameSource) base = &c;
@@ -50,7 +50,7 @@ void Problem::prefetch(const std::vector<std::pair<Eigen::VectorXd, double>>& po
             ++evaluations_;
             insert(k, std::move(one));
           } else {
-            insert(k, build(solver_, k));
+            insert(k, build(solver_, k, true));
           }
         }
         return;
@@ -58,16 +58,17 @@ void Problem::prefetch(const std::vector<std::pair<Eigen::VectorXd, double>>& po
     }
   }
   std::vector<Built> built(todo.size());
+  const bool arm = armed();  // (decided once for the batch: its threads count solves as they go)
   if (threads_ > 1 && todo.size() > 1) {
     model::ModalSolver& second = second_solver();
     // The second thread takes the odd points (one FE model each, equal work).
     std::thread other([&] {
-      for (std::size_t i = 1; i < todo.size(); i += 2) built[i] = build(second, todo[i]);
+      for (std::size_t i = 1; i < todo.size(); i += 2) built[i] = build(second, todo[i], arm);
     });
-    for (std::size_t i = 0; i < todo.size(); i += 2) built[i] = build(solver_, todo[i]);
+    for (std::size_t i = 0; i < todo.size(); i += 2) built[i] = build(solver_, todo[i], arm);
     other.join();
   } else {
-    for (std::size_t i = 0; i < todo.size(); ++i) built[i] = build(solver_, todo[i]);
+    for (std::size_t i = 0; i < todo.size(); ++i) built[i] = build(solver_, todo[i], arm);
   }
   for (std::size_t i = 0; i < todo.size(); ++i) insert(todo[i], std::move(built[i]));
 }
@@ -76,7 +77,8 @@ Problem::Problem(const Problem& o, model::ModalSolver& solver)
     : solver_(solver), cls_(o.cls_), co_(o.co_), modal_(o.modal_), r1_(o.r1_), fx_(o.fx_), free_(o.free_),
       fs_(o.fs_), band_hz_(o.band_hz_), n_(o.n_), nfft_(o.nfft_), fft_(o.nfft_), kmax_(o.kmax_), decim_(o.decim_), l_(o.l_),
       lv1_(o.lv1_), ly_(o.ly_), spec_(o.spec_), buf_(o.buf_), idx_(o.idx_), dinv_(o.dinv_), columns_(o.columns_),
-      reduced_(o.reduced_), local_(o.local_), surrogate_(o.surrogate_), tangent_(o.tangent_),
+      reduced_(o.reduced_), local_(o.local_), surrogate_(o.surrogate_), exact_since_(o.exact_since_.load()),
+      tangent_(o.tangent_),
       cache_(o.cache_), clock_(o.clock_) {}
 
 model::ModalSolver& Problem::second_solver() {
@@ -201,6 +203,7 @@ void Problem::use_reduced(const Eigen::VectorXd& centre, double end_mass) {
   reduced_ = std::make_shared<Reduced>();
   reduced_->centre = key_of(centre, end_mass);
   local_.clear();
+  exact_since_ = 0;
 }
 
 void Problem::set_surrogate(bool on) {
@@ -279,7 +282,7 @@ Problem::Basis Problem::make_basis(const Key& centre, bool mass, bool two_thread
   model::ModalOptions o = modal_;
   o.end_mass_fraction = centre[4];
   try {
-    auto b = model::ReducedPort::build(snaps, points[0].material, o, reduced_space());
+    auto b = model::ReducedPort::build(snaps, points[0].material, o, reduced_space(), false);
     if (b) return std::make_shared<const model::ReducedPort>(std::move(*b));
   } catch (const std::exception&) {
   }
@@ -287,7 +290,7 @@ Problem::Basis Problem::make_basis(const Key& centre, bool mass, bool two_thread
 }
 
 Problem::Built Problem::reduced_model(model::ModalSolver& solver, const Key& key) {
-  if (!reduced_ || !surrogate_) return {};
+  if (!reduced_) return {};
   try {
     return reduced_model_at(solver, key, material_at(key));
   } catch (const std::exception&) {
@@ -320,7 +323,7 @@ Problem::Built Problem::reduced_model_at(model::ModalSolver& solver, const Key& 
       if (!rd->tried) {
         rd->tried = true;
         try {
-          if (auto b = model::ReducedPort::build(solver, basis_points(rd->centre, false), modal_, space))
+          if (auto b = model::ReducedPort::build(solver, basis_points(rd->centre, false), modal_, space, false))
             rd->basis = std::make_shared<const model::ReducedPort>(std::move(*b));
         } catch (const std::exception&) {
         }
@@ -350,13 +353,15 @@ Problem::Built Problem::reduced_model_at(model::ModalSolver& solver, const Key& 
   return {};  // none reaches it: a modal solve (a basis about it if a Jacobian follows: prefetch)
 }
 
-Problem::Built Problem::build(model::ModalSolver& solver, const Key& key) {
+Problem::Built Problem::build(model::ModalSolver& solver, const Key& key, bool armed) {
   ++evaluations_;
-  if (Built r = reduced_model(solver, key); r.port) return r;
+  if (armed)
+    if (Built r = reduced_model(solver, key); r.port) return r;
   try {
     model::ModalOptions mo = modal_;
     mo.end_mass_fraction = key[4];
     auto port = solver.port_model(material_at(key), mo);
+    if (surrogate_) ++exact_since_;  // (atomic: prefetch's two threads)
     if (port.converged) return {std::move(port), nullptr};
   } catch (const std::exception&) {
   }
