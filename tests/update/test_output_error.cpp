@@ -101,6 +101,34 @@ class OutputErrorSimulated : public ::testing::Test {
     t.eps_t33 *= 0.97;
     return t;
   }
+  // One shot of the lab drive through a lead of r_lead ohms the fit does not
+  // know, 1 % noise on each channel (a lack of fit: the scan refits). The
+  // shot's samples live in the fixture (OeShot holds spans).
+  std::vector<double> lead_v1, lead_v2;
+  update::OeData with_lead(double r_lead, std::uint64_t seed) {
+    const auto s = simulate(solver, cls, truth(), 0.0, 11);  // the clean drive
+    model::ModalOptions mo;
+    mo.n_modes = 40;
+    const auto port = solver.port_model(cls.e_form(truth()), mo);
+    model::DividerCircuit c;
+    c.r1_ohm = 3140.0;
+    c.r_lead_ohm = r_lead;
+    std::vector<double> v1 = s.v1, v2 = model::simulate_divider(port, {0.0, s.beta}, c, s.v1, 10e6);
+    std::mt19937_64 rng(seed);
+    for (auto* v : {&v1, &v2}) {
+      double ms = 0;
+      for (double x : *v) ms += x * x;
+      std::normal_distribution<double> nd(0.0, 0.01 * std::sqrt(ms / double(v->size())));
+      for (auto& x : *v) x += nd(rng);
+    }
+    lead_v1 = std::move(v1);
+    lead_v2 = std::move(v2);
+    update::OeData d;
+    d.sample_rate_hz = 10e6;
+    d.circuit.r1_ohm = 3140.0;
+    d.shots.push_back({lead_v1, lead_v2, s.pretrigger});
+    return d;
+  }
 };
 
 #ifndef PIEZO_OE_VALIDATE  // the make-test program; the validate one runs the study below
@@ -155,28 +183,10 @@ TEST_F(OutputErrorSimulated, BadInputIsRefusedWithAMessage) {
 // later starts, the effect scan and the exact Jacobians' models side by side)
 // gives the same answer, to the last bit, as on one: every task starts from
 // the same state and every FE model is a function of its parameters alone.
-// A capture with an effect (a 10 Ω lead) so that the scan refits under a lack
+// A capture with an effect (a 20 Ω lead) so that the scan refits under a lack
 // of fit, the path with the most tasks.
 TEST_F(OutputErrorSimulated, TwoThreadsGiveTheSameAnswerAsOne) {
-  const auto s = simulate(solver, cls, truth(), 0.0, 11);  // the clean drive
-  model::ModalOptions mo;
-  mo.n_modes = 40;
-  const auto port = solver.port_model(cls.e_form(truth()), mo);
-  model::DividerCircuit c;
-  c.r1_ohm = 3140.0;
-  c.r_lead_ohm = 20.0;
-  std::vector<double> v1 = s.v1, v2 = model::simulate_divider(port, {0.0, s.beta}, c, s.v1, 10e6);
-  std::mt19937_64 rng(12);
-  for (auto* v : {&v1, &v2}) {
-    double ms = 0;
-    for (double x : *v) ms += x * x;
-    std::normal_distribution<double> nd(0.0, 0.01 * std::sqrt(ms / double(v->size())));
-    for (auto& x : *v) x += nd(rng);
-  }
-  update::OeData d;
-  d.sample_rate_hz = 10e6;
-  d.circuit.r1_ohm = 3140.0;
-  d.shots.push_back({v1, v2, s.pretrigger});
+  const update::OeData d = with_lead(20.0, 12);
   update::OeOptions o1;
   o1.scan_effects = update::supported_gap_effects();
   o1.threads = 1;
@@ -233,25 +243,7 @@ TEST_F(OutputErrorSimulated, TwoThreadsGiveTheSameAnswerAsOne) {
 // the runs' own stopping rule (½χ² falling by less than 1e-2 an
 // iteration), the five constants untouched — for fewer modal solves.
 TEST_F(OutputErrorSimulated, TheScanOnItsSurrogateAgreesWithTheExactScan) {
-  const auto s = simulate(solver, cls, truth(), 0.0, 11);
-  model::ModalOptions mo;
-  mo.n_modes = 40;
-  const auto port = solver.port_model(cls.e_form(truth()), mo);
-  model::DividerCircuit c;
-  c.r1_ohm = 3140.0;
-  c.r_lead_ohm = 20.0;
-  std::vector<double> v1 = s.v1, v2 = model::simulate_divider(port, {0.0, s.beta}, c, s.v1, 10e6);
-  std::mt19937_64 rng(13);
-  for (auto* v : {&v1, &v2}) {
-    double ms = 0;
-    for (double x : *v) ms += x * x;
-    std::normal_distribution<double> nd(0.0, 0.01 * std::sqrt(ms / double(v->size())));
-    for (auto& x : *v) x += nd(rng);
-  }
-  update::OeData d;
-  d.sample_rate_hz = 10e6;
-  d.circuit.r1_ohm = 3140.0;
-  d.shots.push_back({v1, v2, s.pretrigger});
+  const update::OeData d = with_lead(20.0, 13);
   update::OeOptions exact;
   exact.scan_effects = update::supported_gap_effects();
   exact.scan_surrogate = false;
