@@ -104,15 +104,16 @@ class Problem {
   // the answers do not depend on the thread count.
   void prefetch(const std::vector<std::pair<Eigen::VectorXd, double>>& points);
 
-  // The effect scan's surrogate (issue 43 item 2): with set_surrogate(true)
-  // a port model not cached comes from a reduced basis
-  // (model/reduced_port.hpp) — the exact solutions at a centre and at its
-  // plus-points (centre + h·e_c in the constants and the end mass), a small
-  // dense eigenproblem per model in place of a modal solve — where one
-  // reaches it (kReducedReach in every constant's coordinate,
-  // kReducedMassReach in the end mass; the nearest) and that basis's own
-  // error estimate is below the surrogate's tolerances; else from a modal
-  // solve. The bases: one about `centre` (the optimum), built on first use,
+  // The effect scan's surrogate (issue 43 item 2): with set_surrogate(true),
+  // once kSurrogateAfter modal solves have been paid (armed()), a port model
+  // not cached comes from a reduced basis (model/reduced_port.hpp) — the
+  // exact solutions at a centre and at its plus-points (centre + h·e_c in the
+  // constants and the end mass), a small dense eigenproblem per model in
+  // place of a modal solve — where one reaches it (kReducedReach in every
+  // constant's coordinate, kReducedMassReach in the end mass; the nearest),
+  // without its error estimates (a quarter of a modal solve each; the
+  // answers are made exact below); else from a modal solve. The bases: one
+  // about `centre` (the optimum), built on first use,
   // once for this problem and its forks, its content — and so every answer
   // and count — the same whatever thread builds it; and one about each
   // point where an exact Jacobian is asked for (prefetch: its plus-points
