@@ -36,8 +36,9 @@ Eigen::MatrixXd symmetric(const Eigen::MatrixXd& a) { return 0.5 * (a + a.transp
 
 }  // namespace
 
-ReducedPortSpace::ReducedPortSpace(std::shared_ptr<const TubeModel> half, const PiezoMaterialE& reference)
-    : model(std::move(half)) {
+ReducedPortSpace::ReducedPortSpace(std::shared_ptr<const TubeModel> half, const PiezoMaterialE& reference,
+                                   bool estimates)
+    : model(std::move(half)), estimates(estimates) {
   if (!model || model->extent() != TubeExtent::upper_half)
     throw std::invalid_argument("ReducedPortSpace: needs the upper half of a tube (TubeModel::upper_half)");
   nu = model->n_u();
@@ -58,6 +59,7 @@ ReducedPortSpace::ReducedPortSpace(std::shared_ptr<const TubeModel> half, const 
   dm = SpMat(model->mass(1.0) - m);
   on_plane.assign(static_cast<std::size_t>(nu), 0);
   for (int dof : model->symmetry_plane_dofs()) on_plane[static_cast<std::size_t>(dof)] = 1;
+  if (!estimates) return;  // (the factorisations below are the check's only)
   // M with the mid-plane's u_z constrained (identity rows), for ‖r‖_M⁻¹.
   std::vector<Eigen::Triplet<double>> t;
   for (int col = 0; col < m.outerSize(); ++col)
@@ -90,7 +92,8 @@ std::optional<ReducedPort> ReducedPort::build(std::span<const PortVectors> snaps
     nu_cols += s.u.cols();
     np_cols += s.phi.cols();
   }
-  if (!space) space = std::make_shared<const ReducedPortSpace>(model, centre);
+  if (!space) space = std::make_shared<const ReducedPortSpace>(model, centre, estimates);
+  if (estimates && !space->estimates) return std::nullopt;
   if (space->model != model) return std::nullopt;
   const ReducedPortSpace& sp = *space;
   const int nu = sp.nu, np = sp.np1 - 1;
@@ -168,7 +171,7 @@ ModalPortModel ReducedPort::port_model(const PiezoMaterialE& material, double en
                                        Bound* bound) const {
   g_reduced_port_models.fetch_add(1, std::memory_order_relaxed);  // model/work_counters.hpp
   const auto w = weights(material);
-  const int r = r_, q = q_;
+  const int q = q_;
   // K = Σ w_p K_p by blocks: U×U (the cE's), U×[Φ_int V] (the e's), [Φ_int V]² (the εS's).
   Eigen::MatrixXd kuu = w[0] * kuu_[0];
   for (std::size_t k = 1; k < 5; ++k) kuu.noalias() += w[k] * kuu_[k];
@@ -220,7 +223,6 @@ ModalPortModel ReducedPort::port_model(const PiezoMaterialE& material, double en
   if (bound) *bound = estimates_ ? check(w, df, x, g, es.eigenvectors(), es.eigenvalues(), out) : Bound{INFINITY, INFINITY};
   add_residual_mode(out, u_s.dot(m_r * u_s));
   half_to_whole(out);
-  (void)r;
   return out;
 }
 
@@ -233,7 +235,7 @@ ReducedPort::Bound ReducedPort::check(const MaterialWeights& w, double df, const
                                       const Eigen::VectorXd& lambda, const ModalPortModel& half) const {
   Bound b;
   const ReducedPortSpace& sp = *space_;
-  const int r = r_, q = q_, nu = sp.nu, np = sp.np1 - 1;
+  const int q = q_, nu = sp.nu, np = sp.np1 - 1;
   // (−K_ΦΦ)⁻¹ on Φ_int at this material.
   std::optional<Eigen::SimplicialLDLT<SpMat>> own;
   const Eigen::SimplicialLDLT<SpMat>* pp = nullptr;
@@ -307,7 +309,6 @@ ReducedPort::Bound ReducedPort::check(const MaterialWeights& w, double df, const
     const double knorm2 = 2.0 * std::max(0.0, r_sc.dot(y.head(nu)));
     b.participation = std::max(b.participation, std::sqrt(2.0 * a2 * knorm2) / std::abs(p));
   }
-  (void)r;
   return b;
 }
 

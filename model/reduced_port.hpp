@@ -72,9 +72,12 @@ namespace piezo::model {
 struct ReducedPortSpace {
   // `reference`: the material whose static short-circuit stiffness the check
   // takes for every basis's (ReducedPort::Bound; spectrally within a few
-  // per cent of theirs where the bases are used). Throws std::invalid_argument.
-  ReducedPortSpace(std::shared_ptr<const TubeModel> half, const PiezoMaterialE& reference);
+  // per cent of theirs where the bases are used). `estimates` false: without
+  // the check's factorisations (for bases built without estimates). Throws
+  // std::invalid_argument.
+  ReducedPortSpace(std::shared_ptr<const TubeModel> half, const PiezoMaterialE& reference, bool estimates = true);
   std::shared_ptr<const TubeModel> model;
+  bool estimates = true;  // the check's factorisations below made
   int nu = 0, np1 = 0;  // U DOFs; Φ DOFs with the electrode's V last
   std::array<SpMat, 5> k_uu;
   std::array<SpMat, 3> k_up, k_pu;  // (and transposed)
@@ -95,7 +98,8 @@ class ReducedPort {
   // (null: made here, with `centre` its reference). nullopt when they are empty, live on different
   // models, or span fewer U directions than modes.
   // `estimates` false: a basis without them (port_model's bound then
-  // infinite), a third less work to build and half the memory.
+  // infinite), a third less work to build and half the memory; a space made
+  // without estimates serves only such bases.
   static std::optional<ReducedPort> build(std::span<const PortVectors> snapshots, const PiezoMaterialE& centre,
                                           const ModalOptions& opt,
                                           std::shared_ptr<const ReducedPortSpace> space = nullptr,
@@ -128,9 +132,6 @@ class ReducedPort {
   ModalPortModel port_model(const PiezoMaterialE& material, double end_mass_fraction,
                             Bound* bound = nullptr) const;
 
-  double end_mass_fraction() const { return end_mass_; }
-  int u_dimension() const { return r_; }
-  int phi_dimension() const { return q_; }
   const std::shared_ptr<const ReducedPortSpace>& space() const { return space_; }
 
  private:

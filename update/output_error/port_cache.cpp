@@ -239,7 +239,8 @@ std::shared_ptr<const model::ReducedPortSpace> Problem::reduced_space() {
   if (!reduced_->space) {
     const auto half = solver_.half_model();  // (built with the fit's first port model)
     try {
-      if (half) reduced_->space = std::make_shared<const model::ReducedPortSpace>(half, material_at(reduced_->centre));
+      if (half)  // (the bases here are built without error estimates)
+        reduced_->space = std::make_shared<const model::ReducedPortSpace>(half, material_at(reduced_->centre), false);
     } catch (const std::exception&) {
     }
   }
