@@ -1,6 +1,7 @@
 #include "model/modal.hpp"
 
-#include <Spectra/SymGEigsShiftSolver.h>
+#include <Eigen/SparseCholesky>
+#include <Spectra/SymEigsSolver.h>
 
 #include <algorithm>
 #include <cmath>
@@ -43,76 +44,69 @@ class CondensedShiftInvert {
   mutable Eigen::VectorXd rhs_, sol_;
 };
 
-// B-product x ↦ M x for Spectra with M symmetric and stored with both
-// triangles (SplitSystem's pattern): column j of M is also its row j, so
-// y_j = M(:, j)·x is one gather per column. Spectra's SparseSymMatProd goes
-// through selfadjointView, which scatters into y and was a quarter of a port
-// model's time (perf, single-shot diagnosis bench).
-//
-// Spectra's Lanczos step asks for B·f twice in a row for the same residual f
-// (its B-norm, then Vᵀ·B·f for the re-orthogonalisation test, and again
-// after each correction): the last product is kept and returned when the
-// input is the same vector, one comparison instead of a sparse product
-// (a third of the B-products of a port model).
-class SymmetricStoredProd {
+// y = Lᵀ P (K_cond − σM)⁻¹ Pᵀ L x: the shift-invert operator in the standard
+// form of K φ = λ M φ, with P M Pᵀ = L Lᵀ and ψ = Lᵀ P φ (eigenvalue
+// μ = 1/(λ − σ), φ = Pᵀ L⁻ᵀ ψ). Lanczos then runs in the Euclidean inner
+// product: two products with the Cholesky factor per step where the
+// generalised (M-inner-product) Lanczos paid three to four products with M
+// for its op, norms and re-orthogonalisation (a quarter of a port model;
+// issue 43). L and Lᵀ are both stored column-major, so that each product is
+// a gather per column, four columns at a time (four independent sums the
+// CPU overlaps; the product is latency-bound otherwise).
+void gather_product(const SpMat& a, const double* x, double* y) {
+  const Eigen::Index n = a.cols();
+  const int* outer = a.outerIndexPtr();
+  const int* inner = a.innerIndexPtr();
+  const double* val = a.valuePtr();
+  Eigen::Index j = 0;
+  for (; j + 4 <= n; j += 4) {
+    const int b0 = outer[j], b1 = outer[j + 1], b2 = outer[j + 2], b3 = outer[j + 3], e3 = outer[j + 4];
+    const int common = std::min({b1 - b0, b2 - b1, b3 - b2, e3 - b3});
+    double s0 = 0.0, s1 = 0.0, s2 = 0.0, s3 = 0.0;
+    for (int t = 0; t < common; ++t) {
+      s0 += val[b0 + t] * x[inner[b0 + t]];
+      s1 += val[b1 + t] * x[inner[b1 + t]];
+      s2 += val[b2 + t] * x[inner[b2 + t]];
+      s3 += val[b3 + t] * x[inner[b3 + t]];
+    }
+    for (int p = b0 + common; p < b1; ++p) s0 += val[p] * x[inner[p]];
+    for (int p = b1 + common; p < b2; ++p) s1 += val[p] * x[inner[p]];
+    for (int p = b2 + common; p < b3; ++p) s2 += val[p] * x[inner[p]];
+    for (int p = b3 + common; p < e3; ++p) s3 += val[p] * x[inner[p]];
+    y[j] = s0;
+    y[j + 1] = s1;
+    y[j + 2] = s2;
+    y[j + 3] = s3;
+  }
+  for (; j < n; ++j) {
+    double s = 0.0;
+    for (int p = outer[j]; p < outer[j + 1]; ++p) s += val[p] * x[inner[p]];
+    y[j] = s;
+  }
+}
+
+class StandardShiftInvert {
  public:
   using Scalar = double;
-  explicit SymmetricStoredProd(const SpMat& m)
-      : m_(&m), last_in_(Eigen::VectorXd::Constant(m.cols(), NAN)), last_out_(m.cols()) {}
-  Eigen::Index rows() const { return m_->rows(); }
-  Eigen::Index cols() const { return m_->cols(); }
+  StandardShiftInvert(const CondensedShiftInvert& inv, const SpMat& l, const SpMat& lt,
+                      const Eigen::PermutationMatrix<Eigen::Dynamic, Eigen::Dynamic, int>& p,
+                      const Eigen::PermutationMatrix<Eigen::Dynamic, Eigen::Dynamic, int>& p_inv)
+      : inv_(&inv), l_(&l), lt_(&lt), p_(&p), p_inv_(&p_inv), t_(l.rows()), u_(l.rows()), w_(l.rows()) {}
+  Eigen::Index rows() const { return l_->rows(); }
+  Eigen::Index cols() const { return l_->rows(); }
   void perform_op(const Scalar* x_in, Scalar* y_out) const {
-    const Eigen::Index n = m_->cols();
-    if (std::equal(x_in, x_in + n, last_in_.data())) {  // (NaN at first: never equal)
-      std::copy(last_out_.data(), last_out_.data() + n, y_out);
-      return;
-    }
-    const int* outer = m_->outerIndexPtr();
-    const int* inner = m_->innerIndexPtr();
-    const double* val = m_->valuePtr();
-    // Four columns at a time: four independent sums the CPU overlaps, where one
-    // column's sum waits on its previous add at every term (the product was a
-    // sixth of a replay's time, latency-bound). Each sum still runs over its
-    // column in storage order, so the product is bit-identical to one column
-    // at a time (no FMA contraction on our x86-64 baseline; issue 43).
-    Eigen::Index j = 0;
-    for (; j + 4 <= n; j += 4) {
-      const int b0 = outer[j], b1 = outer[j + 1], b2 = outer[j + 2], b3 = outer[j + 3], e3 = outer[j + 4];
-      const int common = std::min({b1 - b0, b2 - b1, b3 - b2, e3 - b3});
-      double s0 = 0.0, s1 = 0.0, s2 = 0.0, s3 = 0.0;
-      for (int t = 0; t < common; ++t) {
-        s0 += val[b0 + t] * x_in[inner[b0 + t]];
-        s1 += val[b1 + t] * x_in[inner[b1 + t]];
-        s2 += val[b2 + t] * x_in[inner[b2 + t]];
-        s3 += val[b3 + t] * x_in[inner[b3 + t]];
-      }
-      for (int p = b0 + common; p < b1; ++p) s0 += val[p] * x_in[inner[p]];
-      for (int p = b1 + common; p < b2; ++p) s1 += val[p] * x_in[inner[p]];
-      for (int p = b2 + common; p < b3; ++p) s2 += val[p] * x_in[inner[p]];
-      for (int p = b3 + common; p < e3; ++p) s3 += val[p] * x_in[inner[p]];
-      y_out[j] = s0;
-      y_out[j + 1] = s1;
-      y_out[j + 2] = s2;
-      y_out[j + 3] = s3;
-    }
-    for (; j < n; ++j) {
-      double s = 0.0;
-      for (int p = outer[j]; p < outer[j + 1]; ++p) s += val[p] * x_in[inner[p]];
-      y_out[j] = s;
-    }
-    std::copy(x_in, x_in + n, last_in_.data());
-    std::copy(y_out, y_out + n, last_out_.data());
+    gather_product(*lt_, x_in, t_.data());  // t = L x (row i of L = column i of Lᵀ)
+    u_.noalias() = *p_inv_ * t_;             // Pᵀ t
+    inv_->perform_op(u_.data(), w_.data());
+    t_.noalias() = *p_ * w_;                 // P w
+    gather_product(*l_, t_.data(), y_out);   // Lᵀ (P w)
   }
-  Eigen::MatrixXd operator*(const Eigen::Ref<const Eigen::MatrixXd>& x) const {
-    Eigen::MatrixXd y(rows(), x.cols());
-    for (Eigen::Index c = 0; c < x.cols(); ++c) perform_op(x.col(c).data(), y.col(c).data());
-    return y;
-  }
-  Scalar operator()(Eigen::Index i, Eigen::Index j) const { return m_->coeff(i, j); }
 
  private:
-  const SpMat* m_;
-  mutable Eigen::VectorXd last_in_, last_out_;
+  const CondensedShiftInvert* inv_;
+  const SpMat *l_, *lt_;
+  const Eigen::PermutationMatrix<Eigen::Dynamic, Eigen::Dynamic, int>*p_, *p_inv_;
+  mutable Eigen::VectorXd t_, u_, w_;
 };
 
 }  // namespace
@@ -161,8 +155,6 @@ void ModalSolver::check(const PiezoMaterialE& material, const char* caller) cons
 
 ModalSolver::ModalSolver(const TubeModel& model) : model_(&model), factor_(model) {
   m_uu_ = model.split().m;
-  all_u_.resize(model.n_u());
-  std::iota(all_u_.begin(), all_u_.end(), 0);
 }
 
 ModalSolver::ModalSolver(const TubeModel& model, std::shared_ptr<const TubeModel> half) : ModalSolver(model) {
@@ -185,10 +177,25 @@ std::shared_ptr<const TubeModel> ModalSolver::half_model() {
 double ModalSolver::clamped_capacitance(const PiezoMaterialE& material, Eigen::VectorXd* g) {
   check(material, "ModalSolver::clamped_capacitance");
   Eigen::VectorXd x;
-  const double c0 = factor_.charge_for_unit_voltage(weights(material), all_u_, &x);
+  const double c0 = factor_.charge_for_unit_voltage_u_clamped(weights(material), &x);
   if (g) *g = (factor_.matrix() * x).head(model_->n_u());  // g = K_UΦ [Φ_int; 1]
   if (keep_clamped_) clamped_x_ = std::move(x);  // (own_port_vectors)
   return c0;
+}
+
+const ModalSolver::MassFactor& ModalSolver::mass_factor(double f) {
+  MassFactor& mf = f == 0.0 ? m_factor_unloaded_ : m_factor_loaded_;
+  if (mf.fraction != f) {
+    Eigen::SimplicialLLT<SpMat, Eigen::Lower, Eigen::AMDOrdering<int>> llt(mass(f));
+    if (llt.info() != Eigen::Success)
+      throw std::runtime_error("ModalSolver: the mass matrix is not positive definite (its Cholesky failed)");
+    mf.l = llt.matrixL();
+    mf.lt = mf.l.transpose();
+    mf.p = llt.permutationP();
+    mf.p_inv = llt.permutationPinv();
+    mf.fraction = f;
+  }
+  return mf;
 }
 
 const SpMat& ModalSolver::mass(double f) {
@@ -252,12 +259,11 @@ ModalResult ModalSolver::solve(const PiezoMaterialE& material, Electrodes electr
     res.message = "singular shifted system";
     return res;
   }
-  CondensedShiftInvert op(factor_, nu, sigma, plane);
-  SymmetricStoredProd bop(m_uu);
+  CondensedShiftInvert inv(factor_, nu, sigma, plane);
+  const MassFactor& mf = mass_factor(opt.end_mass_fraction);
+  StandardShiftInvert op(inv, mf.l, mf.lt, mf.p, mf.p_inv);
   const int ncv = std::min<int>(nu, opt.ncv > 0 ? opt.ncv : std::max(2 * opt.n_modes + 1, opt.n_modes + 20));
-  Spectra::SymGEigsShiftSolver<CondensedShiftInvert, SymmetricStoredProd,
-                               Spectra::GEigsMode::ShiftInvert>
-      eigs(op, bop, opt.n_modes, ncv, sigma);
+  Spectra::SymEigsSolver<StandardShiftInvert> eigs(op, opt.n_modes, ncv);
   eigs.init();
   res.n_converged = static_cast<int>(
       eigs.compute(Spectra::SortRule::LargestMagn, opt.max_iterations, opt.tolerance));
@@ -267,27 +273,34 @@ ModalResult ModalSolver::solve(const PiezoMaterialE& material, Electrodes electr
                   std::to_string(opt.n_modes) + " modes";
     if (res.n_converged == 0) return res;
   }
-  const Eigen::VectorXd lambda = eigs.eigenvalues();
-  const Eigen::MatrixXd vecs = eigs.eigenvectors();
+  // μ = 1/(λ − σ) → λ; ψ → φ = Pᵀ L⁻ᵀ ψ (M(f)-orthonormal).
+  const Eigen::VectorXd lambda = (sigma + eigs.eigenvalues().array().inverse()).matrix();
+  Eigen::MatrixXd vecs = eigs.eigenvectors();
+  mf.lt.triangularView<Eigen::Upper>().solveInPlace(vecs);
+  vecs = mf.p_inv * vecs;
   std::vector<int> order(lambda.size());
   std::iota(order.begin(), order.end(), 0);
   std::sort(order.begin(), order.end(), [&](int a, int b) { return lambda[a] < lambda[b]; });
 
-  // κ_k = φᵀK_UUφ without assembling K_UU: the factorised matrix's U block is
-  // K_UU − σ·M(f), and φ is M(f)-normalised, so κ = [φ;0]ᵀA[φ;0] + σ.
-  const SpMat& a_shifted = factor_.matrix();
-  Eigen::VectorXd phi_full = Eigen::VectorXd::Zero(a_shifted.rows());
-
+  // The shapes, M(f)-normalised by the transform (φ = Pᵀ L⁻ᵀ ψ, ψ orthonormal),
+  // ascending; sign convention: largest |u_r| component positive (reproducible shapes).
   res.shapes.resize(nu, static_cast<Eigen::Index>(order.size()));
-  const double rigid_omega = 2.0 * M_PI * 1e-3 * opt.shift_hz;
   for (std::size_t j = 0; j < order.size(); ++j) {
-    Eigen::VectorXd phi = vecs.col(order[j]);
-    const double mnorm = std::sqrt(phi.dot(m_uu * phi));
-    phi /= mnorm;
-    // Sign convention: largest |u_r| component positive (reproducible shapes).
+    auto phi = res.shapes.col(static_cast<Eigen::Index>(j));
+    phi = vecs.col(order[j]);
     Eigen::Index imax;
     phi.cwiseAbs().maxCoeff(&imax);
     if (phi[imax] < 0) phi = -phi;
+  }
+  // κ_k = φᵀK_UUφ without assembling K_UU: the factorised matrix's U block is
+  // K_UU − σ·M(f), and φ is M(f)-normalised, so κ = [φ;0]ᵀA[φ;0] + σ — all
+  // modes' products in one pass over A's U columns.
+  const SpMat& a_shifted = factor_.matrix();
+  const Eigen::MatrixXd a_phi = (a_shifted.leftCols(nu) * res.shapes).topRows(nu);
+
+  const double rigid_omega = 2.0 * M_PI * 1e-3 * opt.shift_hz;
+  for (std::size_t j = 0; j < order.size(); ++j) {
+    const auto phi = res.shapes.col(static_cast<Eigen::Index>(j));
     Mode m;
     m.eigenvalue = lambda[order[j]];
     m.omega = std::sqrt(std::max(m.eigenvalue, 0.0));
@@ -302,14 +315,12 @@ ModalResult ModalSolver::solve(const PiezoMaterialE& material, Electrodes electr
                  : m.symmetric_fraction < 0.01 ? Symmetry::antisymmetric
                                                : Symmetry::mixed;
     m.participation = g.dot(phi);
-    phi_full.head(nu) = phi;
-    m.kappa = phi_full.dot(a_shifted * phi_full) + sigma;
+    m.kappa = phi.dot(a_phi.col(static_cast<Eigen::Index>(j))) + sigma;
     if (m.omega > rigid_omega)
       m.coupling = m.participation * m.participation / (m.omega * m.omega * res.c_clamped);
     const double threshold =
         electrodes == Electrodes::open_circuit ? opt.active_coupling_open : opt.active_coupling;
     m.electrically_active = m.symmetric_fraction > 0.5 && m.coupling > threshold;
-    res.shapes.col(static_cast<Eigen::Index>(j)) = phi;
     res.modes.push_back(m);
   }
   return res;

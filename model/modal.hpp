@@ -1,9 +1,11 @@
 #pragma once
 // Modal analysis of the tube with short-circuited (V = 0, eq. 88) or
 // open-circuited (zero net charge, static condensation eq. 92) electrodes:
-// the lowest N modes of (K_cond − ω²M) U = 0 by Spectra's shift-invert
-// generalized Lanczos, where (K_cond − σM)⁻¹ is applied by solving the full
-// coupled system (internal potentials condensed implicitly). The mechanical
+// the lowest N modes of (K_cond − ω²M) U = 0 by shift-invert Lanczos
+// (Spectra), in the standard form of the Cholesky factor P M Pᵀ = L Lᵀ
+// (operator Lᵀ P (K_cond − σM)⁻¹ Pᵀ L), where (K_cond − σM)⁻¹ is applied by
+// solving the full coupled system (internal potentials condensed
+// implicitly). The mechanical
 // boundary is free–free, so mode 0 is the rigid axial translation (0 Hz).
 //
 // Per mode: frequency, M-normalised shape, symmetry about the mid-plane, and
@@ -146,6 +148,14 @@ class ModalSolver {
   void check(const PiezoMaterialE& material, const char* caller) const;
   // M + f·ΔM (cached for the last f).
   const SpMat& mass(double end_mass_fraction);
+  // Its sparse Cholesky factor P·M(f)·Pᵀ = L·Lᵀ (cached for f = 0 and the last
+  // f): the standard form of the shift-invert problem (solve()).
+  struct MassFactor {
+    double fraction = -1.0;
+    SpMat l, lt;  // L and Lᵀ, both column-major (each product a gather over columns)
+    Eigen::PermutationMatrix<Eigen::Dynamic, Eigen::Dynamic, int> p, p_inv;
+  };
+  const MassFactor& mass_factor(double end_mass_fraction);
   // Static solve for V = 1 with the rigid translation fixed; u_static is made
   // M-orthogonal to the rigid mode for the given mass matrix.
   double static_solve(const PiezoMaterialE& material, const SpMat& mass, Eigen::VectorXd* u_static);
@@ -164,7 +174,7 @@ class ModalSolver {
   SpMat m_uu_, k_uu_;
   SpMat m_loaded_;
   double m_loaded_fraction_ = -1.0;
-  std::vector<int> all_u_;  // DOF list to clamp U for C0
+  MassFactor m_factor_unloaded_, m_factor_loaded_;
   bool keep_clamped_ = false;      // clamped_capacitance keeps its solution in clamped_x_
   Eigen::VectorXd clamped_x_;
 };
