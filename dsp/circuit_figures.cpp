@@ -7,6 +7,8 @@
 #include <numbers>
 #include <stdexcept>
 
+#include "numerics/complex_division.hpp"
+
 namespace piezo::dsp {
 
 namespace {
@@ -76,7 +78,10 @@ double CircuitBranch::qm() const { return kTwoPi * fs_hz() * l_h / r_ohm; }
 cd EquivalentCircuit::admittance_without_rs(double f_hz) const {
   const cd s(0.0, kTwoPi * f_hz);
   cd y = s * c0_f * cd(1.0, -tan_delta);
-  for (const auto& b : branches) y += 1.0 / (b.r_ohm + s * b.l_h + 1.0 / (s * b.c_f));
+  // 1/(sC) = −j/(ωC), then the branch's admittance by Smith's division
+  // (numerics/complex_division.hpp: no libgcc call in the circuit fits' loop).
+  for (const auto& b : branches)
+    y += numerics::reciprocal(b.r_ohm + s * b.l_h + cd(0.0, -1.0 / (s.imag() * b.c_f)));
   return y;
 }
 

@@ -4,6 +4,8 @@
 #include <stdexcept>
 #include <vector>
 
+#include "numerics/complex_division.hpp"
+
 namespace piezo::model {
 
 using cd = std::complex<double>;
@@ -66,13 +68,14 @@ cd recorded_transfer(cd y_tube, const EffectSet& fx, double r1_nominal_ohm, doub
   for (const EffectInfo* e : entries(EffectStage::series))
     if (present(*e, fx))
       if (const cd z = e->term(fx.*(e->field), omega); z != 0.0)
-        y = z.imag() == 0.0 ? y / (1.0 + z.real() * y) : y / (1.0 + z * y);  // a real term: a real product
+        y = z.imag() == 0.0 ? numerics::divide(y, 1.0 + z.real() * y)  // a real term: a real product
+                            : numerics::divide(y, 1.0 + z * y);
   for (const EffectInfo* e : entries(EffectStage::shunt))
     if (present(*e, fx)) y += e->term(fx.*(e->field), omega);
   double r1 = r1_nominal_ohm;
   for (const EffectInfo* e : entries(EffectStage::r1))
     if (present(*e, fx)) r1 *= e->term(fx.*(e->field), omega).real();
-  cd h = 1.0 / (1.0 + r1 * y);
+  cd h = numerics::reciprocal(1.0 + r1 * y);
   // The channel-2 factors from the catalogue's last to its first (the gain
   // before the skew's phase, the order this product was first written in:
   // only the rounding depends on it).
@@ -89,7 +92,7 @@ cd recorded_transfer(cd y_tube, const EffectSet& fx, double r1_nominal_ohm, doub
 cd reported_impedance(cd y_tube, const EffectSet& fx, double r1_nominal_ohm, double omega) {
   if (!(r1_nominal_ohm > 0)) throw std::invalid_argument("reported_impedance: R1 must be positive");
   const cd hm = recorded_transfer(y_tube, fx, r1_nominal_ohm, omega);
-  return r1_nominal_ohm * hm / (1.0 - hm);
+  return numerics::divide(r1_nominal_ohm * hm, 1.0 - hm);
 }
 
 std::vector<cd> bench_impedance(const ModalPortModel& port, const RayleighDamping& d,
