@@ -4,7 +4,9 @@
 
 #include <algorithm>
 #include <cstring>
+#include <map>
 #include <mutex>
+#include <utility>
 #include <new>
 #include <stdexcept>
 
@@ -17,6 +19,24 @@ std::mutex& planner_mutex() {
   static std::mutex m;
   return m;
 }
+
+// The shared r2c/c2r plans of each size (made on first use, under the planner
+// lock, on scratch buffers from fftw_alloc: every RealFft's buffers come from
+// it too, so they have the alignment the plans assume). Kept for the process;
+// at most kMaxSharedSizes sizes (a batch of captures of many lengths plans the
+// rest per object, as before).
+constexpr std::size_t kMaxSharedSizes = 64;
+std::map<std::size_t, std::pair<fftw_plan, fftw_plan>>& shared_plans() {
+  static auto* plans = new std::map<std::size_t, std::pair<fftw_plan, fftw_plan>>();  // never freed: outlives every RealFft
+  return *plans;
+}
+
+std::pair<fftw_plan, fftw_plan> make_plans(std::size_t n, double* r, fftw_complex* c) {
+  fftw_plan f = fftw_plan_dft_r2c_1d(static_cast<int>(n), r, c, FFTW_ESTIMATE);
+  fftw_plan i = fftw_plan_dft_c2r_1d(static_cast<int>(n), c, r, FFTW_ESTIMATE);
+  if (!f || !i) throw std::runtime_error("RealFft: FFTW planning failed");
+  return {f, i};
+}
 }  // namespace
 
 RealFft::RealFft(std::size_t n) : n_(n) {
@@ -25,16 +45,44 @@ RealFft::RealFft(std::size_t n) : n_(n) {
   rbuf_ = fftw_alloc_real(n);
   auto* c = fftw_alloc_complex(n / 2 + 1);
   cbuf_ = c;
-  if (!rbuf_ || !c) throw std::bad_alloc();
-  fwd_ = fftw_plan_dft_r2c_1d(static_cast<int>(n), rbuf_, c, FFTW_ESTIMATE);
-  inv_ = fftw_plan_dft_c2r_1d(static_cast<int>(n), c, rbuf_, FFTW_ESTIMATE);
-  if (!fwd_ || !inv_) throw std::runtime_error("RealFft: FFTW planning failed");
+  if (!rbuf_ || !c) {
+    fftw_free(rbuf_);
+    fftw_free(c);
+    throw std::bad_alloc();
+  }
+  auto& shared = shared_plans();
+  std::pair<fftw_plan, fftw_plan> p;
+  if (auto it = shared.find(n); it != shared.end()) {
+    p = it->second;
+  } else if (shared.size() < kMaxSharedSizes) {
+    // Planned on scratch buffers (FFTW_ESTIMATE does not touch them) of the same allocator.
+    double* r = fftw_alloc_real(n);
+    fftw_complex* sc = fftw_alloc_complex(n / 2 + 1);
+    if (!r || !sc) {
+      fftw_free(r);
+      fftw_free(sc);
+      fftw_free(rbuf_);
+      fftw_free(c);
+      throw std::bad_alloc();
+    }
+    p = make_plans(n, r, sc);
+    fftw_free(r);
+    fftw_free(sc);
+    shared.emplace(n, p);
+  } else {
+    p = make_plans(n, rbuf_, c);
+    own_plans_ = true;
+  }
+  fwd_ = p.first;
+  inv_ = p.second;
 }
 
 RealFft::~RealFft() {
   std::lock_guard<std::mutex> lock(planner_mutex());
-  if (fwd_) fftw_destroy_plan(static_cast<fftw_plan>(fwd_));
-  if (inv_) fftw_destroy_plan(static_cast<fftw_plan>(inv_));
+  if (own_plans_) {
+    fftw_destroy_plan(static_cast<fftw_plan>(fwd_));
+    fftw_destroy_plan(static_cast<fftw_plan>(inv_));
+  }
   fftw_free(rbuf_);
   fftw_free(cbuf_);
 }
@@ -44,14 +92,15 @@ void RealFft::forward(const double* in, std::size_t count, std::complex<double>*
   count = std::min(count, n_);
   std::memcpy(rbuf_, in, count * sizeof(double));
   std::fill(rbuf_ + count, rbuf_ + n_, 0.0);
-  fftw_execute(static_cast<fftw_plan>(fwd_));
+  fftw_execute_dft_r2c(static_cast<fftw_plan>(fwd_), rbuf_, static_cast<fftw_complex*>(cbuf_));
   std::memcpy(static_cast<void*>(out), cbuf_, bins() * sizeof(fftw_complex));
 }
 
 void RealFft::inverse(const std::complex<double>* in, double* out, std::size_t count) {
   g_ffts.fetch_add(1, std::memory_order_relaxed);
   std::memcpy(cbuf_, static_cast<const void*>(in), bins() * sizeof(fftw_complex));
-  fftw_execute(static_cast<fftw_plan>(inv_));  // c2r destroys its input: cbuf_ is scratch
+  // c2r destroys its input: cbuf_ is scratch
+  fftw_execute_dft_c2r(static_cast<fftw_plan>(inv_), static_cast<fftw_complex*>(cbuf_), rbuf_);
   std::memcpy(out, rbuf_, std::min(count, n_) * sizeof(double));
 }
 

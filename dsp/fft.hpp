@@ -2,6 +2,11 @@
 // Thin RAII wrapper over FFTW3's real transforms (the only FFTW user in dsp/).
 // Plans are made with FFTW_ESTIMATE under a process-wide lock (the FFTW planner
 // is not thread-safe); execution is lock-free, one RealFft per thread.
+// RealFft's plans are made once per size and process and shared (FFTW's
+// new-array execute: each RealFft transforms its own buffers with them):
+// planning, even FFTW_ESTIMATE's, cost twice the transforms themselves in a
+// replay, where every fit's Problem and each of its scan forks made its own
+// (issue 43). The transforms are the same plans', so bit-identical.
 #include <Eigen/Core>
 #include <complex>
 #include <cstddef>
@@ -28,6 +33,7 @@ class RealFft {
   void* cbuf_ = nullptr;
   void* fwd_ = nullptr;
   void* inv_ = nullptr;
+  bool own_plans_ = false;  // past the shared cache's size limit: its own plans
 };
 
 // FFTW3's complex transform of size n, in place on its own buffer (data()).
