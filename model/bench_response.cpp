@@ -38,6 +38,34 @@ cd tube_admittance(const ModalPortModel& port, const RayleighDamping& d, const E
   return cd(0.0, omega) * q;
 }
 
+void tube_admittances(const ModalPortModel& port, const RayleighDamping& d, const EffectSet& fx,
+                      std::span<const double> omega, double elastic_loss, std::span<cd> y) {
+  const std::size_t n = omega.size();
+  if (y.size() < n) throw std::invalid_argument("tube_admittances: y shorter than omega");
+  thread_local std::vector<double> qr, qi;
+  qr.resize(n);
+  qi.resize(n);
+  for (std::size_t i = 0; i < n; ++i) {
+    const cd q = port_capacitance(port, fx, omega[i]);
+    qr[i] = q.real();
+    qi[i] = q.imag();
+  }
+  const double* w = omega.data();
+  double* r = qr.data();
+  double* im_q = qi.data();
+  for (const auto& m : port.modes) {  // as tube_admittance, term by term
+    const double ck = d.alpha + d.beta * m.kappa + 2.0 * fx.mechanical_damping * m.omega;
+    const double w2 = m.omega * m.omega, p2 = m.participation * m.participation, loss = elastic_loss * m.kappa;
+    for (std::size_t i = 0; i < n; ++i) {
+      const double re = w2 - w[i] * w[i], im = w[i] * ck + loss;
+      const double s = p2 / (re * re + im * im);
+      r[i] += s * re;
+      im_q[i] += -s * im;
+    }
+  }
+  for (std::size_t i = 0; i < n; ++i) y[i] = cd(0.0, w[i]) * cd(r[i], im_q[i]);
+}
+
 namespace {
 // The catalogue's entries of each circuit/DAQ stage, found once (this is the
 // fits' inner loop: a few entries, no search).

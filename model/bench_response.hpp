@@ -53,6 +53,12 @@ std::complex<double> port_capacitance(const ModalPortModel& port, const EffectSe
 // (1.1e-3 on the weakly coupled ones with 11 % electrical stiffness).
 std::complex<double> tube_admittance(const ModalPortModel& port, const RayleighDamping& d,
                                      const EffectSet& fx, double omega, double elastic_loss = 0.0);
+// The same at every ω of `omega` (each > 0) into y (y.size() ≥ omega.size()):
+// the same operations in the same order for each ω, bit-identical, but with
+// the modes' loop outside so that the frequencies' loop vectorises (the
+// output-error fit's inner loop, issue 43).
+void tube_admittances(const ModalPortModel& port, const RayleighDamping& d, const EffectSet& fx,
+                      std::span<const double> omega, double elastic_loss, std::span<std::complex<double>> y);
 
 // H'(ω) = v2/v1 as the DAQ records it (the divider, then channel 2's gain and
 // skew), from the tube's admittance and the circuit/DAQ effects: what the

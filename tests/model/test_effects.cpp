@@ -104,3 +104,29 @@ TEST(EffectTable, NamesListEveryEffect) {
   const std::string wrapped = effect_names(4);
   EXPECT_NE(wrapped.find(",\n"), std::string::npos);
 }
+
+// tube_admittances (the fits' batched form) is tube_admittance at each ω, to
+// the bit: the same operations per frequency, only the loops swapped.
+TEST(BenchResponse, BatchedAdmittancesEqualThePointwiseOnes) {
+  ModalPortModel port;
+  port.c_clamped = 6.1e-9;
+  port.c_residual = 2.3e-10;
+  port.eps_t_over_s = 1.7;
+  port.modes = {{2 * M_PI * 48e3, 2.1e-2, 9.0e10, true}, {2 * M_PI * 87e3, 7.5e-3, 3.1e11, true},
+                {2 * M_PI * 131e3, 1.2e-3, 6.8e11, true}};
+  const RayleighDamping d{15.0, 2.2e-9};
+  std::vector<double> w;
+  for (int k = 1; k <= 257; ++k) w.push_back(2 * M_PI * 800.0 * k);
+  for (const double loss : {0.0, 3e-3}) {
+    EffectSet fx;
+    fx.mechanical_damping = 1.5e-3;
+    fx.dielectric_loss = loss;
+    std::vector<cd> y(w.size());
+    tube_admittances(port, d, fx, w, 2e-9, y);
+    for (std::size_t i = 0; i < w.size(); ++i) {
+      const cd one = tube_admittance(port, d, fx, w[i], 2e-9);
+      EXPECT_EQ(y[i].real(), one.real()) << i;
+      EXPECT_EQ(y[i].imag(), one.imag()) << i;
+    }
+  }
+}

@@ -149,11 +149,16 @@ std::vector<cd> Problem::transfer_of(const model::ModalPortModel& port, double b
                                      const model::EffectSet& fx) const {
   const model::RayleighDamping damp{0.0, beta};
   std::vector<cd> t(kmax_ + 1);
-  for (std::size_t k = 0; k <= kmax_; ++k) {
-    const double w = kTwoPi * fs_ * double(k) / double(nfft_);
-    const cd yt = w > 0 ? model::tube_admittance(port, damp, fx, w, eta) : cd(0.0, 0.0);
-    t[k] = model::recorded_transfer(yt, fx, r1_, w);
-  }
+  // The bins' ω (bin 0, ω = 0: no admittance), their admittances in one pass
+  // (model::tube_admittances), then the circuit per bin.
+  thread_local std::vector<double> w;
+  w.resize(kmax_ + 1);
+  for (std::size_t k = 0; k <= kmax_; ++k) w[k] = kTwoPi * fs_ * double(k) / double(nfft_);
+  std::size_t first = 0;
+  while (first <= kmax_ && !(w[first] > 0)) t[first++] = cd(0.0, 0.0);
+  model::tube_admittances(port, damp, fx, std::span<const double>(w).subspan(first), eta,
+                          std::span<cd>(t).subspan(first));
+  for (std::size_t k = 0; k <= kmax_; ++k) t[k] = model::recorded_transfer(t[k], fx, r1_, w[k]);
   return t;
 }
 
