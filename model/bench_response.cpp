@@ -87,34 +87,57 @@ bool present(const EffectInfo& e, const EffectSet& fx) {
 }
 }  // namespace
 
-cd recorded_transfer(cd y_tube, const EffectSet& fx, double r1_nominal_ohm, double omega) {
-  if (!(r1_nominal_ohm > 0)) throw std::invalid_argument("recorded_transfer: R1 must be positive");
+namespace {
+// The circuit/DAQ effects of fx, stage by stage (the catalogue's order; the
+// channel-2 factors from its last to its first: the order this product was
+// first written in, only the rounding depends on it).
+struct PresentEffects {
+  std::vector<const EffectInfo*> series, shunt, r1, daq;
+  explicit PresentEffects(const EffectSet& fx) {
+    for (const EffectInfo* e : entries(EffectStage::series))
+      if (present(*e, fx)) series.push_back(e);
+    for (const EffectInfo* e : entries(EffectStage::shunt))
+      if (present(*e, fx)) shunt.push_back(e);
+    for (const EffectInfo* e : entries(EffectStage::r1))
+      if (present(*e, fx)) r1.push_back(e);
+    const auto& d = entries(EffectStage::channel2);
+    for (auto it = d.rbegin(); it != d.rend(); ++it)
+      if (present(**it, fx)) daq.push_back(*it);
+  }
+};
+
+cd transfer_with(const PresentEffects& pe, cd y_tube, const EffectSet& fx, double r1_nominal_ohm, double omega) {
   // Each circuit and DAQ effect by its catalogue term (model/effects.hpp):
   // Z_a = 1/Y_t + ΣZ_series, Y_n = 1/Z_a + ΣY_shunt, H = 1/(1 + R1·Πf_r1·Y_n),
   // H' = H·Πf_channel2.
   cd y = y_tube;
-  for (const EffectInfo* e : entries(EffectStage::series))
-    if (present(*e, fx))
-      if (const cd z = e->term(fx.*(e->field), omega); z != 0.0)
-        y = z.imag() == 0.0 ? numerics::divide(y, 1.0 + z.real() * y)  // a real term: a real product
-                            : numerics::divide(y, 1.0 + z * y);
-  for (const EffectInfo* e : entries(EffectStage::shunt))
-    if (present(*e, fx)) y += e->term(fx.*(e->field), omega);
+  for (const EffectInfo* e : pe.series)
+    if (const cd z = e->term(fx.*(e->field), omega); z != 0.0)
+      y = z.imag() == 0.0 ? numerics::divide(y, 1.0 + z.real() * y)  // a real term: a real product
+                          : numerics::divide(y, 1.0 + z * y);
+  for (const EffectInfo* e : pe.shunt) y += e->term(fx.*(e->field), omega);
   double r1 = r1_nominal_ohm;
-  for (const EffectInfo* e : entries(EffectStage::r1))
-    if (present(*e, fx)) r1 *= e->term(fx.*(e->field), omega).real();
+  for (const EffectInfo* e : pe.r1) r1 *= e->term(fx.*(e->field), omega).real();
   cd h = numerics::reciprocal(1.0 + r1 * y);
-  // The channel-2 factors from the catalogue's last to its first (the gain
-  // before the skew's phase, the order this product was first written in:
-  // only the rounding depends on it).
-  const auto& daq = entries(EffectStage::channel2);
-  for (auto it = daq.rbegin(); it != daq.rend(); ++it)
-    if (present(**it, fx)) {
-      const cd f = (*it)->term(fx.*((*it)->field), omega);
-      if (f.imag() == 0.0) h *= f.real();  // (the same numbers, without a complex product's NaN checks)
-      else h *= f;
-    }
+  for (const EffectInfo* e : pe.daq) {
+    const cd f = e->term(fx.*(e->field), omega);
+    if (f.imag() == 0.0) h *= f.real();  // (the same numbers, without a complex product's NaN checks)
+    else h *= f;
+  }
   return h;
+}
+}  // namespace
+
+cd recorded_transfer(cd y_tube, const EffectSet& fx, double r1_nominal_ohm, double omega) {
+  if (!(r1_nominal_ohm > 0)) throw std::invalid_argument("recorded_transfer: R1 must be positive");
+  return transfer_with(PresentEffects(fx), y_tube, fx, r1_nominal_ohm, omega);
+}
+
+void recorded_transfers(std::span<cd> y, const EffectSet& fx, double r1_nominal_ohm, std::span<const double> omega) {
+  if (!(r1_nominal_ohm > 0)) throw std::invalid_argument("recorded_transfers: R1 must be positive");
+  if (y.size() != omega.size()) throw std::invalid_argument("recorded_transfers: y and omega differ in size");
+  const PresentEffects pe(fx);
+  for (std::size_t i = 0; i < y.size(); ++i) y[i] = transfer_with(pe, y[i], fx, r1_nominal_ohm, omega[i]);
 }
 
 cd reported_impedance(cd y_tube, const EffectSet& fx, double r1_nominal_ohm, double omega) {

@@ -65,6 +65,11 @@ void tube_admittances(const ModalPortModel& port, const RayleighDamping& d, cons
 // output-error fit (update/output_error.hpp) applies to the recorded v1.
 std::complex<double> recorded_transfer(std::complex<double> y_tube, const EffectSet& fx,
                                        double r1_nominal_ohm, double omega);
+// The same for every ω of `omega`, in place (y: the tube's admittances in,
+// H' out; y.size() == omega.size()): the effects present found once, not per
+// frequency; bit-identical to recorded_transfer at each ω.
+void recorded_transfers(std::span<std::complex<double>> y, const EffectSet& fx, double r1_nominal_ohm,
+                        std::span<const double> omega);
 
 // Z_reported(ω) from the tube's admittance (any source) and the circuit/DAQ effects.
 std::complex<double> reported_impedance(std::complex<double> y_tube, const EffectSet& fx,

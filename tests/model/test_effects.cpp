@@ -130,3 +130,30 @@ TEST(BenchResponse, BatchedAdmittancesEqualThePointwiseOnes) {
     }
   }
 }
+
+// recorded_transfers (the effects present found once) is recorded_transfer at
+// each ω, to the bit, with every stage's effects present and with none.
+TEST(BenchResponse, BatchedTransfersEqualThePointwiseOnes) {
+  EffectSet all;
+  all.series_resistance_ohm = 3.5;
+  all.parallel_capacitance_f = 4.7e-11;
+  all.daq_input_resistance_ohm = 1e6;
+  all.channel_skew_s = 2e-8;
+  all.channel_gain = 4e-3;
+  all.r1_tolerance = -2e-3;
+  for (const EffectSet& fx : {EffectSet{}, all}) {
+    std::vector<double> w;
+    std::vector<cd> y;
+    for (int k = 0; k <= 300; ++k) {
+      w.push_back(2 * M_PI * 700.0 * k);
+      y.emplace_back(1e-7 * k, 2e-4 * std::sin(0.05 * k) + 1e-6 * k);
+    }
+    std::vector<cd> t = y;
+    recorded_transfers(t, fx, 1000.0, w);
+    for (std::size_t i = 0; i < w.size(); ++i) {
+      const cd one = recorded_transfer(y[i], fx, 1000.0, w[i]);
+      EXPECT_EQ(t[i].real(), one.real()) << i;
+      EXPECT_EQ(t[i].imag(), one.imag()) << i;
+    }
+  }
+}

@@ -158,7 +158,7 @@ std::vector<cd> Problem::transfer_of(const model::ModalPortModel& port, double b
   while (first <= kmax_ && !(w[first] > 0)) t[first++] = cd(0.0, 0.0);
   model::tube_admittances(port, damp, fx, std::span<const double>(w).subspan(first), eta,
                           std::span<cd>(t).subspan(first));
-  for (std::size_t k = 0; k <= kmax_; ++k) t[k] = model::recorded_transfer(t[k], fx, r1_, w[k]);
+  model::recorded_transfers(t, fx, r1_, w);
   return t;
 }
 
