@@ -24,79 +24,15 @@ void CoupledFactor::constrain(int dof, SpMat& m) const {
   val[diagonal] = 1.0;
 }
 
-void CoupledFactor::analyse() {
-  // AMD on the pattern (values do not matter), as SimplicialLDLT<AMD> finds it.
-  Eigen::SimplicialLDLT<SpMat, Eigen::Lower, Eigen::AMDOrdering<int>> amd;
-  amd.analyzePattern(a_);
-  perm_ = amd.permutationP();
-  perm_inv_ = amd.permutationPinv();
-  // The permuted upper triangle by Eigen's own assignment (its entries in the
-  // order SimplicialLDLT<AMD> builds them), each value the 1-based position of
-  // its source in a_ (exact in a double): the gather map.
-  SpMat idx = a_;
-  for (Eigen::Index k = 0; k < idx.nonZeros(); ++k) idx.valuePtr()[k] = static_cast<double>(k + 1);
-  ap_.resize(n_, n_);
-  ap_.selfadjointView<Eigen::Upper>() = idx.selfadjointView<Eigen::Lower>().twistedBy(perm_);
-  ap_.makeCompressed();
-  const auto nnz = static_cast<std::size_t>(ap_.nonZeros());
-  src_.resize(nnz);
-  // a_'s entry positions → their (row, column), to list each DOF's entries.
-  std::vector<int> row_of(static_cast<std::size_t>(a_.nonZeros())), col_of(row_of.size());
-  for (int c = 0; c < a_.outerSize(); ++c)
-    for (int p = a_.outerIndexPtr()[c]; p < a_.outerIndexPtr()[c + 1]; ++p) {
-      row_of[static_cast<std::size_t>(p)] = a_.innerIndexPtr()[p];
-      col_of[static_cast<std::size_t>(p)] = c;
-    }
-  std::vector<int> count(static_cast<std::size_t>(n_) + 1, 0);
-  diag_.assign(static_cast<std::size_t>(n_), -1);
-  for (std::size_t k = 0; k < nnz; ++k) {
-    const int s = static_cast<int>(ap_.valuePtr()[k]) - 1;
-    if (s < 0 || s >= a_.nonZeros()) throw std::logic_error("CoupledFactor: permutation map out of range");
-    src_[k] = s;
-    const int r = row_of[static_cast<std::size_t>(s)], c = col_of[static_cast<std::size_t>(s)];
-    ++count[static_cast<std::size_t>(r) + 1];
-    if (c != r) ++count[static_cast<std::size_t>(c) + 1];
-    else diag_[static_cast<std::size_t>(r)] = static_cast<int>(k);
-  }
-  for (int d = 0; d < n_; ++d) {
-    if (diag_[static_cast<std::size_t>(d)] < 0)
-      throw std::logic_error("CoupledFactor: the pattern has no diagonal entry for a DOF");
-    count[static_cast<std::size_t>(d) + 1] += count[static_cast<std::size_t>(d)];
-  }
-  touch_begin_ = count;
-  touch_.resize(static_cast<std::size_t>(count.back()));
-  for (std::size_t k = 0; k < nnz; ++k) {
-    const int r = row_of[static_cast<std::size_t>(src_[k])], c = col_of[static_cast<std::size_t>(src_[k])];
-    touch_[static_cast<std::size_t>(count[static_cast<std::size_t>(r)]++)] = static_cast<int>(k);
-    if (c != r) touch_[static_cast<std::size_t>(count[static_cast<std::size_t>(c)]++)] = static_cast<int>(k);
-  }
-  ldlt_.analyzePattern(ap_);  // natural order, upper: the factorisation reads ap_ itself
-  analysed_ = true;
-}
-
 bool CoupledFactor::factorize(const MaterialWeights& w, double sigma, Electrodes electrodes,
                               std::span<const int> clamped, double end_mass_fraction) {
   model_->system().combine(w, sigma, a_, end_mass_fraction);
-  if (!analysed_) analyse();
-  const double* av = a_.valuePtr();
-  double* pv = ap_.valuePtr();
-  for (std::size_t k = 0; k < src_.size(); ++k) pv[k] = av[src_[k]];
-  // The constraints as constrain() applies them to A (row and column zero,
-  // diagonal one), on the permuted triangle's entries of each DOF.
-  auto fix = [&](int dof) {
-    if (dof < 0 || dof >= n_) throw std::invalid_argument("CoupledFactor: constrained DOF out of range");
-    const auto d = static_cast<std::size_t>(dof);
-    for (int t = touch_begin_[d]; t < touch_begin_[d + 1]; ++t) pv[touch_[static_cast<std::size_t>(t)]] = 0.0;
-    pv[diag_[d]] = 1.0;
-  };
-  if (electrodes == Electrodes::short_circuit) fix(model_->dofs().electrode());
-  for (int d : clamped) fix(d);
-  ldlt_.factorize(ap_);
-  use_lu_ = ldlt_.info() != Eigen::Success;
-  if (!use_lu_) inv_d_ = ldlt_.vectorD().cwiseInverse();
+  if (!sky_.analysed()) sky_.analyse(a_);
+  const int electrode = electrodes == Electrodes::short_circuit ? model_->dofs().electrode() : -1;
+  use_lu_ = !sky_.factorize(a_.valuePtr(), clamped, electrode);
   if (use_lu_) {
     ac_ = a_;
-    if (electrodes == Electrodes::short_circuit) constrain(model_->dofs().electrode(), ac_);
+    if (electrode >= 0) constrain(electrode, ac_);
     for (int d : clamped) constrain(d, ac_);
     if (!lu_) {
       lu_ = std::make_unique<Eigen::SparseLU<SpMat>>();
@@ -113,34 +49,8 @@ void CoupledFactor::solve(const Eigen::VectorXd& rhs, Eigen::VectorXd& x) const 
     x = lu_->solve(rhs);
     return;
   }
-  // SimplicialLDLT<AMD>::solve's steps — P b, L⁻¹, D⁻¹, L⁻ᵀ, P⁻¹ — on the
-  // factor's arrays (L unit lower, its strict part stored by columns): the
-  // Lanczos op's solve is a third of a port model, and Eigen's generic sparse
-  // triangular solve pays an iterator and a zero test per column.
-  const SpMat& l = ldlt_.matrixL().nestedExpression();
-  const int* outer = l.outerIndexPtr();
-  const int* inner = l.innerIndexPtr();
-  const double* val = l.valuePtr();
-  const int* p = perm_.indices().data();
-  const double* b = rhs.data();
   x.resize(n_);
-  double* y = x.data();
-  thread_local std::vector<double> work;  // (a factor may be shared by threads: reduced_port's)
-  work.resize(static_cast<std::size_t>(n_));
-  double* z = work.data();
-  for (int i = 0; i < n_; ++i) z[p[i]] = b[i];
-  for (int j = 0; j < n_; ++j) {
-    const double zj = z[j];
-    for (int q = outer[j]; q < outer[j + 1]; ++q) z[inner[q]] -= val[q] * zj;
-  }
-  const double* inv_d = inv_d_.data();
-  for (int j = 0; j < n_; ++j) z[j] *= inv_d[j];
-  for (int j = n_ - 1; j >= 0; --j) {
-    double s = z[j];
-    for (int q = outer[j]; q < outer[j + 1]; ++q) s -= val[q] * z[inner[q]];
-    z[j] = s;
-  }
-  for (int i = 0; i < n_; ++i) y[i] = z[p[i]];
+  sky_.solve(rhs.data(), x.data());
 }
 
 double CoupledFactor::charge_for_unit_voltage(const MaterialWeights& w,

@@ -10,22 +10,17 @@
 //
 // A is symmetric indefinite (K_ΦΦ < 0). For σ < 0 (or σ = 0 with the rigid
 // z-translation clamped) it is quasi-definite, for which an LDLᵀ exists for
-// every symmetric ordering; SimplicialLDLT is used, with SparseLU as fallback.
-//
-// The AMD ordering is found once; after it every factorisation gathers the
-// combined values straight into the permuted upper triangle the simplicial
-// factorisation reads (a map built once with Eigen's own permutation, so the
-// entries and their order are Eigen's), applies the constraints there, and
-// factorises it in natural order: no copy of the whole matrix, no constraint
-// pass over it, no permutation per factorisation (issue 43; the factor and
-// every solve are bit-identical to SimplicialLDLT<AMD> on the constrained
-// matrix).
+// every symmetric ordering; an envelope LDLᵀ (model/skyline_ldlt.hpp, its
+// reverse Cuthill–McKee ordering found once per mesh) is used, with SparseLU
+// as fallback. Each factorisation scatters the combined values into the
+// envelope and applies the constraints there (no copy of the whole matrix).
 #include <Eigen/SparseCholesky>
 #include <Eigen/SparseLU>
 #include <memory>
 #include <span>
 #include <vector>
 
+#include "model/skyline_ldlt.hpp"
 #include "model/tube_model.hpp"
 
 namespace piezo::model {
@@ -59,23 +54,16 @@ class CoupledFactor {
 
  private:
   void constrain(int dof, SpMat& m) const;
-  // The AMD permutation, the permuted upper triangle's map and the natural-order analysis.
-  void analyse();
   const TubeModel* model_;
   int n_ = 0;
   SpMat a_, ac_;  // ac_: the constrained matrix, made only for the LU fallback
-  Eigen::PermutationMatrix<Eigen::Dynamic, Eigen::Dynamic, int> perm_, perm_inv_;  // AMD's P and P⁻¹
-  SpMat ap_;                 // P·A_c·Pᵀ, upper triangle (Eigen's entry order)
-  std::vector<int> src_;     // ap_'s entry k holds a_'s value src_[k]
-  std::vector<int> touch_begin_, touch_, diag_;  // per DOF: ap_'s entries in its row and column, its diagonal
-  Eigen::SimplicialLDLT<SpMat, Eigen::Upper, Eigen::NaturalOrdering<int>> ldlt_;
-  Eigen::VectorXd inv_d_;              // 1/D of the factor
+  SkylineLdlt sky_;
   std::unique_ptr<Eigen::SparseLU<SpMat>> lu_;  // fallback, analysed lazily
   // The interior potentials' block K_ii (charge_for_unit_voltage_u_clamped).
   SpMat kii_;
   std::vector<int> kii_src_;  // kii_'s entry k holds a_'s value kii_src_[k]
   Eigen::SimplicialLDLT<SpMat, Eigen::Lower, Eigen::AMDOrdering<int>> kii_ldlt_;
-  bool analysed_ = false, use_lu_ = false;
+  bool use_lu_ = false;
 };
 
 }  // namespace piezo::model

@@ -22,9 +22,11 @@ const std::vector<std::string_view>& internal_function_names() {
       "open_bench", "open_transport", "open_usbtmc", "parasitic_branch", "parse_disturbances",
       "parse_ohm_at_hz", "phase_slope_delay", "predict_output_error", "prepare_divider", "probe_capture",
       "prony_ss", "rayleigh_fit", "rayleigh_from_damping", "rayleigh_from_two_modes", "read_impedance_file",
-      "read_impedance_table", "recorded_transfer", "render_raster", "render_svg", "reported_impedance",
+      "read_impedance_table", "recorded_transfer", "recorded_transfers", "render_raster", "render_svg",
+      "reported_impedance",
       "run_measurement", "scan_effects", "select_order", "select_shard", "sensitivity_params", "solve_tsvd",
-      "stabilization_chart", "to_d_form", "to_e_form", "to_e_form_unchecked", "torsion_frequency_hz", "update_cmcm",
+      "stabilization_chart", "to_d_form", "to_e_form", "to_e_form_unchecked", "torsion_frequency_hz",
+      "tube_admittances", "update_cmcm",
       "update_lm", "vector_fit", "write_impedance_csv", "write_touchstone_s1p", "xcorr_delay"};
   return names;
 }

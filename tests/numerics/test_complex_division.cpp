@@ -26,7 +26,8 @@ TEST(ComplexDivision, AgreesWithStdOverManyMagnitudes) {
   std::mt19937_64 rng(7);
   std::uniform_real_distribution<double> part(-1.0, 1.0), expo(-150.0, 150.0);
   for (int i = 0; i < 20000; ++i) {
-    const cd a(part(rng) * std::pow(10.0, expo(rng) / 5), part(rng) * std::pow(10.0, expo(rng) / 5));
+    const cd a(part(rng) * std::pow(10.0, expo(rng) / 5),
+               part(rng) * std::pow(10.0, expo(rng) / 5));
     const cd b(part(rng) * std::pow(10.0, expo(rng)), part(rng) * std::pow(10.0, expo(rng)));
     expect_close(divide(a, b), a / b);
   }
