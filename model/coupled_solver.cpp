@@ -24,9 +24,20 @@ void CoupledFactor::constrain(int dof, SpMat& m) const {
   val[diagonal] = 1.0;
 }
 
+void CoupledFactor::combine(const MaterialWeights& w, double sigma, double end_mass_fraction) {
+  // (σ = 0: the mass does not enter, whatever its loading.)
+  const double f = sigma == 0.0 ? 0.0 : end_mass_fraction;
+  if (combined_ && w == combined_w_ && sigma == combined_sigma_ && f == combined_f_) return;
+  model_->system().combine(w, sigma, a_, f);
+  combined_ = true;
+  combined_w_ = w;
+  combined_sigma_ = sigma;
+  combined_f_ = f;
+}
+
 bool CoupledFactor::factorize(const MaterialWeights& w, double sigma, Electrodes electrodes,
                               std::span<const int> clamped, double end_mass_fraction) {
-  model_->system().combine(w, sigma, a_, end_mass_fraction);
+  combine(w, sigma, end_mass_fraction);
   if (!sky_.analysed()) sky_.analyse(a_);
   const int electrode = electrodes == Electrodes::short_circuit ? model_->dofs().electrode() : -1;
   use_lu_ = !sky_.factorize(a_.valuePtr(), clamped, electrode);
@@ -71,7 +82,7 @@ double CoupledFactor::charge_for_unit_voltage(const MaterialWeights& w,
 }
 
 double CoupledFactor::charge_for_unit_voltage_u_clamped(const MaterialWeights& w, Eigen::VectorXd* x_out) {
-  model_->system().combine(w, 0.0, a_);
+  combine(w, 0.0, 0.0);
   const int nu = model_->n_u(), v = model_->dofs().electrode(), ni = n_ - nu - 1;
   if (v != n_ - 1 || ni < 1) throw std::logic_error("CoupledFactor: expected [U; Φ_int; V] DOF order");
   if (kii_src_.empty()) {  // the block's pattern and its map into a_, once

@@ -54,6 +54,12 @@ class CoupledFactor {
 
  private:
   void constrain(int dof, SpMat& m) const;
+  // a_ ← K(w) − σ(M + f·ΔM), unless a_ already holds it (a port model's
+  // static solve and clamped capacitance share σ = 0).
+  void combine(const MaterialWeights& w, double sigma, double end_mass_fraction);
+  bool combined_ = false;
+  MaterialWeights combined_w_{};
+  double combined_sigma_ = 0, combined_f_ = 0;
   const TubeModel* model_;
   int n_ = 0;
   SpMat a_, ac_;  // ac_: the constrained matrix, made only for the LU fallback

@@ -191,6 +191,9 @@ const ModalSolver::MassFactor& ModalSolver::mass_factor(double f) {
       throw std::runtime_error("ModalSolver: the mass matrix is not positive definite (its Cholesky failed)");
     mf.l = llt.matrixL();
     mf.lt = mf.l.transpose();
+    for (Eigen::Index i = 0; i < mf.l.cols(); ++i)  // solve() reads each column's diagonal first
+      if (mf.l.outerIndexPtr()[i] == mf.l.outerIndexPtr()[i + 1] || mf.l.innerIndexPtr()[mf.l.outerIndexPtr()[i]] != i)
+        throw std::logic_error("ModalSolver: the mass factor's column has no leading diagonal entry");
     mf.p = llt.permutationP();
     mf.p_inv = llt.permutationPinv();
     mf.fraction = f;
@@ -276,8 +279,22 @@ ModalResult ModalSolver::solve(const PiezoMaterialE& material, Electrodes electr
   // μ = 1/(λ − σ) → λ; ψ → φ = Pᵀ L⁻ᵀ ψ (M(f)-orthonormal).
   const Eigen::VectorXd lambda = (sigma + eigs.eigenvalues().array().inverse()).matrix();
   Eigen::MatrixXd vecs = eigs.eigenvectors();
-  mf.lt.triangularView<Eigen::Upper>().solveInPlace(vecs);
-  vecs = mf.p_inv * vecs;
+  {
+    // Lᵀ X = Ψ for all modes at once, backwards through L's columns, each
+    // step an AXPY over the modes (X stored transposed: a DOF's modes
+    // contiguous) instead of one sparse triangular solve per mode.
+    Eigen::MatrixXd xt = vecs.transpose();
+    const int* outer = mf.l.outerIndexPtr();
+    const int* inner = mf.l.innerIndexPtr();
+    const double* val = mf.l.valuePtr();
+    for (int i = nu - 1; i >= 0; --i) {
+      auto xi = xt.col(i);
+      // Column i of L: its diagonal first, then rows below (sorted).
+      for (int q = outer[i] + 1; q < outer[i + 1]; ++q) xi -= val[q] * xt.col(inner[q]);
+      xi /= val[outer[i]];
+    }
+    vecs = mf.p_inv * xt.transpose();
+  }
   std::vector<int> order(lambda.size());
   std::iota(order.begin(), order.end(), 0);
   std::sort(order.begin(), order.end(), [&](int a, int b) { return lambda[a] < lambda[b]; });
@@ -296,7 +313,18 @@ ModalResult ModalSolver::solve(const PiezoMaterialE& material, Electrodes electr
   // K_UU − σ·M(f), and φ is M(f)-normalised, so κ = [φ;0]ᵀA[φ;0] + σ — all
   // modes' products in one pass over A's U columns.
   const SpMat& a_shifted = factor_.matrix();
-  const Eigen::MatrixXd a_phi = (a_shifted.leftCols(nu) * res.shapes).topRows(nu);
+  Eigen::VectorXd kappa = Eigen::VectorXd::Constant(res.shapes.cols(), sigma);
+  {
+    const Eigen::MatrixXd st = res.shapes.transpose();  // a DOF's modes contiguous
+    const int* outer = a_shifted.outerIndexPtr();
+    const int* inner = a_shifted.innerIndexPtr();
+    const double* val = a_shifted.valuePtr();
+    Eigen::VectorXd acc = Eigen::VectorXd::Zero(res.shapes.cols());
+    for (int j = 0; j < nu; ++j)
+      for (int q = outer[j]; q < outer[j + 1]; ++q)
+        if (const int i = inner[q]; i < nu) acc += val[q] * st.col(i).cwiseProduct(st.col(j));
+    kappa += acc;
+  }
 
   const double rigid_omega = 2.0 * M_PI * 1e-3 * opt.shift_hz;
   for (std::size_t j = 0; j < order.size(); ++j) {
@@ -315,7 +343,7 @@ ModalResult ModalSolver::solve(const PiezoMaterialE& material, Electrodes electr
                  : m.symmetric_fraction < 0.01 ? Symmetry::antisymmetric
                                                : Symmetry::mixed;
     m.participation = g.dot(phi);
-    m.kappa = phi.dot(a_phi.col(static_cast<Eigen::Index>(j))) + sigma;
+    m.kappa = kappa[static_cast<Eigen::Index>(j)];
     if (m.omega > rigid_omega)
       m.coupling = m.participation * m.participation / (m.omega * m.omega * res.c_clamped);
     const double threshold =
@@ -346,15 +374,21 @@ ModalPortModel ModalSolver::port_model(const PiezoMaterialE& material, const Mod
       return half_port_model(material, opt);
     }
   }
+  // The static solve first: the short-circuit solve's clamped capacitance
+  // then finds the same σ = 0 matrix combined (CoupledFactor::combine). The
+  // solve's own checks before it, so that bad input fails as it did.
+  check(material, "ModalSolver::solve");
+  opt.validate();
+  const SpMat& m_uu = mass(opt.end_mass_fraction);
+  Eigen::VectorXd us;
+  const double c_static = static_solve(material, m_uu, &us);
   ModalResult sc = solve(material, Electrodes::short_circuit, opt);
   ModalPortModel p;
   p.converged = sc.converged;
   p.c_clamped = sc.c_clamped;
   p.end_mass_fraction = opt.end_mass_fraction;
   if (material.eps_s33 > 0) p.eps_t_over_s = to_d_form(material).eps_t33 / material.eps_s33;
-  const SpMat& m_uu = mass(opt.end_mass_fraction);
-  Eigen::VectorXd us;
-  p.c_static = static_solve(material, m_uu, &us);
+  p.c_static = c_static;
   const double rigid_omega = 2.0 * M_PI * 1e-3 * opt.shift_hz;
   for (std::size_t j = 0; j < sc.modes.size(); ++j) {
     const Mode& m = sc.modes[j];
