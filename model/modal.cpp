@@ -21,14 +21,8 @@ namespace {
 class CondensedShiftInvert {
  public:
   using Scalar = double;
-  CondensedShiftInvert(const CoupledFactor& f, int n_u, double sigma, std::span<const int> clamped)
-      : f_(&f), n_u_(n_u), sigma_(sigma), clamped_(clamped), rhs_(Eigen::VectorXd::Zero(f.size())) {}
-  Eigen::Index rows() const { return n_u_; }
-  Eigen::Index cols() const { return n_u_; }
-  void set_shift(const Scalar& sigma) {
-    if (sigma != sigma_)
-      throw std::logic_error("CondensedShiftInvert: factorised for a different shift");
-  }
+  CondensedShiftInvert(const CoupledFactor& f, int n_u, std::span<const int> clamped)
+      : f_(&f), n_u_(n_u), clamped_(clamped), rhs_(Eigen::VectorXd::Zero(f.size())) {}
   void perform_op(const Scalar* x_in, Scalar* y_out) const {
     rhs_.head(n_u_) = Eigen::Map<const Eigen::VectorXd>(x_in, n_u_);
     for (int d : clamped_) rhs_[d] = 0.0;  // the solve returns the rhs at a constrained DOF
@@ -39,7 +33,6 @@ class CondensedShiftInvert {
  private:
   const CoupledFactor* f_;
   int n_u_;
-  double sigma_;
   std::span<const int> clamped_;
   mutable Eigen::VectorXd rhs_, sol_;
 };
@@ -262,7 +255,7 @@ ModalResult ModalSolver::solve(const PiezoMaterialE& material, Electrodes electr
     res.message = "singular shifted system";
     return res;
   }
-  CondensedShiftInvert inv(factor_, nu, sigma, plane);
+  CondensedShiftInvert inv(factor_, nu, plane);
   const MassFactor& mf = mass_factor(opt.end_mass_fraction);
   StandardShiftInvert op(inv, mf.l, mf.lt, mf.p, mf.p_inv);
   const int ncv = std::min<int>(nu, opt.ncv > 0 ? opt.ncv : std::max(2 * opt.n_modes + 1, opt.n_modes + 20));
