@@ -112,13 +112,22 @@ wait
 "$PB" replay-merge shard-0.h5 shard-1.h5 shard-2.h5 shard-3.h5 --out merged.h5
 
 cat >compare.py <<'EOF'
-# Order-independent comparison of two results files, wall-clock fields ignored.
+# Order-independent comparison of two results files, wall-clock fields ignored
+# (the keys scripts/strip-timing.py drops, at any depth: the work phases' and
+# the fits' seconds are per record too).
 import h5py, json, sys
+DROP = {"seconds", "elapsed_s", "wall_s", "cpu_s", "started", "finished", "timestamp", "created"}
+def strip(v):
+    if isinstance(v, dict):
+        return {k: strip(x) for k, x in v.items() if k not in DROP}
+    if isinstance(v, list):
+        return [strip(x) for x in v]
+    return v
 def content(path):
     out = {}
     with h5py.File(path, "r") as f:
         for k, g in f["results"].items():
-            j = json.loads(g["result_json"][()])
+            j = strip(json.loads(g["result_json"][()]))
             for s in j.get("result", {}).get("stages", []):
                 s.pop("note", None)  # stage notes carry timings
             curves = {}
