@@ -21,6 +21,7 @@ N=${2:-200}
 JOBS=${3:-2}
 WORK=${4:-$(mktemp -d /tmp/piezobench-replay-scale.XXXXXX)}
 PB=$(realpath "$BUILD/ui/piezobench")
+STRIP=$(realpath "$(dirname "$0")/strip-timing.py")  # the wall-clock keys the comparison drops
 PY=/usr/bin/python3  # Debian's, with h5py (scripts/install-deps.sh)
 lines() { if [ -f "$1" ]; then wc -l <"$1"; else echo 0; fi; }
 mkdir -p "$WORK"
@@ -114,15 +115,12 @@ wait
 cat >compare.py <<'EOF'
 # Order-independent comparison of two results files, wall-clock fields ignored
 # (the keys scripts/strip-timing.py drops, at any depth: the work phases' and
-# the fits' seconds are per record too).
-import h5py, json, sys
-DROP = {"seconds", "elapsed_s", "wall_s", "cpu_s", "started", "finished", "timestamp", "created"}
-def strip(v):
-    if isinstance(v, dict):
-        return {k: strip(x) for k, x in v.items() if k not in DROP}
-    if isinstance(v, list):
-        return [strip(x) for x in v]
-    return v
+# the fits' seconds are per record too). Usage: compare.py STRIP_TIMING A B
+import h5py, importlib.util, json, sys
+spec = importlib.util.spec_from_file_location("strip_timing", sys.argv[1])
+strip_timing = importlib.util.module_from_spec(spec)
+spec.loader.exec_module(strip_timing)
+strip = strip_timing.strip
 def content(path):
     out = {}
     with h5py.File(path, "r") as f:
@@ -136,12 +134,12 @@ def content(path):
                     curves[c.attrs["label"]] = (c["f_hz"][()].tobytes(), c["z_ohm"][()].tobytes())
             out[k] = (g.attrs["input_path"], g.attrs["sha256"], g.attrs["status"], json.dumps(j, sort_keys=True), curves)
     return out
-a, b = content(sys.argv[1]), content(sys.argv[2])
+a, b = content(sys.argv[2]), content(sys.argv[3])
 assert a.keys() == b.keys(), "different captures: %s" % (a.keys() ^ b.keys())
 diff = [k for k in a if a[k] != b[k]]
 assert not diff, "%d records differ, e.g. %s" % (len(diff), a[diff[0]][0])
-print("replay-scale: %s == %s (%d records, bit-identical numbers)" % (sys.argv[1], sys.argv[2], len(a)))
+print("replay-scale: %s == %s (%d records, bit-identical numbers)" % (sys.argv[2], sys.argv[3], len(a)))
 EOF
-"$PY" compare.py full.h5 merged.h5
-"$PY" compare.py full.h5 resumed.h5
+"$PY" compare.py "$STRIP" full.h5 merged.h5
+"$PY" compare.py "$STRIP" full.h5 resumed.h5
 echo "replay-scale: done ($WORK)"

@@ -9,10 +9,11 @@ def strip(v):
     if isinstance(v, list):
         return [strip(x) for x in v]
     return v
-text = sys.stdin.read()
-try:
-    print(json.dumps(strip(json.loads(text)), indent=1, sort_keys=True))
-except json.JSONDecodeError:
-    # a batch's lines come in completion order: sorted, they compare
-    lines = [json.dumps(strip(json.loads(l)), sort_keys=True) for l in text.splitlines() if l.strip()]
-    print("\n".join(sorted(lines)))
+if __name__ == "__main__":  # (replay-scale.sh's comparison imports DROP and strip)
+    text = sys.stdin.read()
+    try:
+        print(json.dumps(strip(json.loads(text)), indent=1, sort_keys=True))
+    except json.JSONDecodeError:
+        # a batch's lines come in completion order: sorted, they compare
+        lines = [json.dumps(strip(json.loads(l)), sort_keys=True) for l in text.splitlines() if l.strip()]
+        print("\n".join(sorted(lines)))
