@@ -21,8 +21,8 @@ std::mutex& planner_mutex() {
 }
 
 // The shared r2c/c2r plans of each size (made on first use, under the planner
-// lock, on scratch buffers from fftw_alloc: every RealFft's buffers come from
-// it too, so they have the alignment the plans assume). Kept for the process;
+// lock, on the first RealFft's buffers: every RealFft's buffers come from
+// fftw_alloc, so they have the alignment the plans assume). Kept for the process;
 // at most kMaxSharedSizes sizes (a batch of captures of many lengths plans the
 // rest per object, as before).
 constexpr std::size_t kMaxSharedSizes = 64;
@@ -50,28 +50,16 @@ RealFft::RealFft(std::size_t n) : n_(n) {
     fftw_free(c);
     throw std::bad_alloc();
   }
+  // Planned on this object's buffers (FFTW_ESTIMATE does not touch them);
+  // the plans never read them again (new-array execute only).
   auto& shared = shared_plans();
   std::pair<fftw_plan, fftw_plan> p;
   if (auto it = shared.find(n); it != shared.end()) {
     p = it->second;
-  } else if (shared.size() < kMaxSharedSizes) {
-    // Planned on scratch buffers (FFTW_ESTIMATE does not touch them) of the same allocator.
-    double* r = fftw_alloc_real(n);
-    fftw_complex* sc = fftw_alloc_complex(n / 2 + 1);
-    if (!r || !sc) {
-      fftw_free(r);
-      fftw_free(sc);
-      fftw_free(rbuf_);
-      fftw_free(c);
-      throw std::bad_alloc();
-    }
-    p = make_plans(n, r, sc);
-    fftw_free(r);
-    fftw_free(sc);
-    shared.emplace(n, p);
   } else {
     p = make_plans(n, rbuf_, c);
-    own_plans_ = true;
+    if (shared.size() < kMaxSharedSizes) shared.emplace(n, p);
+    else own_plans_ = true;
   }
   fwd_ = p.first;
   inv_ = p.second;

@@ -36,7 +36,7 @@ std::vector<int> rcm_order(const Eigen::SparseMatrix<double>& p, const std::vect
   };
   std::vector<int> best;
   long long best_env = std::numeric_limits<long long>::max();
-  std::vector<char> seen(static_cast<std::size_t>(n));
+  std::vector<char> seen;
   std::vector<int> order, nb;
   order.reserve(static_cast<std::size_t>(n));
   std::vector<int> starts;
@@ -48,9 +48,7 @@ std::vector<int> rcm_order(const Eigen::SparseMatrix<double>& p, const std::vect
   if (starts.size() > static_cast<std::size_t>(kMaxStarts))
     starts.resize(static_cast<std::size_t>(kMaxStarts));
   for (int start : starts) {
-    std::fill(seen.begin(), seen.end(), 0);
-    for (int i = 0; i < n; ++i)
-      seen[static_cast<std::size_t>(i)] = last[static_cast<std::size_t>(i)];
+    seen = last;  // the last DOFs are not walked
     order.clear();
     // Every component from its own lowest-degree DOF after the first.
     int s = start;
