@@ -28,6 +28,7 @@ void CoupledFactor::combine(const MaterialWeights& w, double sigma, double end_m
   // (σ = 0: the mass does not enter, whatever its loading.)
   const double f = sigma == 0.0 ? 0.0 : end_mass_fraction;
   if (combined_ && w == combined_w_ && sigma == combined_sigma_ && f == combined_f_) return;
+  factored_ = false;  // a_ changes under the factor
   model_->system().combine(w, sigma, a_, f);
   combined_ = true;
   combined_w_ = w;
@@ -40,6 +41,10 @@ bool CoupledFactor::factorize(const MaterialWeights& w, double sigma, Electrodes
   combine(w, sigma, end_mass_fraction);
   if (!sky_.analysed()) sky_.analyse(a_);
   const int electrode = electrodes == Electrodes::short_circuit ? model_->dofs().electrode() : -1;
+  if (factored_ && electrode == factored_electrode_ &&
+      std::equal(clamped.begin(), clamped.end(), factored_clamped_.begin(), factored_clamped_.end()))
+    return true;
+  factored_ = false;
   use_lu_ = !sky_.factorize(a_.valuePtr(), clamped, electrode);
   if (use_lu_) {
     ac_ = a_;
@@ -50,8 +55,11 @@ bool CoupledFactor::factorize(const MaterialWeights& w, double sigma, Electrodes
       lu_->analyzePattern(ac_);
     }
     lu_->factorize(ac_);
-    return lu_->info() == Eigen::Success;
+    if (lu_->info() != Eigen::Success) return false;
   }
+  factored_ = true;
+  factored_electrode_ = electrode;
+  factored_clamped_.assign(clamped.begin(), clamped.end());
   return true;
 }
 

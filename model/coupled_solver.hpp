@@ -34,7 +34,8 @@ class CoupledFactor {
   // Factorises K(w) − σ(M + f·ΔM) with the electrode grounded (short_circuit)
   // or free, and the DOFs in `clamped` fixed; f = end_mass_fraction (end-face
   // mass loading, model/end_mass.hpp). Returns false (status, not exception)
-  // if the matrix is numerically singular.
+  // if the matrix is numerically singular. The same matrix and conditions as
+  // the last successful call: nothing to do (the factor is kept).
   bool factorize(const MaterialWeights& w, double sigma, Electrodes electrodes,
                  std::span<const int> clamped = {}, double end_mass_fraction = 0.0);
   // x = A_c⁻¹ rhs (A_c the constrained matrix); rhs at constrained DOFs gives x there.
@@ -60,6 +61,12 @@ class CoupledFactor {
   bool combined_ = false;
   MaterialWeights combined_w_{};
   double combined_sigma_ = 0, combined_f_ = 0;
+  // What the factor holds: a_'s values (combine) with these DOFs constrained.
+  // A repeat (a port model's static solve, then its Lanczos at σ = 0 on a
+  // model without a rigid mode) reuses it.
+  bool factored_ = false;
+  int factored_electrode_ = -1;
+  std::vector<int> factored_clamped_;
   const TubeModel* model_;
   int n_ = 0;
   SpMat a_, ac_;  // ac_: the constrained matrix, made only for the LU fallback

@@ -249,8 +249,13 @@ ModalResult ModalSolver::solve(const PiezoMaterialE& material, Electrodes electr
   Eigen::VectorXd g;
   res.c_clamped = clamped_capacitance(material, &g);
 
-  const double sigma = -std::pow(2.0 * M_PI * opt.shift_hz, 2);
   const std::vector<int>& plane = model_->symmetry_plane_dofs();  // empty for the whole tube
+  // The whole tube's rigid axial translation needs a shift below it; the
+  // half (u_z = 0 on the mid-plane) has no rigid mode, so K itself is
+  // factorised (σ = 0): the static solve's factor, which a port model has
+  // just made (CoupledFactor keeps it). The shift's size against the first
+  // mode's λ (1 kHz against tens of kHz) hardly changes the Lanczos run.
+  const double sigma = plane.empty() ? -std::pow(2.0 * M_PI * opt.shift_hz, 2) : 0.0;
   if (!factor_.factorize(w, sigma, electrodes, plane, opt.end_mass_fraction)) {
     res.message = "singular shifted system";
     return res;

@@ -25,7 +25,8 @@ namespace piezo::model {
 struct ModalOptions {
   int n_modes = 10;
   // σ = −(2π·shift_hz)²: below the rigid-body mode, so the N lowest modes are
-  // the N largest eigenvalues of the shift-inverted operator.
+  // the N largest eigenvalues of the shift-inverted operator (the whole tube;
+  // the upper half has no rigid mode and is solved at σ = 0).
   double shift_hz = 1000.0;
   int ncv = 0;  // Lanczos basis size; 0 → max(2N + 1, N + 20) (capped at n_u)
   double tolerance = 1e-10;

@@ -15,7 +15,7 @@ namespace piezo::update::oe {
 
 Problem::Problem(model::ModalSolver& solver, const MaterialClass& cls, const Coordinates5& co,
                  const Averaged& rec, const OeData& data, double band_hz,
-                 const model::ModalOptions& modal)
+                 const model::ModalOptions& modal, const std::shared_ptr<OeRecordShare>& share)
     : solver_(solver), cls_(cls), co_(co), modal_(modal), r1_(data.circuit.r1_ohm),
       fs_(data.sample_rate_hz), band_hz_(band_hz), n_(rec.v1.size()),
       nfft_(dsp::good_fft_size(std::max<std::size_t>(4 * n_, 1u << 14))), fft_(nfft_) {
@@ -24,23 +24,40 @@ Problem::Problem(model::ModalSolver& solver, const MaterialClass& cls, const Coo
   fx_.daq_input_resistance_ohm = data.circuit.r_daq_ohm;
   fx_.channel_skew_s = data.v2_delay_s;
   fx_.mass_loading = modal_.end_mass_fraction;
-  const Eigen::VectorXd h = dsp::blackman_lowpass(fs_, band_hz);
-  if (static_cast<std::size_t>(h.size()) > nfft_ - n_) fail("record too short for the band");
   kmax_ = std::min<std::size_t>(fft_.bins() - 1,
                                 static_cast<std::size_t>(std::ceil(2.5 * band_hz * double(nfft_) / fs_)));
-  std::vector<cd> hl(fft_.bins()), v1(fft_.bins()), v2(fft_.bins());
-  fft_.forward(h.data(), static_cast<std::size_t>(h.size()), hl.data());
-  fft_.forward(rec.v1.data(), n_, v1.data());
-  fft_.forward(rec.v2.data(), n_, v2.data());
-  lv1_.resize(kmax_ + 1);
-  ly_.resize(kmax_ + 1);
-  l_.resize(kmax_ + 1);
-  for (std::size_t k = 0; k <= kmax_; ++k) {
-    l_[k] = hl[k];
-    lv1_[k] = hl[k] * v1[k];
-    ly_[k] = hl[k] * v2[k];
-  }
   decim_ = std::max<std::size_t>(1, static_cast<std::size_t>(fs_ / (2.0 * band_hz)));
+  const std::array<double, 5> shape{double(n_), fs_, double(nfft_), band_hz_, double(decim_)};
+  std::unique_lock<std::mutex> lock;
+  if (share) {
+    lock = std::unique_lock<std::mutex>(share->mutex);
+    const auto& sp = share->spectra;
+    if (sp && sp->shape == shape && sp->v1 == rec.v1 && sp->v2 == rec.v2) {
+      l_ = sp->l;
+      lv1_ = sp->lv1;
+      ly_ = sp->ly;
+    }
+  }
+  if (l_.empty()) {
+    const Eigen::VectorXd h = dsp::blackman_lowpass(fs_, band_hz);
+    if (static_cast<std::size_t>(h.size()) > nfft_ - n_) fail("record too short for the band");
+    std::vector<cd> hl(fft_.bins()), v1(fft_.bins()), v2(fft_.bins());
+    fft_.forward(h.data(), static_cast<std::size_t>(h.size()), hl.data());
+    fft_.forward(rec.v1.data(), n_, v1.data());
+    fft_.forward(rec.v2.data(), n_, v2.data());
+    lv1_.resize(kmax_ + 1);
+    ly_.resize(kmax_ + 1);
+    l_.resize(kmax_ + 1);
+    for (std::size_t k = 0; k <= kmax_; ++k) {
+      l_[k] = hl[k];
+      lv1_[k] = hl[k] * v1[k];
+      ly_[k] = hl[k] * v2[k];
+    }
+    if (share && !share->spectra)
+      share->spectra = std::make_shared<const OeRecordShare::Spectra>(
+          OeRecordShare::Spectra{shape, rec.v1, rec.v2, l_, lv1_, ly_});
+  }
+  if (lock.owns_lock()) lock.unlock();
   for (std::size_t i = 0; i < n_; i += decim_) idx_.push_back(i);
   spec_.assign(kmax_ + 1, cd(0.0, 0.0));
   dinv_.emplace(nfft_, kmax_, decim_, idx_.size());

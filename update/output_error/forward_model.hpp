@@ -41,6 +41,15 @@ struct OeRecordShare {
   std::mutex mutex;
   std::optional<std::array<double, 5>> shape;
   std::map<ColumnKey, Eigen::VectorXd> columns;
+  // The record's filtered spectra (Problem's constructor: its three forward
+  // FFTs of the padded record and the low-pass), made by the first problem
+  // that joins and copied by the others whose record and shape are the same.
+  struct Spectra {
+    std::array<double, 5> shape{};
+    std::vector<double> v1, v2;  // the record they are of (compared, not trusted)
+    std::vector<std::complex<double>> l, lv1, ly;
+  };
+  std::shared_ptr<const Spectra> spectra;
 };
 
 }  // namespace piezo::update
@@ -72,9 +81,12 @@ struct Coordinates5 {
 // The filtered, decimated output error of one parameter vector.
 class Problem {
  public:
+  // With `share` (predictions on one held-out record), the record's
+  // filtered spectra are taken from it when another problem made them from
+  // the same samples with the same shape, and left there otherwise.
   Problem(model::ModalSolver& solver, const MaterialClass& cls, const Coordinates5& co,
           const Averaged& rec, const OeData& data, double band_hz,
-          const model::ModalOptions& modal);
+          const model::ModalOptions& modal, const std::shared_ptr<OeRecordShare>& share = nullptr);
 
   std::size_t samples() const { return idx_.size(); }
   int evaluations() const { return evaluations_; }  // FE port models built

@@ -45,7 +45,7 @@ OePrediction predict_output_error(model::ModalSolver& solver, const MaterialClas
   if (rec.v1.size() < 256) fail("too short: " + std::to_string(rec.v1.size()) + " samples (need 256)");
   const Coordinates5 co{params, loss.model == OeDamping::complex_constants ? loss.eta : loss.beta_s,
                         loss.model};
-  Problem prob(solver, cls, co, rec, data, band_hz, opt.modal);
+  Problem prob(solver, cls, co, rec, data, band_hz, opt.modal, shared);
   prob.share_columns(shared);
   const Eigen::VectorXd x = Eigen::VectorXd::Zero(kParams);
   const auto t = prob.transfer(x, effects);
