@@ -78,7 +78,8 @@ std::complex<double> PronyImpedance::transform(Eigen::Index k, std::complex<doub
 
 std::complex<double> PronyImpedance::z(double f_hz) const {
   const std::complex<double> s(0.0, kTwoPi * f_hz);
-  return r1_ohm * transform(1, s) / (transform(0, s) - transform(1, s));
+  const std::complex<double> v2 = transform(1, s);
+  return r1_ohm * v2 / (transform(0, s) - v2);
 }
 
 std::complex<double> PronyImpedance::zero_or_pole(double f_hz, bool resonance) const {

@@ -2,7 +2,9 @@
 
 #include <algorithm>
 #include <cmath>
+#include <mutex>
 #include <optional>
+#include <utility>
 
 #include <stdexcept>
 
@@ -13,13 +15,44 @@
 
 namespace piezo::jobs {
 
+namespace {
+
+// The last geometry's tube and upper half this process built (CaptureModel::tube).
+struct SharedTube {
+  std::mutex mutex;
+  std::optional<model::TubeGeometry> geometry;
+  std::shared_ptr<const model::TubeModel> whole, half;
+};
+
+bool same(const model::TubeGeometry& a, const model::TubeGeometry& b) {
+  return a.inner_diameter_m == b.inner_diameter_m && a.outer_diameter_m == b.outer_diameter_m &&
+         a.length_m == b.length_m && a.density_kg_m3 == b.density_kg_m3;
+}
+
+std::pair<std::shared_ptr<const model::TubeModel>, std::shared_ptr<const model::TubeModel>> tube_of(
+    const model::TubeGeometry& g) {
+  static SharedTube shared;
+  std::lock_guard<std::mutex> lock(shared.mutex);
+  if (!shared.geometry || !same(*shared.geometry, g)) {
+    auto whole = std::make_shared<const model::TubeModel>(g);
+    std::shared_ptr<const model::TubeModel> half = whole->upper_half();
+    shared.whole = std::move(whole);
+    shared.half = std::move(half);
+    shared.geometry = g;
+  }
+  return {shared.whole, shared.half};
+}
+
+}  // namespace
+
 CaptureModel capture_model(const acq::Capture& cap, const std::string& material, bool isotropic) {
   CaptureModel m;
   m.nominal = model::resolve_material({material, isotropic, ""});
   model::TubeGeometry g = cap.setup.geometry();
   if (!cap.setup.density_kg_m3) g.density_kg_m3 = m.nominal.density_kg_m3;
-  m.tube = std::make_unique<model::TubeModel>(g);
-  m.solver = std::make_unique<model::ModalSolver>(*m.tube);
+  auto [whole, half] = tube_of(g);
+  m.tube = std::move(whole);
+  m.solver = std::make_unique<model::ModalSolver>(*m.tube, std::move(half));
   m.cls = isotropic ? update::MaterialClass::isotropic()
                     : update::MaterialClass::transversely_isotropic(m.nominal.d);
   m.p0 = model::isotropic_params(m.nominal.d);

@@ -20,7 +20,10 @@ namespace piezo::jobs {
 // the capture states none), the nominal material and the model class.
 struct CaptureModel {
   model::ResolvedMaterial nominal;
-  std::unique_ptr<model::TubeModel> tube;
+  // Immutable, and shared with the other captures of this process that have
+  // the same geometry (a lot of identical tubes in a batch: the whole tube and
+  // its upper half are assembled once per geometry, not per capture).
+  std::shared_ptr<const model::TubeModel> tube;
   std::unique_ptr<model::ModalSolver> solver;  // of *tube
   update::MaterialClass cls;
   update::TubeParams p0;  // the nominal material's four constants
