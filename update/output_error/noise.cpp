@@ -92,20 +92,12 @@ RecordNoise record_noise(Problem& prob, const Averaged& rec, const std::vector<c
   return out;
 }
 
-namespace {
-
-// u = L ∗ (T ∗ 0 − 1): the filtered error of a unit offset on v2 (out of line:
-// GCC 12 inlining it into OffsetWhitening reports a false free-nonheap-object).
-[[gnu::noinline]] Eigen::VectorXd unit_offset_response(Problem& prob, std::size_t n, const std::vector<cd>& t) {
-  const std::vector<double> zero(n, 0.0), one(n, 1.0);
-  return -prob.deviation(t, zero, one);
-}
-
-}  // namespace
-
 OffsetWhitening::OffsetWhitening(Problem& prob, const Averaged& rec,
                                  const std::vector<cd>& t_nominal, double sigma) {
-  u = unit_offset_response(prob, rec.v1.size(), t_nominal);
+  // u = L ∗ (T ∗ 0 − 1), the filtered error of a unit offset on v2: the
+  // baseline's P0 column (L ∗ 1, T·0 − (−1) being 1 exactly), which the
+  // problem keeps — and the predictions on one held-out record share.
+  u = baseline_columns(prob, rec, t_nominal, 0, 0.0, 0).col(0);
   uu = u.squaredNorm();
   if (rec.pretrigger >= 16 && rec.pretrigger < rec.v1.size()) {
     double s1 = 0, s2 = 0;  // the (averaged) record's idle noise: its mean was removed
