@@ -27,6 +27,7 @@ Problem::Problem(model::ModalSolver& solver, const MaterialClass& cls, const Coo
   kmax_ = std::min<std::size_t>(fft_.bins() - 1,
                                 static_cast<std::size_t>(std::ceil(2.5 * band_hz * double(nfft_) / fs_)));
   decim_ = std::max<std::size_t>(1, static_cast<std::size_t>(fs_ / (2.0 * band_hz)));
+  for (std::size_t i = 0; i < n_; i += decim_) idx_.push_back(i);
   const std::array<double, 5> shape{double(n_), fs_, double(nfft_), band_hz_, double(decim_)};
   std::unique_lock<std::mutex> lock;
   if (share) {
@@ -36,6 +37,7 @@ Problem::Problem(model::ModalSolver& solver, const MaterialClass& cls, const Coo
       l_ = sp->l;
       lv1_ = sp->lv1;
       ly_ = sp->ly;
+      dinv_.emplace(*sp->dinv);  // (its chirp and kernel; a buffer of its own)
     }
   }
   if (l_.empty()) {
@@ -53,14 +55,13 @@ Problem::Problem(model::ModalSolver& solver, const MaterialClass& cls, const Coo
       lv1_[k] = hl[k] * v1[k];
       ly_[k] = hl[k] * v2[k];
     }
+    dinv_.emplace(nfft_, kmax_, decim_, idx_.size());
     if (share && !share->spectra)
-      share->spectra = std::make_shared<const OeRecordShare::Spectra>(
-          OeRecordShare::Spectra{shape, rec.v1, rec.v2, l_, lv1_, ly_});
+      share->spectra = std::make_shared<const OeRecordShare::Spectra>(OeRecordShare::Spectra{
+          shape, rec.v1, rec.v2, l_, lv1_, ly_, std::make_shared<const dsp::DecimatedInverse>(*dinv_)});
   }
   if (lock.owns_lock()) lock.unlock();
-  for (std::size_t i = 0; i < n_; i += decim_) idx_.push_back(i);
   spec_.assign(kmax_ + 1, cd(0.0, 0.0));
-  dinv_.emplace(nfft_, kmax_, decim_, idx_.size());
   buf_.resize(idx_.size());
   cache_.reserve(kCache);
 }

@@ -48,6 +48,7 @@ struct OeRecordShare {
     std::array<double, 5> shape{};
     std::vector<double> v1, v2;  // the record they are of (compared, not trusted)
     std::vector<std::complex<double>> l, lv1, ly;
+    std::shared_ptr<const dsp::DecimatedInverse> dinv;  // (copied: its buffer is per problem)
   };
   std::shared_ptr<const Spectra> spectra;
 };
