@@ -1,6 +1,7 @@
 // model/skyline_ldlt: the envelope LDLᵀ of the coupled system against a dense
 // LU of the same constrained matrix, its envelope against the sparse minimum-
-// degree factor's fill, and its report of a zero pivot.
+// degree factor's fill, and its report of a zero pivot; CoupledFactor's kept
+// factor (model/coupled_solver.hpp) against a fresh one.
 #include "model/skyline_ldlt.hpp"
 
 #include <gtest/gtest.h>
@@ -10,6 +11,7 @@
 #include <random>
 #include <vector>
 
+#include "model/coupled_solver.hpp"
 #include "model/material.hpp"
 #include "model/material_presets.hpp"
 #include "model/tube_model.hpp"
@@ -91,3 +93,57 @@ TEST(SkylineLdlt, ReportsAZeroPivot) {
 }
 
 }  // namespace
+
+// CoupledFactor keeps its factor for a repeat of the same matrix and
+// conditions (a port model's static solve, then its Lanczos at σ = 0): after
+// any sequence of factorisations, a solve must be bit-equal to a fresh
+// factor's of the same matrix and conditions — a changed material, shift,
+// end mass, electrode or set of clamped DOFs is factorised again.
+TEST(CoupledFactor, KeepsItsFactorOnlyForTheSameMatrixAndConditions) {
+  TubeModel whole(TubeGeometry{}, MeshOptions{});
+  const auto half = whole.upper_half();
+  ASSERT_TRUE(half);
+  const std::vector<int>& plane = half->symmetry_plane_dofs();
+  const std::vector<int> more = {plane.front(), 0, 1};
+  PiezoMaterialE other = material();
+  other.c_e11 *= 1.0 + 1e-6;
+  struct Step {
+    const PiezoMaterialE* m;
+    double sigma;
+    Electrodes electrodes;
+    const std::vector<int>* clamped;
+    double mass;
+  };
+  const PiezoMaterialE base = material();
+  const double shift = -std::pow(2 * M_PI * 1000.0, 2);
+  const std::vector<Step> steps = {
+      {&base, 0.0, Electrodes::short_circuit, &plane, 0.0},
+      {&base, 0.0, Electrodes::short_circuit, &plane, 0.02},  // σ = 0: the mass does not enter (kept)
+      {&base, 0.0, Electrodes::short_circuit, &plane, 0.0},   // the same again (kept)
+      {&base, 0.0, Electrodes::open_circuit, &plane, 0.0},    // another electrode condition
+      {&base, 0.0, Electrodes::short_circuit, &more, 0.0},    // other clamped DOFs
+      {&base, 0.0, Electrodes::short_circuit, &plane, 0.0},
+      {&other, 0.0, Electrodes::short_circuit, &plane, 0.0},  // another material, 1e-6 away
+      {&other, shift, Electrodes::short_circuit, &plane, 0.02},
+      {&other, shift, Electrodes::short_circuit, &plane, 0.0},  // another end mass at σ ≠ 0
+      {&base, 0.0, Electrodes::short_circuit, &plane, 0.0},
+  };
+  CoupledFactor kept(*half);
+  std::mt19937 rng(5);
+  std::normal_distribution<double> g;
+  Eigen::VectorXd b(half->dofs().n_total());
+  for (Eigen::Index i = 0; i < b.size(); ++i) b[i] = g(rng);
+  for (std::size_t k = 0; k < steps.size(); ++k) {
+    const Step& st = steps[k];
+    const auto w = weights(*st.m);
+    ASSERT_TRUE(kept.factorize(w, st.sigma, st.electrodes, *st.clamped, st.mass)) << "step " << k;
+    CoupledFactor fresh(*half);
+    ASSERT_TRUE(fresh.factorize(w, st.sigma, st.electrodes, *st.clamped, st.mass)) << "step " << k;
+    Eigen::VectorXd rhs = b, xk, xf;
+    for (int d : *st.clamped) rhs[d] = 0.0;
+    kept.solve(rhs, xk);
+    fresh.solve(rhs, xf);
+    ASSERT_EQ(xk.size(), xf.size());
+    for (Eigen::Index i = 0; i < xk.size(); ++i) ASSERT_EQ(xk[i], xf[i]) << "step " << k << ", entry " << i;
+  }
+}
