@@ -363,6 +363,16 @@ ModalPortModel ModalSolver::half_port_model(const PiezoMaterialE& material, cons
 
 ModalPortModel ModalSolver::port_model(const PiezoMaterialE& material, const ModalOptions& opt,
                                        ModalResult* sc_result) {
+  // (A model with its shapes, sc_result, is solved: the memo keeps port models only.)
+  if (sc_result || !memo_ || memo_->tube() != model_) return solve_port_model(material, opt, sc_result);
+  if (auto p = memo_->find(material, opt, physical_checks_, memo_reader_)) return std::move(*p);
+  ModalPortModel p = solve_port_model(material, opt, nullptr);  // (throws as it did: nothing remembered)
+  memo_->insert(material, opt, physical_checks_, p, memo_reader_);
+  return p;
+}
+
+ModalPortModel ModalSolver::solve_port_model(const PiezoMaterialE& material, const ModalOptions& opt,
+                                             ModalResult* sc_result) {
   if (opt.mirror_symmetry && !sc_result && model_->extent() == TubeExtent::whole) {
     half_model();  // built on the first port model
     if (half_solver_) {

@@ -17,6 +17,7 @@
 #include <vector>
 
 #include "model/coupled_solver.hpp"
+#include "model/port_memo.hpp"
 #include "model/port_model.hpp"
 #include "model/tube_model.hpp"
 
@@ -127,8 +128,20 @@ class ModalSolver {
   // Short-circuit modes + C0 + C_static (+ residual mode) → the electrical port
   // model; with options.end_mass_fraction for a mass-loaded tube (C0 and
   // C_static do not depend on the mass; the modes and the residual mode do).
+  // With a memo of this solver's tube (set_memo), a model asked for before
+  // (by any solver sharing the memo) is taken from it, the same bits.
   ModalPortModel port_model(const PiezoMaterialE& material, const ModalOptions& options = {},
                             ModalResult* sc_result = nullptr);
+
+  // The port models of this tube remembered across solvers, stages and
+  // captures (model/port_memo.hpp); ignored if it is another tube's.
+  // `reader`: whose work the solves count as (PortModelMemo::new_reader()).
+  void set_memo(std::shared_ptr<PortModelMemo> memo, long reader = 0) {
+    memo_ = std::move(memo);
+    memo_reader_ = reader;
+  }
+  const std::shared_ptr<PortModelMemo>& memo() const { return memo_; }
+  long memo_reader() const { return memo_reader_; }
 
   // The vectors of the port model at `material` (options as port_model's:
   // the half's n_modes/2 + 1 modes), for a reduced port model; nullopt when
@@ -161,6 +174,8 @@ class ModalSolver {
   // M-orthogonal to the rigid mode for the given mass matrix.
   double static_solve(const PiezoMaterialE& material, const SpMat& mass, Eigen::VectorXd* u_static);
 
+  // port_model without the memo.
+  ModalPortModel solve_port_model(const PiezoMaterialE& material, const ModalOptions& opt, ModalResult* sc_result);
   // port_vectors on this solver's own model (the upper half).
   std::optional<PortVectors> own_port_vectors(const PiezoMaterialE& material, const ModalOptions& opt);
   // Port model of the upper half (TubeExtent::upper_half), scaled to the whole tube.
@@ -172,6 +187,8 @@ class ModalSolver {
   std::unique_ptr<ModalSolver> half_solver_;
   bool half_tried_ = false;
   bool physical_checks_ = true;
+  std::shared_ptr<PortModelMemo> memo_;
+  long memo_reader_ = 0;
   SpMat m_uu_, k_uu_;
   SpMat m_loaded_;
   double m_loaded_fraction_ = -1.0;

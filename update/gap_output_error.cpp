@@ -359,7 +359,8 @@ GapDiagnosis gap_from_output_error(const OeResult& r, const std::string& fit_des
       }
     };
     if (options.threads > 1 && n > 1) {
-      model::ModalSolver second(solver.model());
+      model::ModalSolver second(solver.model(), solver.half_model());
+      second.set_memo(solver.memo(), solver.memo_reader());  // (the same tube's port models)
       std::thread t([&] { work(second); });
       work(solver);
       t.join();

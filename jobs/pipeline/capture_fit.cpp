@@ -22,6 +22,7 @@ struct SharedTube {
   std::mutex mutex;
   std::optional<model::TubeGeometry> geometry;
   std::shared_ptr<const model::TubeModel> whole, half;
+  std::shared_ptr<model::PortModelMemo> memo;
 };
 
 bool same(const model::TubeGeometry& a, const model::TubeGeometry& b) {
@@ -29,18 +30,22 @@ bool same(const model::TubeGeometry& a, const model::TubeGeometry& b) {
          a.length_m == b.length_m && a.density_kg_m3 == b.density_kg_m3;
 }
 
-std::pair<std::shared_ptr<const model::TubeModel>, std::shared_ptr<const model::TubeModel>> tube_of(
-    const model::TubeGeometry& g) {
+struct TubeOf {
+  std::shared_ptr<const model::TubeModel> whole, half;
+  std::shared_ptr<model::PortModelMemo> memo;
+};
+TubeOf tube_of(const model::TubeGeometry& g) {
   static SharedTube shared;
   std::lock_guard<std::mutex> lock(shared.mutex);
   if (!shared.geometry || !same(*shared.geometry, g)) {
     auto whole = std::make_shared<const model::TubeModel>(g);
     std::shared_ptr<const model::TubeModel> half = whole->upper_half();
+    shared.memo = std::make_shared<model::PortModelMemo>(whole);
     shared.whole = std::move(whole);
     shared.half = std::move(half);
     shared.geometry = g;
   }
-  return {shared.whole, shared.half};
+  return {shared.whole, shared.half, shared.memo};
 }
 
 }  // namespace
@@ -50,9 +55,14 @@ CaptureModel capture_model(const acq::Capture& cap, const std::string& material,
   m.nominal = model::resolve_material({material, isotropic, ""});
   model::TubeGeometry g = cap.setup.geometry();
   if (!cap.setup.density_kg_m3) g.density_kg_m3 = m.nominal.density_kg_m3;
-  auto [whole, half] = tube_of(g);
+  auto [whole, half, memo] = tube_of(g);
   m.tube = std::move(whole);
   m.solver = std::make_unique<model::ModalSolver>(*m.tube, std::move(half));
+  // The port models of this process's captures of the tube (a lot's share the
+  // nominal model and the coarse grid's, a capture's stages its answers'):
+  // this capture's own reader of the memo, so that its work counts stay its
+  // own (model/port_memo.hpp).
+  m.solver->set_memo(std::move(memo), model::PortModelMemo::new_reader());
   m.cls = isotropic ? update::MaterialClass::isotropic()
                     : update::MaterialClass::transversely_isotropic(m.nominal.d);
   m.p0 = model::isotropic_params(m.nominal.d);

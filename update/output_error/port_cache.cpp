@@ -83,9 +83,11 @@ Problem::Problem(const Problem& o, model::ModalSolver& solver)
 
 model::ModalSolver& Problem::second_solver() {
   // (sharing the first solver's upper half: one model build less a fit)
-  if (!solver2_)
+  if (!solver2_) {
     solver2_ = std::make_unique<model::ModalSolver>(solver_.model(),
                                                     modal_.mirror_symmetry ? solver_.half_model() : nullptr);
+    solver2_->set_memo(solver_.memo(), solver_.memo_reader());  // (the same tube's port models)
+  }
   return *solver2_;
 }
 
