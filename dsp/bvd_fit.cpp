@@ -5,6 +5,7 @@
 #include <numbers>
 #include <stdexcept>
 
+#include "numerics/complex_division.hpp"
 #include "numerics/levenberg_marquardt.hpp"
 
 namespace piezo::dsp {
@@ -21,7 +22,8 @@ void check_range(const char* fn, const Eigen::VectorXd& f, Eigen::Index first, E
 
 cd BvdParams::motional_admittance(double f_hz) const {
   const cd s(0.0, kTwoPi * f_hz);
-  return 1.0 / (r1_ohm + s * l1_h + 1.0 / (s * c1_f));
+  // (numerics/complex_division.hpp: no libgcc call in the circuit fits' loop)
+  return numerics::reciprocal(r1_ohm + s * l1_h + numerics::reciprocal(s * c1_f));
 }
 
 cd BvdParams::admittance(double f_hz) const {
@@ -109,16 +111,16 @@ struct Model {
       const Eigen::Index k = first + i;
       const double w = kTwoPi * f[k];
       const cd s(0.0, w);
-      const cd ym = 1.0 / (p.r1_ohm + s * p.l1_h + 1.0 / (s * p.c1_f));
+      const cd ym = numerics::reciprocal(p.r1_ohm + s * p.l1_h + numerics::reciprocal(s * p.c1_f));
       const cd y = s * p.c0_f + ym + (yb.size() ? yb[k] : cd(0.0));
-      const cd zm = 1.0 / y;
+      const cd zm = numerics::reciprocal(y);
       const double sc = scale(k);
       const cd e = (zm - z[k]) / sc;
       r[2 * i] = e.real();
       r[2 * i + 1] = e.imag();
       if (!jac) continue;
       const cd ym2 = ym * ym;
-      const cd dy[4] = {-ym2 * p.r1_ohm, -ym2 * s * p.l1_h, ym2 / (s * p.c1_f), s * p.c0_f};
+      const cd dy[4] = {-ym2 * p.r1_ohm, -ym2 * s * p.l1_h, numerics::divide(ym2, s * p.c1_f), s * p.c0_f};
       for (int j = 0; j < 4; ++j) {
         const cd dz = -zm * zm * dy[j] / sc;  // dZ = −Z² dY
         (*jac)(2 * i, j) = dz.real();
@@ -199,7 +201,7 @@ BvdFit fit_bvd(const Eigen::VectorXd& f, const Eigen::VectorXcd& z, const Eigen:
   for (Eigen::Index i = 0; i < n; ++i) {
     const Eigen::Index k = first + i;
     const cd y = out.p.admittance(f[k]) + (y_background.size() ? y_background[k] : cd(0.0));
-    rel += std::norm((1.0 / y - z[k]) / z[k]);
+    rel += std::norm(numerics::divide(numerics::reciprocal(y) - z[k], z[k]));
   }
   out.rms_rel_residual = std::sqrt(rel / double(n));
   return out;

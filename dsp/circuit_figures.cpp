@@ -85,7 +85,7 @@ cd EquivalentCircuit::admittance_without_rs(double f_hz) const {
   return y;
 }
 
-cd EquivalentCircuit::impedance(double f_hz) const { return 1.0 / admittance_without_rs(f_hz) + rs_ohm; }
+cd EquivalentCircuit::impedance(double f_hz) const { return numerics::reciprocal(admittance_without_rs(f_hz)) + rs_ohm; }
 
 double EquivalentCircuit::lossless_susceptance(double f_hz) const {
   const double w = kTwoPi * f_hz;
@@ -213,7 +213,7 @@ CircuitModeFigures figures_of(const EquivalentCircuit& c, const Resonances& res,
     }
   }
   // Bandwidth Qm: the conductance peak near fs and its half-power points.
-  auto g = [&](double f) { return (1.0 / c.impedance(f)).real(); };
+  auto g = [&](double f) { return numerics::reciprocal(c.impedance(f)).real(); };
   const double fg = grid_min([&](double f) { return -g(f); }, a, fp);
   if (std::isfinite(fg)) {
     const double half = 0.5 * g(fg);
