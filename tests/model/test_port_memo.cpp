@@ -5,6 +5,7 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <cstring>
 #include <memory>
 #include <stdexcept>
@@ -44,6 +45,7 @@ void expect_same_bits(const ModalPortModel& a, const ModalPortModel& b) {
     EXPECT_TRUE(same(a.modes[i].omega, b.modes[i].omega)) << "mode " << i;
     EXPECT_TRUE(same(a.modes[i].participation, b.modes[i].participation)) << "mode " << i;
     EXPECT_TRUE(same(a.modes[i].kappa, b.modes[i].kappa)) << "mode " << i;
+    EXPECT_TRUE(same(a.modes[i].radiation_damping, b.modes[i].radiation_damping)) << "mode " << i;
     EXPECT_EQ(a.modes[i].symmetric, b.modes[i].symmetric);
     EXPECT_EQ(a.modes[i].residual, b.modes[i].residual);
   }
