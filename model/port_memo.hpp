@@ -24,6 +24,10 @@
 // capture's counts do not depend on which captures a worker replayed before
 // it (test_replay: shards and one run give the same records). The solves
 // saved across captures are counted in g_modal_solves_remembered.
+// (The entry remembers its last reader only: exact when captures take turns,
+// as a replay worker's and the GUI's do; two captures of one tube running at
+// once in one process could count a shared model twice — the counts, never
+// the models.)
 #include <array>
 #include <cstddef>
 #include <cstdint>
