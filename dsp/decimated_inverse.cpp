@@ -14,6 +14,7 @@
 #include <string>
 
 #include "dsp/work_counters.hpp"
+#include "numerics/simd_clones.hpp"
 
 namespace piezo::dsp {
 
@@ -56,20 +57,47 @@ DecimatedInverse::DecimatedInverse(const DecimatedInverse& o)
     : n_(o.n_), k_max_(o.k_max_), count_(o.count_), chirp_(o.chirp_), kernel_(o.kernel_),
       fft_(o.fft_.size()) {}
 
+namespace {
+// The element-wise products of operator(), over the complex arrays' (re, im)
+// pairs: (a + jb)(c + jd) = (ac − bd) + j(ad + bc), as std::complex's
+// product for finite parts, without its NaN check (a branch per element
+// that keeps the loop scalar); in SIMD clones (numerics/simd_clones.hpp).
+PIEZO_SIMD_CLONES void multiply(const double* __restrict x, const double* __restrict y, double* __restrict z,
+                                std::size_t n) {
+  for (std::size_t i = 0; i < n; ++i) {
+    const double a = x[2 * i], b = x[2 * i + 1], c = y[2 * i], d = y[2 * i + 1];
+    z[2 * i] = a * c - b * d;
+    z[2 * i + 1] = a * d + b * c;
+  }
+}
+PIEZO_SIMD_CLONES void multiply_in_place(double* __restrict z, const double* __restrict y, std::size_t n) {
+  for (std::size_t i = 0; i < n; ++i) {
+    const double a = z[2 * i], b = z[2 * i + 1], c = y[2 * i], d = y[2 * i + 1];
+    z[2 * i] = a * c - b * d;
+    z[2 * i + 1] = a * d + b * c;
+  }
+}
+PIEZO_SIMD_CLONES void twice_real_of_product(const double* __restrict x, const double* __restrict y,
+                                             double* __restrict out, std::size_t n) {
+  for (std::size_t i = 0; i < n; ++i) out[i] = 2.0 * (x[2 * i] * y[2 * i] - x[2 * i + 1] * y[2 * i + 1]);
+}
+const double* parts(const std::complex<double>* z) { return reinterpret_cast<const double*>(z); }
+double* parts(std::complex<double>* z) { return reinterpret_cast<double*>(z); }
+}  // namespace
+
 void DecimatedInverse::operator()(const std::complex<double>* bins, double* out) {
   g_ffts.fetch_add(1, std::memory_order_relaxed);  // one inverse DFT (dsp/work_counters.hpp)
   const std::size_t l = fft_.size();
   std::complex<double>* u = fft_.data();
-  for (std::size_t k = 0; k <= k_max_; ++k) {
-    std::complex<double> a = bins[k];
-    if (k == 0 || 2 * k == n_) a = {0.5 * a.real(), 0.0};
-    u[k] = a * chirp_[k];
-  }
+  // (std::complex<double> is an array of its two parts: [complex.numbers.general])
+  multiply(parts(bins), parts(chirp_.data()), parts(u), k_max_ + 1);
+  u[0] = 0.5 * bins[0].real() * chirp_[0];  // a_0 = Re X[0]/2 (chirp_[0] = 1)
+  if (2 * k_max_ == n_) u[k_max_] = 0.5 * bins[k_max_].real() * chirp_[k_max_];  // a_{N/2}
   std::fill(u + k_max_ + 1, u + l, std::complex<double>(0.0, 0.0));
   fft_.forward();
-  for (std::size_t i = 0; i < l; ++i) u[i] *= kernel_[i];
+  multiply_in_place(parts(u), parts(kernel_.data()), l);
   fft_.inverse();
-  for (std::size_t m = 0; m < count_; ++m) out[m] = 2.0 * (chirp_[m] * u[m]).real();
+  twice_real_of_product(parts(chirp_.data()), parts(u), out, count_);
 }
 
 }  // namespace piezo::dsp

@@ -5,6 +5,7 @@
 #include <vector>
 
 #include "numerics/complex_division.hpp"
+#include "numerics/simd_clones.hpp"
 
 namespace piezo::model {
 
@@ -38,6 +39,7 @@ cd tube_admittance(const ModalPortModel& port, const RayleighDamping& d, const E
   return cd(0.0, omega) * q;
 }
 
+PIEZO_SIMD_CLONES  // (its modal loop is element-wise over the bins: numerics/simd_clones.hpp)
 void tube_admittances(const ModalPortModel& port, const RayleighDamping& d, const EffectSet& fx,
                       std::span<const double> omega, double elastic_loss, std::span<cd> y) {
   const std::size_t n = omega.size();

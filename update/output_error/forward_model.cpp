@@ -10,8 +10,24 @@
 
 #include "dsp/windows.hpp"
 #include "model/bench_response.hpp"
+#include "numerics/simd_clones.hpp"
 
 namespace piezo::update::oe {
+
+namespace {
+// e = t·a − b over n bins (the complex arrays as (re, im) pairs): the
+// residual's spectrum, element-wise, as std::complex's product for finite
+// parts without its NaN branch; in SIMD clones (numerics/simd_clones.hpp).
+PIEZO_SIMD_CLONES void times_minus(const double* __restrict t, const double* __restrict a, const double* __restrict b,
+                                   double* __restrict e, std::size_t n) {
+  for (std::size_t k = 0; k < n; ++k) {
+    const double tr = t[2 * k], ti = t[2 * k + 1], ar = a[2 * k], ai = a[2 * k + 1];
+    e[2 * k] = (tr * ar - ti * ai) - b[2 * k];
+    e[2 * k + 1] = (tr * ai + ti * ar) - b[2 * k + 1];
+  }
+}
+const double* parts(const std::vector<cd>& z) { return reinterpret_cast<const double*>(z.data()); }
+}  // namespace
 
 Problem::Problem(model::ModalSolver& solver, const MaterialClass& cls, const Coordinates5& co,
                  const Averaged& rec, const OeData& data, double band_hz,
@@ -74,7 +90,7 @@ std::optional<std::vector<cd>> Problem::transfer(const Eigen::VectorXd& x,
 }
 
 Eigen::VectorXd Problem::residual_of(const std::vector<cd>& t) {
-  for (std::size_t k = 0; k <= kmax_; ++k) spec_[k] = t[k] * lv1_[k] - ly_[k];
+  times_minus(parts(t), parts(lv1_), parts(ly_), reinterpret_cast<double*>(spec_.data()), kmax_ + 1);
   return invert();
 }
 
