@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "model/element.hpp"
+#include "numerics/simd_clones.hpp"
 
 namespace piezo::model {
 
@@ -108,16 +109,38 @@ Eigen::VectorXd SplitSystem::loaded_mass(double f, const char* fn) const {
   return m_ + f * m_end_;
 }
 
+namespace {
+// v = −σ·(m + f·m_end) + Σ_q w_q·k_q over the pattern's values, pass by pass
+// in q's order (each element's operations those of the Eigen expressions
+// this replaced, so the same bits), in SIMD clones (numerics/simd_clones.hpp).
+PIEZO_SIMD_CLONES void weighted_values(double* __restrict v, std::size_t n, double sigma, const double* __restrict m,
+                                       const double* __restrict m_end, double f,
+                                       const std::array<const double*, kNumMaterialParams>& k, const MaterialWeights& w) {
+  if (m_end)
+    for (std::size_t i = 0; i < n; ++i) v[i] = -sigma * (m[i] + f * m_end[i]);
+  else
+    for (std::size_t i = 0; i < n; ++i) v[i] = -sigma * m[i];
+  for (int q = 0; q < kNumMaterialParams; ++q) {
+    const double wq = w[static_cast<std::size_t>(q)];
+    if (wq == 0.0) continue;
+    const double* __restrict kq = k[static_cast<std::size_t>(q)];
+    for (std::size_t i = 0; i < n; ++i) v[i] += wq * kq[i];
+  }
+}
+}  // namespace
+
 void SplitSystem::combine(const MaterialWeights& w, double sigma, SpMat& out,
                           double end_mass_fraction) const {
   if (out.nonZeros() != pattern_.nonZeros() || out.rows() != pattern_.rows()) out = pattern_;
-  Eigen::Map<Eigen::VectorXd> v(out.valuePtr(), out.nonZeros());
-  if (end_mass_fraction == 0.0)
-    v = -sigma * m_;
-  else
-    v = -sigma * loaded_mass(end_mass_fraction, "SplitSystem::combine");
-  for (int q = 0; q < kNumMaterialParams; ++q)
-    if (w[q] != 0.0) v += w[q] * k_[q];
+  if (end_mass_fraction != 0.0) {  // (loaded_mass's checks)
+    if (!std::isfinite(end_mass_fraction) || end_mass_fraction < 0.0)
+      throw std::invalid_argument("SplitSystem::combine: end_mass_fraction must be finite and >= 0");
+    if (m_end_.size() != m_.size()) throw std::invalid_argument("SplitSystem::combine: no end-face mass set (set_end_mass)");
+  }
+  std::array<const double*, kNumMaterialParams> k{};
+  for (int q = 0; q < kNumMaterialParams; ++q) k[static_cast<std::size_t>(q)] = k_[q].data();
+  weighted_values(out.valuePtr(), static_cast<std::size_t>(out.nonZeros()), sigma, m_.data(),
+                  end_mass_fraction == 0.0 ? nullptr : m_end_.data(), end_mass_fraction, k, w);
 }
 
 void SplitSystem::combine(const std::array<std::complex<double>, kNumMaterialParams>& w,

@@ -6,6 +6,8 @@
 #include <queue>
 #include <stdexcept>
 
+#include "numerics/simd_clones.hpp"
+
 namespace piezo::model {
 
 namespace {
@@ -90,6 +92,19 @@ std::vector<int> rcm_order(const Eigen::SparseMatrix<double>& p, const std::vect
   if (best.empty())  // every DOF "last": natural order
     for (int i = 0; i < n; ++i) best.push_back(i);
   return best;
+}
+
+// Lᵀ x = y in place, column by column of Lᵀ (row i of L): AXPYs, element-
+// wise, in SIMD clones (numerics/simd_clones.hpp; the forward pass is a dot
+// product per row, a sum whose order stays).
+PIEZO_SIMD_CLONES void backward(const double* __restrict env, const int* __restrict first,
+                                const int* __restrict row_start, double* __restrict y, int n) {
+  for (int i = n - 1; i >= 0; --i) {
+    const int fi = first[i];
+    const double* li = env + row_start[i] - fi;
+    const double yi = y[i];
+    for (int k = fi; k < i; ++k) y[k] -= li[k] * yi;
+  }
 }
 
 }  // namespace
@@ -225,12 +240,7 @@ void SkylineLdlt::solve(const double* b, double* x) const {
     y[i] = s;
   }
   for (int i = 0; i < n_; ++i) y[i] *= inv_d_[static_cast<std::size_t>(i)];
-  for (int i = n_ - 1; i >= 0; --i) {  // Lᵀ x = D⁻¹ y, column by column of Lᵀ (row i of L)
-    const int fi = first_[static_cast<std::size_t>(i)];
-    const double* li = env + row_start_[static_cast<std::size_t>(i)] - fi;
-    const double yi = y[i];
-    for (int k = fi; k < i; ++k) y[k] -= li[k] * yi;
-  }
+  backward(env, first_.data(), row_start_.data(), y, n_);  // Lᵀ x = D⁻¹ y
   for (int i = 0; i < n_; ++i) x[i] = y[perm_[static_cast<std::size_t>(i)]];
 }
 
