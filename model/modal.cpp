@@ -10,6 +10,7 @@
 
 #include "model/outer_surface_damping.hpp"
 #include "model/work_counters.hpp"
+#include "numerics/simd_clones.hpp"
 
 namespace piezo::model {
 
@@ -75,6 +76,47 @@ void gather_product(const SpMat& a, const double* x, double* y) {
     double s = 0.0;
     for (int p = outer[j]; p < outer[j + 1]; ++p) s += val[p] * x[inner[p]];
     y[j] = s;
+  }
+}
+
+// Lᵀ X = Ψ for all modes at once (ModalSolver::solve), X stored transposed
+// (xt: column i = DOF i's nm modes): backwards through L's columns, each
+// step an AXPY over the modes — element-wise over the modes, in SIMD clones
+// (numerics/simd_clones.hpp), each element's operations those of the Eigen
+// column expressions this replaced (x_i −= l_qi·x_q, then x_i /= l_ii).
+PIEZO_SIMD_CLONES void back_substitute_modes(double* xt, int nm, int nu, const int* outer, const int* inner,
+                                             const double* val) {
+  std::vector<double> acc(static_cast<std::size_t>(nm));
+  double* __restrict a = acc.data();
+  for (int i = nu - 1; i >= 0; --i) {
+    double* xi = xt + static_cast<std::ptrdiff_t>(i) * nm;
+    for (int m = 0; m < nm; ++m) a[m] = xi[m];
+    // Column i of L: its diagonal first, then rows below (sorted, > i).
+    for (int q = outer[i] + 1; q < outer[i + 1]; ++q) {
+      const double* __restrict xq = xt + static_cast<std::ptrdiff_t>(inner[q]) * nm;
+      const double l = val[q];
+      for (int m = 0; m < nm; ++m) a[m] -= l * xq[m];
+    }
+    const double d = val[outer[i]];
+    for (int m = 0; m < nm; ++m) xi[m] = a[m] / d;
+  }
+}
+
+// acc_m += a_q·(x_im·x_jm) over A's entries (i, j) in its U block, x stored
+// transposed (column i = DOF i's nm modes): every mode's [φ;0]ᵀA[φ;0] in one
+// pass, element-wise over the modes, in SIMD clones (the Eigen expression
+// this replaced: acc += a_q * x_i.cwiseProduct(x_j)).
+PIEZO_SIMD_CLONES void modal_quadratic_forms(const double* xt, int nm, int nu, const int* outer, const int* inner,
+                                             const double* val, double* __restrict acc) {
+  for (int j = 0; j < nu; ++j) {
+    const double* __restrict xj = xt + static_cast<std::ptrdiff_t>(j) * nm;
+    for (int q = outer[j]; q < outer[j + 1]; ++q) {
+      const int i = inner[q];
+      if (i >= nu) continue;
+      const double* __restrict xi = xt + static_cast<std::ptrdiff_t>(i) * nm;
+      const double v = val[q];
+      for (int m = 0; m < nm; ++m) acc[m] += v * (xi[m] * xj[m]);
+    }
   }
 }
 
@@ -285,12 +327,7 @@ ModalResult ModalSolver::solve(const PiezoMaterialE& material, Electrodes electr
     const int* outer = mf.l.outerIndexPtr();
     const int* inner = mf.l.innerIndexPtr();
     const double* val = mf.l.valuePtr();
-    for (int i = nu - 1; i >= 0; --i) {
-      auto xi = xt.col(i);
-      // Column i of L: its diagonal first, then rows below (sorted).
-      for (int q = outer[i] + 1; q < outer[i + 1]; ++q) xi -= val[q] * xt.col(inner[q]);
-      xi /= val[outer[i]];
-    }
+    back_substitute_modes(xt.data(), static_cast<int>(xt.rows()), nu, outer, inner, val);
     vecs = mf.p_inv * xt.transpose();
   }
   std::vector<int> order(lambda.size());
@@ -318,9 +355,7 @@ ModalResult ModalSolver::solve(const PiezoMaterialE& material, Electrodes electr
     const int* inner = a_shifted.innerIndexPtr();
     const double* val = a_shifted.valuePtr();
     Eigen::VectorXd acc = Eigen::VectorXd::Zero(res.shapes.cols());
-    for (int j = 0; j < nu; ++j)
-      for (int q = outer[j]; q < outer[j + 1]; ++q)
-        if (const int i = inner[q]; i < nu) acc += val[q] * st.col(i).cwiseProduct(st.col(j));
+    modal_quadratic_forms(st.data(), static_cast<int>(st.rows()), nu, outer, inner, val, acc.data());
     kappa += acc;
   }
 
