@@ -38,47 +38,6 @@ class CondensedShiftInvert {
   mutable Eigen::VectorXd rhs_, sol_;
 };
 
-// y = Lᵀ P (K_cond − σM)⁻¹ Pᵀ L x: the shift-invert operator in the standard
-// form of K φ = λ M φ, with P M Pᵀ = L Lᵀ and ψ = Lᵀ P φ (eigenvalue
-// μ = 1/(λ − σ), φ = Pᵀ L⁻ᵀ ψ). Lanczos then runs in the Euclidean inner
-// product: two products with the Cholesky factor per step where the
-// generalised (M-inner-product) Lanczos paid three to four products with M
-// for its op, norms and re-orthogonalisation (a quarter of a port model;
-// issue 43). L and Lᵀ are both stored column-major, so that each product is
-// a gather per column, four columns at a time (four independent sums the
-// CPU overlaps; the product is latency-bound otherwise).
-void gather_product(const SpMat& a, const double* x, double* y) {
-  const Eigen::Index n = a.cols();
-  const int* outer = a.outerIndexPtr();
-  const int* inner = a.innerIndexPtr();
-  const double* val = a.valuePtr();
-  Eigen::Index j = 0;
-  for (; j + 4 <= n; j += 4) {
-    const int b0 = outer[j], b1 = outer[j + 1], b2 = outer[j + 2], b3 = outer[j + 3], e3 = outer[j + 4];
-    const int common = std::min({b1 - b0, b2 - b1, b3 - b2, e3 - b3});
-    double s0 = 0.0, s1 = 0.0, s2 = 0.0, s3 = 0.0;
-    for (int t = 0; t < common; ++t) {
-      s0 += val[b0 + t] * x[inner[b0 + t]];
-      s1 += val[b1 + t] * x[inner[b1 + t]];
-      s2 += val[b2 + t] * x[inner[b2 + t]];
-      s3 += val[b3 + t] * x[inner[b3 + t]];
-    }
-    for (int p = b0 + common; p < b1; ++p) s0 += val[p] * x[inner[p]];
-    for (int p = b1 + common; p < b2; ++p) s1 += val[p] * x[inner[p]];
-    for (int p = b2 + common; p < b3; ++p) s2 += val[p] * x[inner[p]];
-    for (int p = b3 + common; p < e3; ++p) s3 += val[p] * x[inner[p]];
-    y[j] = s0;
-    y[j + 1] = s1;
-    y[j + 2] = s2;
-    y[j + 3] = s3;
-  }
-  for (; j < n; ++j) {
-    double s = 0.0;
-    for (int p = outer[j]; p < outer[j + 1]; ++p) s += val[p] * x[inner[p]];
-    y[j] = s;
-  }
-}
-
 // Lᵀ X = Ψ for all modes at once (ModalSolver::solve), X stored transposed
 // (xt: column i = DOF i's nm modes): backwards through L's columns, each
 // step an AXPY over the modes — element-wise over the modes, in SIMD clones
@@ -120,26 +79,35 @@ PIEZO_SIMD_CLONES void modal_quadratic_forms(const double* xt, int nm, int nu, c
   }
 }
 
+// y = Lᵀ P (K_cond − σM)⁻¹ Pᵀ L x: the shift-invert operator in the standard
+// form of K φ = λ M φ, with P M Pᵀ = L Lᵀ and ψ = Lᵀ P φ (eigenvalue
+// μ = 1/(λ − σ), φ = Pᵀ L⁻ᵀ ψ). Lanczos then runs in the Euclidean inner
+// product: two products with the Cholesky factor per step where the
+// generalised (M-inner-product) Lanczos paid three to four products with M
+// for its op, norms and re-orthogonalisation (a quarter of a port model;
+// issue 43). L and Lᵀ are both stored column-major, so that each product is
+// a dot product per column, four columns at a time (model/column_dots.hpp:
+// four independent sums, in the lanes of an AVX2 register where there is one).
 class StandardShiftInvert {
  public:
   using Scalar = double;
-  StandardShiftInvert(const CondensedShiftInvert& inv, const SpMat& l, const SpMat& lt,
+  StandardShiftInvert(const CondensedShiftInvert& inv, const ColumnDots& l, const ColumnDots& lt,
                       const Eigen::PermutationMatrix<Eigen::Dynamic, Eigen::Dynamic, int>& p,
                       const Eigen::PermutationMatrix<Eigen::Dynamic, Eigen::Dynamic, int>& p_inv)
-      : inv_(&inv), l_(&l), lt_(&lt), p_(&p), p_inv_(&p_inv), t_(l.rows()), u_(l.rows()), w_(l.rows()) {}
-  Eigen::Index rows() const { return l_->rows(); }
-  Eigen::Index cols() const { return l_->rows(); }
+      : inv_(&inv), l_(&l), lt_(&lt), p_(&p), p_inv_(&p_inv), t_(l.cols()), u_(l.cols()), w_(l.cols()) {}
+  Eigen::Index rows() const { return l_->cols(); }
+  Eigen::Index cols() const { return l_->cols(); }
   void perform_op(const Scalar* x_in, Scalar* y_out) const {
-    gather_product(*lt_, x_in, t_.data());  // t = L x (row i of L = column i of Lᵀ)
+    lt_->apply(x_in, t_.data());            // t = L x (row i of L = column i of Lᵀ)
     u_.noalias() = *p_inv_ * t_;             // Pᵀ t
     inv_->perform_op(u_.data(), w_.data());
     t_.noalias() = *p_ * w_;                 // P w
-    gather_product(*l_, t_.data(), y_out);   // Lᵀ (P w)
+    l_->apply(t_.data(), y_out);            // Lᵀ (P w)
   }
 
  private:
   const CondensedShiftInvert* inv_;
-  const SpMat *l_, *lt_;
+  const ColumnDots *l_, *lt_;
   const Eigen::PermutationMatrix<Eigen::Dynamic, Eigen::Dynamic, int>*p_, *p_inv_;
   mutable Eigen::VectorXd t_, u_, w_;
 };
@@ -226,6 +194,8 @@ const ModalSolver::MassFactor& ModalSolver::mass_factor(double f) {
       throw std::runtime_error("ModalSolver: the mass matrix is not positive definite (its Cholesky failed)");
     mf.l = llt.matrixL();
     mf.lt = mf.l.transpose();
+    mf.l_dots = ColumnDots(mf.l);
+    mf.lt_dots = ColumnDots(mf.lt);
     for (Eigen::Index i = 0; i < mf.l.cols(); ++i)  // solve() reads each column's diagonal first
       if (mf.l.outerIndexPtr()[i] == mf.l.outerIndexPtr()[i + 1] || mf.l.innerIndexPtr()[mf.l.outerIndexPtr()[i]] != i)
         throw std::logic_error("ModalSolver: the mass factor's column has no leading diagonal entry");
@@ -304,7 +274,7 @@ ModalResult ModalSolver::solve(const PiezoMaterialE& material, Electrodes electr
   }
   CondensedShiftInvert inv(factor_, nu, plane);
   const MassFactor& mf = mass_factor(opt.end_mass_fraction);
-  StandardShiftInvert op(inv, mf.l, mf.lt, mf.p, mf.p_inv);
+  StandardShiftInvert op(inv, mf.l_dots, mf.lt_dots, mf.p, mf.p_inv);
   const int ncv = std::min<int>(nu, opt.ncv > 0 ? opt.ncv : std::max(2 * opt.n_modes + 1, opt.n_modes + 20));
   Spectra::SymEigsSolver<StandardShiftInvert> eigs(op, opt.n_modes, ncv);
   eigs.init();

@@ -16,6 +16,7 @@
 #include <string>
 #include <vector>
 
+#include "model/column_dots.hpp"
 #include "model/coupled_solver.hpp"
 #include "model/port_memo.hpp"
 #include "model/port_model.hpp"
@@ -167,6 +168,7 @@ class ModalSolver {
   struct MassFactor {
     double fraction = -1.0;
     SpMat l, lt;  // L and Lᵀ, both column-major (each product a gather over columns)
+    ColumnDots l_dots, lt_dots;  // their products (model/column_dots.hpp)
     Eigen::PermutationMatrix<Eigen::Dynamic, Eigen::Dynamic, int> p, p_inv;
   };
   const MassFactor& mass_factor(double end_mass_fraction);
