@@ -42,6 +42,23 @@ ColumnDots::ColumnDots(const SpMat& a) : n_(a.cols()) {
   for (; k < order.size(); ++k) single_.push_back(order[k]);
 }
 
+void ColumnDots::finish(const Group& g, double* s, const double* x, double* y) const {
+  for (int l = 0; l < 4; ++l) {  // each column's rest, in its stored order
+    for (int p = g.rest[l][0]; p < g.rest[l][1]; ++p)
+      s[l] += values_[static_cast<std::size_t>(p)] * x[inner_[static_cast<std::size_t>(p)]];
+    y[g.col[l]] = s[l];
+  }
+}
+
+void ColumnDots::singles(const double* x, double* y) const {
+  for (int j : single_) {
+    double s = 0.0;
+    for (int p = outer_[static_cast<std::size_t>(j)]; p < outer_[static_cast<std::size_t>(j) + 1]; ++p)
+      s += values_[static_cast<std::size_t>(p)] * x[inner_[static_cast<std::size_t>(p)]];
+    y[j] = s;
+  }
+}
+
 void ColumnDots::apply_scalar(const double* x, double* y) const {
   for (const Group& g : groups_) {
     const double* v = vals_.data() + g.offset;
@@ -53,17 +70,9 @@ void ColumnDots::apply_scalar(const double* x, double* y) const {
       s[2] += v[2] * x[r[2]];
       s[3] += v[3] * x[r[3]];
     }
-    for (int l = 0; l < 4; ++l) {
-      for (int p = g.rest[l][0]; p < g.rest[l][1]; ++p) s[l] += values_[static_cast<std::size_t>(p)] * x[inner_[static_cast<std::size_t>(p)]];
-      y[g.col[l]] = s[l];
-    }
+    finish(g, s, x, y);
   }
-  for (int j : single_) {
-    double s = 0.0;
-    for (int p = outer_[static_cast<std::size_t>(j)]; p < outer_[static_cast<std::size_t>(j) + 1]; ++p)
-      s += values_[static_cast<std::size_t>(p)] * x[inner_[static_cast<std::size_t>(p)]];
-    y[j] = s;
-  }
+  singles(x, y);
 }
 
 #ifdef PIEZO_COLUMN_DOTS_AVX2
@@ -80,17 +89,9 @@ __attribute__((target("avx2"))) void ColumnDots::apply_avx2(const double* x, dou
     }
     alignas(32) double s[4];
     _mm256_store_pd(s, acc);
-    for (int l = 0; l < 4; ++l) {
-      for (int p = g.rest[l][0]; p < g.rest[l][1]; ++p) s[l] += values_[static_cast<std::size_t>(p)] * x[inner_[static_cast<std::size_t>(p)]];
-      y[g.col[l]] = s[l];
-    }
+    finish(g, s, x, y);
   }
-  for (int j : single_) {
-    double s = 0.0;
-    for (int p = outer_[static_cast<std::size_t>(j)]; p < outer_[static_cast<std::size_t>(j) + 1]; ++p)
-      s += values_[static_cast<std::size_t>(p)] * x[inner_[static_cast<std::size_t>(p)]];
-    y[j] = s;
-  }
+  singles(x, y);
 }
 #endif
 

@@ -37,6 +37,8 @@ class ColumnDots {
   std::vector<int> rows_;
   std::vector<int> outer_, inner_;  // a's own arrays (the rests and the singles)
   std::vector<double> values_;
+  void finish(const Group& g, double* s, const double* x, double* y) const;  // a group's rests, y
+  void singles(const double* x, double* y) const;                             // the columns beyond the groups
   void apply_scalar(const double* x, double* y) const;
 #if defined(__GNUC__) && !defined(__clang__) && defined(__x86_64__)
   __attribute__((target("avx2"))) void apply_avx2(const double* x, double* y) const;
