@@ -40,7 +40,7 @@ class ColumnDots {
   void finish(const Group& g, double* s, const double* x, double* y) const;  // a group's rests, y
   void singles(const double* x, double* y) const;                             // the columns beyond the groups
   void apply_scalar(const double* x, double* y) const;
-#if defined(__GNUC__) && !defined(__clang__) && defined(__x86_64__)
+#if defined(__GNUC__) && !defined(__clang__) && defined(__x86_64__) && !defined(PIEZO_NO_SIMD_CLONES)
   __attribute__((target("avx2"))) void apply_avx2(const double* x, double* y) const;
 #endif
 };

@@ -193,9 +193,8 @@ const ModalSolver::MassFactor& ModalSolver::mass_factor(double f) {
     if (llt.info() != Eigen::Success)
       throw std::runtime_error("ModalSolver: the mass matrix is not positive definite (its Cholesky failed)");
     mf.l = llt.matrixL();
-    mf.lt = mf.l.transpose();
     mf.l_dots = ColumnDots(mf.l);
-    mf.lt_dots = ColumnDots(mf.lt);
+    mf.lt_dots = ColumnDots(SpMat(mf.l.transpose()));
     for (Eigen::Index i = 0; i < mf.l.cols(); ++i)  // solve() reads each column's diagonal first
       if (mf.l.outerIndexPtr()[i] == mf.l.outerIndexPtr()[i + 1] || mf.l.innerIndexPtr()[mf.l.outerIndexPtr()[i]] != i)
         throw std::logic_error("ModalSolver: the mass factor's column has no leading diagonal entry");

@@ -167,8 +167,8 @@ class ModalSolver {
   // f): the standard form of the shift-invert problem (solve()).
   struct MassFactor {
     double fraction = -1.0;
-    SpMat l, lt;  // L and Lᵀ, both column-major (each product a gather over columns)
-    ColumnDots l_dots, lt_dots;  // their products (model/column_dots.hpp)
+    SpMat l;                     // L, column-major (the eigenvectors' back-substitution)
+    ColumnDots l_dots, lt_dots;  // the products with Lᵀ and L, a dot product per column of L and of Lᵀ (model/column_dots.hpp)
     Eigen::PermutationMatrix<Eigen::Dynamic, Eigen::Dynamic, int> p, p_inv;
   };
   const MassFactor& mass_factor(double end_mass_fraction);
