@@ -20,22 +20,29 @@ std::mutex& planner_mutex() {
   return m;
 }
 
-// The shared r2c/c2r plans of each size (made on first use, under the planner
-// lock, on the first RealFft's buffers: every RealFft's buffers come from
-// fftw_alloc, so they have the alignment the plans assume). Kept for the process;
-// at most kMaxSharedSizes sizes (a batch of captures of many lengths plans the
-// rest per object, as before).
+// The shared r2c and c2r plans of each size, each made on its first use
+// (under the planner lock, on that RealFft's buffers: every RealFft's buffers
+// come from fftw_alloc, so they have the alignment the plans assume). Kept
+// for the process; at most kMaxSharedSizes sizes (a batch of captures of
+// many lengths plans the rest per object, as before). FFTW_ESTIMATE chooses
+// a plan from the size alone, so a plan made later or elsewhere is the same.
 constexpr std::size_t kMaxSharedSizes = 64;
 std::map<std::size_t, std::pair<fftw_plan, fftw_plan>>& shared_plans() {
   static auto* plans = new std::map<std::size_t, std::pair<fftw_plan, fftw_plan>>();  // never freed: outlives every RealFft
   return *plans;
 }
 
-std::pair<fftw_plan, fftw_plan> make_plans(std::size_t n, double* r, fftw_complex* c) {
-  fftw_plan f = fftw_plan_dft_r2c_1d(static_cast<int>(n), r, c, FFTW_ESTIMATE);
-  fftw_plan i = fftw_plan_dft_c2r_1d(static_cast<int>(n), c, r, FFTW_ESTIMATE);
-  if (!f || !i) throw std::runtime_error("RealFft: FFTW planning failed");
-  return {f, i};
+// The same for ComplexFft's in-place transforms.
+std::map<std::size_t, std::pair<fftw_plan, fftw_plan>>& shared_complex_plans() {
+  static auto* plans = new std::map<std::size_t, std::pair<fftw_plan, fftw_plan>>();  // never freed
+  return *plans;
+}
+
+fftw_plan make_plan(std::size_t n, double* r, fftw_complex* c, bool inverse) {
+  fftw_plan p = inverse ? fftw_plan_dft_c2r_1d(static_cast<int>(n), c, r, FFTW_ESTIMATE)
+                        : fftw_plan_dft_r2c_1d(static_cast<int>(n), r, c, FFTW_ESTIMATE);
+  if (!p) throw std::runtime_error("RealFft: FFTW planning failed");
+  return p;
 }
 }  // namespace
 
@@ -50,33 +57,46 @@ RealFft::RealFft(std::size_t n) : n_(n) {
     fftw_free(c);
     throw std::bad_alloc();
   }
-  // Planned on this object's buffers (FFTW_ESTIMATE does not touch them);
-  // the plans never read them again (new-array execute only).
-  auto& shared = shared_plans();
-  std::pair<fftw_plan, fftw_plan> p;
-  if (auto it = shared.find(n); it != shared.end()) {
-    p = it->second;
-  } else {
-    p = make_plans(n, rbuf_, c);
-    if (shared.size() < kMaxSharedSizes) shared.emplace(n, p);
-    else own_plans_ = true;
+  // The shared plans made so far; the others on first use (plan()): a size
+  // only ever transformed forward (a record's spectrum) is never planned
+  // backward — planning a long transform costs more than running it.
+  if (auto it = shared_plans().find(n); it != shared_plans().end()) {
+    fwd_ = it->second.first;
+    inv_ = it->second.second;
   }
-  fwd_ = p.first;
-  inv_ = p.second;
+}
+
+void* RealFft::plan(bool inverse) {
+  std::lock_guard<std::mutex> lock(planner_mutex());
+  auto& shared = shared_plans();
+  auto it = shared.find(n_);
+  if (it == shared.end() && shared.size() < kMaxSharedSizes)
+    it = shared.emplace(n_, std::pair<fftw_plan, fftw_plan>{nullptr, nullptr}).first;
+  fftw_plan* slot = it == shared.end() ? nullptr : inverse ? &it->second.second : &it->second.first;
+  fftw_plan p = slot ? *slot : nullptr;
+  if (!p) {
+    // Planned on this object's buffers (FFTW_ESTIMATE does not touch them);
+    // the plans never read them again (new-array execute only).
+    p = make_plan(n_, rbuf_, static_cast<fftw_complex*>(cbuf_), inverse);
+    if (slot)
+      *slot = p;
+    else
+      (inverse ? own_inv_ : own_fwd_) = true;  // past the shared cache's size limit: its own
+  }
+  return (inverse ? inv_ : fwd_) = p;
 }
 
 RealFft::~RealFft() {
   std::lock_guard<std::mutex> lock(planner_mutex());
-  if (own_plans_) {
-    fftw_destroy_plan(static_cast<fftw_plan>(fwd_));
-    fftw_destroy_plan(static_cast<fftw_plan>(inv_));
-  }
+  if (own_fwd_) fftw_destroy_plan(static_cast<fftw_plan>(fwd_));
+  if (own_inv_) fftw_destroy_plan(static_cast<fftw_plan>(inv_));
   fftw_free(rbuf_);
   fftw_free(cbuf_);
 }
 
 void RealFft::forward(const double* in, std::size_t count, std::complex<double>* out) {
   g_ffts.fetch_add(1, std::memory_order_relaxed);  // dsp/work_counters.hpp
+  if (!fwd_) plan(false);
   count = std::min(count, n_);
   std::memcpy(rbuf_, in, count * sizeof(double));
   std::fill(rbuf_ + count, rbuf_ + n_, 0.0);
@@ -86,6 +106,7 @@ void RealFft::forward(const double* in, std::size_t count, std::complex<double>*
 
 void RealFft::inverse(const std::complex<double>* in, double* out, std::size_t count) {
   g_ffts.fetch_add(1, std::memory_order_relaxed);
+  if (!inv_) plan(true);
   std::memcpy(cbuf_, static_cast<const void*>(in), bins() * sizeof(fftw_complex));
   // c2r destroys its input: cbuf_ is scratch
   fftw_execute_dft_c2r(static_cast<fftw_plan>(inv_), static_cast<fftw_complex*>(cbuf_), rbuf_);
@@ -98,20 +119,48 @@ ComplexFft::ComplexFft(std::size_t n) : n_(n) {
   auto* c = fftw_alloc_complex(n);
   if (!c) throw std::bad_alloc();
   buf_ = reinterpret_cast<std::complex<double>*>(c);  // the layouts agree (FFTW's manual, §4.1.1)
-  fwd_ = fftw_plan_dft_1d(static_cast<int>(n), c, c, FFTW_FORWARD, FFTW_ESTIMATE);
-  inv_ = fftw_plan_dft_1d(static_cast<int>(n), c, c, FFTW_BACKWARD, FFTW_ESTIMATE);
-  if (!fwd_ || !inv_) throw std::runtime_error("ComplexFft: FFTW planning failed");
+}
+
+void* ComplexFft::plan(bool inverse) {
+  // Shared as RealFft's (in place, on the first object's buffer: every
+  // buffer comes from fftw_alloc), each direction on first use.
+  std::lock_guard<std::mutex> lock(planner_mutex());
+  auto& shared = shared_complex_plans();
+  auto it = shared.find(n_);
+  if (it == shared.end() && shared.size() < kMaxSharedSizes)
+    it = shared.emplace(n_, std::pair<fftw_plan, fftw_plan>{nullptr, nullptr}).first;
+  fftw_plan* slot = it == shared.end() ? nullptr : inverse ? &it->second.second : &it->second.first;
+  fftw_plan p = slot ? *slot : nullptr;
+  if (!p) {
+    auto* c = reinterpret_cast<fftw_complex*>(buf_);
+    p = fftw_plan_dft_1d(static_cast<int>(n_), c, c, inverse ? FFTW_BACKWARD : FFTW_FORWARD, FFTW_ESTIMATE);
+    if (!p) throw std::runtime_error("ComplexFft: FFTW planning failed");
+    if (slot)
+      *slot = p;
+    else
+      (inverse ? own_inv_ : own_fwd_) = true;
+  }
+  return (inverse ? inv_ : fwd_) = p;
 }
 
 ComplexFft::~ComplexFft() {
   std::lock_guard<std::mutex> lock(planner_mutex());
-  if (fwd_) fftw_destroy_plan(static_cast<fftw_plan>(fwd_));
-  if (inv_) fftw_destroy_plan(static_cast<fftw_plan>(inv_));
+  if (own_fwd_) fftw_destroy_plan(static_cast<fftw_plan>(fwd_));
+  if (own_inv_) fftw_destroy_plan(static_cast<fftw_plan>(inv_));
   fftw_free(buf_);
 }
 
-void ComplexFft::forward() { fftw_execute(static_cast<fftw_plan>(fwd_)); }
-void ComplexFft::inverse() { fftw_execute(static_cast<fftw_plan>(inv_)); }
+void ComplexFft::forward() {
+  if (!fwd_) plan(false);
+  auto* c = reinterpret_cast<fftw_complex*>(buf_);
+  fftw_execute_dft(static_cast<fftw_plan>(fwd_), c, c);
+}
+
+void ComplexFft::inverse() {
+  if (!inv_) plan(true);
+  auto* c = reinterpret_cast<fftw_complex*>(buf_);
+  fftw_execute_dft(static_cast<fftw_plan>(inv_), c, c);
+}
 
 std::size_t good_fft_size(std::size_t n) {
   if (n <= 2) return 2;

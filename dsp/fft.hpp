@@ -31,9 +31,10 @@ class RealFft {
   std::size_t n_;
   double* rbuf_ = nullptr;
   void* cbuf_ = nullptr;
-  void* fwd_ = nullptr;
+  void* fwd_ = nullptr;  // null until the first transform that way (plan())
   void* inv_ = nullptr;
-  bool own_plans_ = false;  // past the shared cache's size limit: its own plans
+  bool own_fwd_ = false, own_inv_ = false;  // past the shared cache's size limit: its own plans
+  void* plan(bool inverse);  // fwd_ or inv_: the shared plan of this size, made if need be
 };
 
 // FFTW3's complex transform of size n, in place on its own buffer (data()).
@@ -52,8 +53,10 @@ class ComplexFft {
  private:
   std::size_t n_;
   std::complex<double>* buf_ = nullptr;
-  void* fwd_ = nullptr;
+  void* fwd_ = nullptr;  // null until the first transform that way (plan())
   void* inv_ = nullptr;
+  bool own_fwd_ = false, own_inv_ = false;  // past the shared cache's size limit: its own plans
+  void* plan(bool inverse);
 };
 
 // Smallest n' >= n whose prime factors are 2, 3, 5, 7 (fast FFTW sizes).

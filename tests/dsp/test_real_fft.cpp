@@ -1,8 +1,8 @@
 // dsp::RealFft (dsp/fft): the transform against the DFT's sum, and instances
 // of one size alive together, on two threads, and after many other sizes, all
 // giving the DFT's numbers and the same numbers as a lone instance, bit for bit
-// (written for a shared plan cache, which was measured, gave no speed, and was
-// taken out: docs/benchmarks.md; the properties hold either way).
+// (the plans are shared per size, each direction made on its first use, and
+// past the cache's limit of sizes an instance's own).
 #include "dsp/fft.hpp"
 
 #include <gtest/gtest.h>
@@ -78,4 +78,33 @@ TEST(RealFft, InstancesGiveTheSameNumbersTogetherOnThreadsAndAfterOtherSizes) {
   t1.join();
   EXPECT_EQ(got[0], alone);
   EXPECT_EQ(got[1], alone);
+}
+
+// Each direction's plan is made on its first use: an instance made before its
+// size had any plan, one whose first transform is an inverse, and sizes past
+// the shared cache's limit (their own plans) all give the DFT's numbers, and
+// two instances of a size the same bits whichever planned it.
+TEST(RealFft, EachDirectionPlannedOnFirstUseGivesTheDftNumbers) {
+  auto check = [](std::size_t n, unsigned seed) {
+    const auto x = noise(n, seed);
+    std::vector<std::complex<double>> dft(n / 2 + 1);
+    for (std::size_t k = 0; k < dft.size(); ++k)
+      for (std::size_t i = 0; i < n; ++i) dft[k] += x[i] * std::polar(1.0, -2.0 * M_PI * double(k * i % n) / double(n));
+    RealFft early(n);  // no plan of this size yet
+    RealFft inverse_first(n);
+    std::vector<double> y(n);
+    inverse_first.inverse(dft.data(), y.data(), n);
+    for (std::size_t i = 0; i < n; ++i) ASSERT_NEAR(y[i] / double(n), x[i], 1e-12) << n << " " << i;
+    std::vector<std::complex<double>> a(early.bins()), b(early.bins());
+    early.forward(x.data(), n, a.data());
+    inverse_first.forward(x.data(), n, b.data());
+    for (std::size_t k = 0; k < a.size(); ++k) ASSERT_LT(std::abs(a[k] - dft[k]), 1e-13 * double(n)) << n << " " << k;
+    EXPECT_EQ(a, b) << n;
+    early.inverse(a.data(), y.data(), n);  // the inverse planned by the other instance
+    for (std::size_t i = 0; i < n; ++i) ASSERT_NEAR(y[i] / double(n), x[i], 1e-12) << n << " " << i;
+  };
+  check(1500, 21);
+  for (std::size_t m = 301; m < 301 + 2 * 70; m += 2) forward(m, noise(m, 5));  // 70 more sizes: past the limit (64)
+  check(1502, 22);  // its own plans
+  check(1500, 23);  // still the shared ones
 }
