@@ -14,6 +14,7 @@
 #include <thread>
 
 #include "model/effects.hpp"
+#include "update/output_error/spare_core.hpp"
 
 namespace piezo::update {
 
@@ -358,11 +359,17 @@ GapDiagnosis gap_from_output_error(const OeResult& r, const std::string& fit_des
         else predict_with(s, tasks[k - (with_base ? 1 : 0)]);
       }
     };
-    if (options.threads > 1 && n > 1) {
+    if (n > 1 && (options.threads > 1 || oe::may_borrow_core())) {  // (or a core lent: spare_core.hpp)
       model::ModalSolver second(solver.model(), solver.half_model());
       second.set_memo(solver.memo(), solver.memo_reader());  // (the same tube's port models)
-      std::thread t([&] { work(second); });
-      work(solver);
+      std::thread t([&] {
+        const oe::TwoThreadScope inside;
+        work(second);
+      });
+      {
+        const oe::TwoThreadScope inside;
+        work(solver);
+      }
       t.join();
     } else {
       work(solver);

@@ -23,6 +23,7 @@
 #include "jobs/export/report_export.hpp"
 #include "jobs/json/json_text.hpp"
 #include "jobs/nominal_material.hpp"
+#include "update/output_error/spare_core.hpp"
 
 namespace piezo::jobs::replay {
 
@@ -313,7 +314,11 @@ class ReplayWork {
 
   void run() {
     WorkerPoolCallbacks cb;
-    cb.work = [this](std::size_t i, const auto& stage) {
+    const std::atomic<int>* spare = nullptr;  // (the pool's, set before it forks its workers)
+    cb.work = [this, &spare](std::size_t i, const auto& stage) {
+      // In the worker: its fit may borrow the core of a sibling that has no
+      // capture left (update/output_error/spare_core.hpp; the same answers).
+      if (opt_.jobs > 1) update::oe::set_spare_cores(spare);
       // A damaged file must not take the machine's memory (contained_read.hpp);
       // twice its size for a held-out partner beside it.
       std::error_code ec;
@@ -325,6 +330,7 @@ class ReplayWork {
     cb.done = [this](std::size_t, const std::string& payload) { apply(decode_outcome(payload)); };
     cb.lost = [this](const LostTask& t) { lost(t); };
     WorkerPool pool({files_.size(), opt_.jobs, opt_.capture_timeout_s}, std::move(cb), cancel_);
+    spare = pool.spare_cores();
     pool.run();
   }
 

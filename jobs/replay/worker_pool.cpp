@@ -5,11 +5,13 @@
 #include <algorithm>
 #include <cstdint>
 #include <cstdio>
+#include <new>
 #include <stdexcept>
 
 #include <fcntl.h>
 #include <poll.h>
 #include <signal.h>
+#include <sys/mman.h>
 #include <sys/prctl.h>
 #include <sys/wait.h>
 #include <unistd.h>
@@ -62,10 +64,15 @@ void keep_only_fds(int a, int b) {
 }  // namespace
 
 WorkerPool::WorkerPool(WorkerPoolOptions opt, WorkerPoolCallbacks cb, const std::atomic<bool>& cancel)
-    : opt_(opt), cb_(std::move(cb)), cancel_(cancel) {}
+    : opt_(opt), cb_(std::move(cb)), cancel_(cancel) {
+  static_assert(std::atomic<int>::is_always_lock_free, "a count shared between processes must be lock-free");
+  void* m = ::mmap(nullptr, sizeof(std::atomic<int>), PROT_READ | PROT_WRITE, MAP_SHARED | MAP_ANONYMOUS, -1, 0);
+  if (m != MAP_FAILED) spare_ = new (m) std::atomic<int>(0);
+}
 
 WorkerPool::~WorkerPool() {
   for (auto& w : workers_) stop(w, /*kill_it=*/true);
+  if (spare_) ::munmap(spare_, sizeof(std::atomic<int>));
 }
 
 void WorkerPool::run() {
@@ -89,10 +96,16 @@ void WorkerPool::run() {
         write_all(w.task_fd, &i, sizeof i);
       }
     bool busy = false;
-    for (const auto& w : workers_) busy |= w.task.has_value();
+    int idle = 0;
+    for (const auto& w : workers_) {
+      busy |= w.task.has_value();
+      idle += !w.task;
+    }
     if (!busy) break;
+    if (spare_) spare_->store(next < opt_.tasks ? 0 : idle, std::memory_order_relaxed);
     wait_and_collect();
   }
+  if (spare_) spare_->store(0, std::memory_order_relaxed);
   for (auto& w : workers_) stop(w, false);
 }
 

@@ -60,6 +60,12 @@ class WorkerPool {
   // started or a pipe fails; what `done` and `lost` throw passes through.
   void run();
 
+  // How many workers idle with no task left to hand them (0 until the tasks
+  // run out), in memory the workers share with the batch: a worker's fit may
+  // borrow a core while it is above zero (update/output_error/spare_core.hpp).
+  // nullptr if that memory could not be had (then none is lent).
+  const std::atomic<int>* spare_cores() const { return spare_; }
+
  private:
   using Clock = std::chrono::steady_clock;
   struct Proc {
@@ -78,6 +84,7 @@ class WorkerPool {
 
   WorkerPoolOptions opt_;
   WorkerPoolCallbacks cb_;
+  std::atomic<int>* spare_ = nullptr;  // (mmap'd shared, anonymous)
   const std::atomic<bool>& cancel_;
   std::vector<Proc> workers_;
 };

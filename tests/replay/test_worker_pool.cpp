@@ -51,3 +51,31 @@ TEST(WorkerPool, CancelStopsWithoutReportingWhatIsUnderWay) {
   pool.run();
   EXPECT_EQ(reported, 0);
 }
+
+// The count of spare cores the workers share with the batch (spare_cores()):
+// 0 while tasks remain to be handed out, then the number of workers idle
+// with none left — what lets the last capture's fit borrow a core.
+TEST(WorkerPool, SpareCoresCountTheIdleWorkersOnceNoTaskIsLeft) {
+  std::map<std::size_t, std::string> done;
+  const std::atomic<int>* spare = nullptr;  // (set before run() forks the workers)
+  WorkerPoolCallbacks cb;
+  cb.work = [&spare](std::size_t i, const auto&) -> std::string {
+    if (!spare) return "no count";
+    const int at_start = spare->load();
+    if (i != 1) return std::to_string(at_start);
+    // The long task: tasks 0 and 2 go to the other worker, which then idles.
+    for (int k = 0; k < 2000 && spare->load() == 0; ++k) std::this_thread::sleep_for(std::chrono::milliseconds(5));
+    return std::to_string(at_start) + " then " + std::to_string(spare->load());
+  };
+  cb.done = [&](std::size_t i, const std::string& o) { done.emplace(i, o); };
+  cb.lost = [](const LostTask& t) { ADD_FAILURE() << "task " << t.task << " lost: " << t.kind; };
+  std::atomic<bool> cancel{false};
+  WorkerPool pool({3, 2, 60.0}, cb, cancel);
+  spare = pool.spare_cores();
+  ASSERT_NE(spare, nullptr);
+  pool.run();
+  ASSERT_EQ(done.size(), 3u);
+  EXPECT_EQ(done[0], "0");         // tasks 1 and 2 still to come
+  EXPECT_EQ(done[1], "0 then 1");  // the other worker idles: one spare core
+  EXPECT_EQ(spare->load(), 0);     // the batch is over: none lent
+}

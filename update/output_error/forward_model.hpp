@@ -27,6 +27,7 @@
 #include "model/reduced_port.hpp"
 #include "update/output_error.hpp"
 #include "update/output_error/common.hpp"
+#include "update/output_error/spare_core.hpp"
 #include "update/output_error/shot_average.hpp"
 #include "update/residual_regions.hpp"
 
@@ -147,6 +148,8 @@ class Problem {
   }
   void set_threads(int n) { threads_ = std::max(1, n); }
   int threads() const { return threads_; }
+  // A two-thread step's choice: threads() > 1, or a core lent now (spare_core.hpp).
+  bool two_threads() const { return threads_ > 1 || may_borrow_core(); }
 
   // The same problem for another thread (the effect scan): its own FFT plan
   // and buffers, `solver` for its FE models, this one's cache and tangent.

@@ -26,13 +26,19 @@ int in_parallel(Fitter& fitter, const std::vector<std::size_t>& order, const Pro
       }
     }
   };
-  if (prob.threads() > 1 && order.size() > 1) {
+  if (order.size() > 1 && prob.two_threads()) {
     Problem other(prob, prob.second_solver());
     Fitter other_fit = fitter.on(other);
     const int threads = prob.threads();
-    prob.set_threads(1);  // (the second solver is the other thread's now)
-    std::thread t([&] { work(other, other_fit); });
-    work(prob, fitter);
+    prob.set_threads(1);  // (the second solver is the other thread's now; nor does either thread borrow a core)
+    std::thread t([&] {
+      const TwoThreadScope inside;
+      work(other, other_fit);
+    });
+    {
+      const TwoThreadScope inside;
+      work(prob, fitter);
+    }
     t.join();
     prob.set_threads(threads);
     models_elsewhere += other.evaluations();

@@ -37,7 +37,7 @@ void Problem::prefetch(const std::vector<std::pair<Eigen::VectorXd, double>>& po
       const Key centre = base->key;
       bool mass = false;  // (a plus-point in the end mass when the Jacobian has a column in it)
       for (const auto& k : todo) mass = mass || k[4] != centre[4];
-      if (Basis b = make_basis(centre, mass, threads_ > 1, solver_)) {
+      if (Basis b = make_basis(centre, mass, two_threads(), solver_)) {
         local_.emplace_back(centre, b);
         for (const auto& k : todo) {
           Built one;
@@ -59,12 +59,14 @@ void Problem::prefetch(const std::vector<std::pair<Eigen::VectorXd, double>>& po
   }
   std::vector<Built> built(todo.size());
   const bool arm = armed();  // (decided once for the batch: its threads count solves as they go)
-  if (threads_ > 1 && todo.size() > 1) {
+  if (todo.size() > 1 && two_threads()) {
     model::ModalSolver& second = second_solver();
     // The second thread takes the odd points (one FE model each, equal work).
     std::thread other([&] {
+      const TwoThreadScope inside;
       for (std::size_t i = 1; i < todo.size(); i += 2) built[i] = build(second, todo[i], arm);
     });
+    const TwoThreadScope inside;
     for (std::size_t i = 0; i < todo.size(); i += 2) built[i] = build(solver_, todo[i], arm);
     other.join();
   } else {
@@ -271,7 +273,11 @@ Problem::Basis Problem::make_basis(const Key& centre, bool mass, bool two_thread
   };
   if (two_threads) {
     model::ModalSolver& second = second_solver();
-    std::thread other([&] { take(second, 1, 2); });
+    std::thread other([&] {
+      const TwoThreadScope inside;
+      take(second, 1, 2);
+    });
+    const TwoThreadScope inside;
     take(solver_, 0, 2);
     other.join();
   } else {
