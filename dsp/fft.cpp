@@ -44,6 +44,25 @@ fftw_plan make_plan(std::size_t n, double* r, fftw_complex* c, bool inverse) {
   if (!p) throw std::runtime_error("RealFft: FFTW planning failed");
   return p;
 }
+
+// The shared plan of size n one way (in `shared`, under the planner lock),
+// made by make() if there is none yet; past the size limit make()'s own, and
+// `own` set (its object destroys it).
+template <class Make>
+fftw_plan plan_of(std::map<std::size_t, std::pair<fftw_plan, fftw_plan>>& shared, std::size_t n, bool inverse,
+                  bool& own, Make make) {
+  auto it = shared.find(n);
+  if (it == shared.end() && shared.size() < kMaxSharedSizes)
+    it = shared.emplace(n, std::pair<fftw_plan, fftw_plan>{nullptr, nullptr}).first;
+  fftw_plan* slot = it == shared.end() ? nullptr : inverse ? &it->second.second : &it->second.first;
+  if (slot && *slot) return *slot;
+  const fftw_plan p = make();
+  if (slot)
+    *slot = p;
+  else
+    own = true;
+  return p;
+}
 }  // namespace
 
 RealFft::RealFft(std::size_t n) : n_(n) {
@@ -68,22 +87,11 @@ RealFft::RealFft(std::size_t n) : n_(n) {
 
 void* RealFft::plan(bool inverse) {
   std::lock_guard<std::mutex> lock(planner_mutex());
-  auto& shared = shared_plans();
-  auto it = shared.find(n_);
-  if (it == shared.end() && shared.size() < kMaxSharedSizes)
-    it = shared.emplace(n_, std::pair<fftw_plan, fftw_plan>{nullptr, nullptr}).first;
-  fftw_plan* slot = it == shared.end() ? nullptr : inverse ? &it->second.second : &it->second.first;
-  fftw_plan p = slot ? *slot : nullptr;
-  if (!p) {
-    // Planned on this object's buffers (FFTW_ESTIMATE does not touch them);
-    // the plans never read them again (new-array execute only).
-    p = make_plan(n_, rbuf_, static_cast<fftw_complex*>(cbuf_), inverse);
-    if (slot)
-      *slot = p;
-    else
-      (inverse ? own_inv_ : own_fwd_) = true;  // past the shared cache's size limit: its own
-  }
-  return (inverse ? inv_ : fwd_) = p;
+  // Planned on this object's buffers (FFTW_ESTIMATE does not touch them);
+  // the plans never read them again (new-array execute only).
+  return (inverse ? inv_ : fwd_) = plan_of(shared_plans(), n_, inverse, inverse ? own_inv_ : own_fwd_, [&] {
+           return make_plan(n_, rbuf_, static_cast<fftw_complex*>(cbuf_), inverse);
+         });
 }
 
 RealFft::~RealFft() {
@@ -125,22 +133,13 @@ void* ComplexFft::plan(bool inverse) {
   // Shared as RealFft's (in place, on the first object's buffer: every
   // buffer comes from fftw_alloc), each direction on first use.
   std::lock_guard<std::mutex> lock(planner_mutex());
-  auto& shared = shared_complex_plans();
-  auto it = shared.find(n_);
-  if (it == shared.end() && shared.size() < kMaxSharedSizes)
-    it = shared.emplace(n_, std::pair<fftw_plan, fftw_plan>{nullptr, nullptr}).first;
-  fftw_plan* slot = it == shared.end() ? nullptr : inverse ? &it->second.second : &it->second.first;
-  fftw_plan p = slot ? *slot : nullptr;
-  if (!p) {
-    auto* c = reinterpret_cast<fftw_complex*>(buf_);
-    p = fftw_plan_dft_1d(static_cast<int>(n_), c, c, inverse ? FFTW_BACKWARD : FFTW_FORWARD, FFTW_ESTIMATE);
-    if (!p) throw std::runtime_error("ComplexFft: FFTW planning failed");
-    if (slot)
-      *slot = p;
-    else
-      (inverse ? own_inv_ : own_fwd_) = true;
-  }
-  return (inverse ? inv_ : fwd_) = p;
+  return (inverse ? inv_ : fwd_) = plan_of(shared_complex_plans(), n_, inverse, inverse ? own_inv_ : own_fwd_, [&] {
+           auto* c = reinterpret_cast<fftw_complex*>(buf_);
+           const fftw_plan p =
+               fftw_plan_dft_1d(static_cast<int>(n_), c, c, inverse ? FFTW_BACKWARD : FFTW_FORWARD, FFTW_ESTIMATE);
+           if (!p) throw std::runtime_error("ComplexFft: FFTW planning failed");
+           return p;
+         });
 }
 
 ComplexFft::~ComplexFft() {
