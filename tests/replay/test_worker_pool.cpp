@@ -61,11 +61,11 @@ TEST(WorkerPool, SpareCoresCountTheIdleWorkersOnceNoTaskIsLeft) {
   WorkerPoolCallbacks cb;
   cb.work = [&spare](std::size_t i, const auto&) -> std::string {
     if (!spare) return "no count";
-    const int at_start = spare->load();
-    if (i != 1) return std::to_string(at_start);
-    // The long task: tasks 0 and 2 go to the other worker, which then idles.
-    for (int k = 0; k < 2000 && spare->load() == 0; ++k) std::this_thread::sleep_for(std::chrono::milliseconds(5));
-    return std::to_string(at_start) + " then " + std::to_string(spare->load());
+    if (i != 1) return std::to_string(spare->load());  // task 0 starts while 1 and 2 remain
+    // The long task (the second worker's from the start): tasks 0 and 2 go to
+    // the other worker, which then idles with none left.
+    for (int k = 0; k < 4000 && spare->load() == 0; ++k) std::this_thread::sleep_for(std::chrono::milliseconds(5));
+    return std::to_string(spare->load());
   };
   cb.done = [&](std::size_t i, const std::string& o) { done.emplace(i, o); };
   cb.lost = [](const LostTask& t) { ADD_FAILURE() << "task " << t.task << " lost: " << t.kind; };
@@ -73,9 +73,10 @@ TEST(WorkerPool, SpareCoresCountTheIdleWorkersOnceNoTaskIsLeft) {
   WorkerPool pool({3, 2, 60.0}, cb, cancel);
   spare = pool.spare_cores();
   ASSERT_NE(spare, nullptr);
+  EXPECT_EQ(spare->load(), 0);
   pool.run();
   ASSERT_EQ(done.size(), 3u);
-  EXPECT_EQ(done[0], "0");         // tasks 1 and 2 still to come
-  EXPECT_EQ(done[1], "0 then 1");  // the other worker idles: one spare core
-  EXPECT_EQ(spare->load(), 0);     // the batch is over: none lent
+  EXPECT_EQ(done[0], "0");      // tasks still to hand out: none lent
+  EXPECT_EQ(done[1], "1");      // the other worker idles with none left: one spare core
+  EXPECT_EQ(spare->load(), 0);  // the batch is over: none lent
 }
