@@ -103,11 +103,16 @@ std::optional<Eigen::VectorXd> Problem::residual(const Eigen::VectorXd& x) {
 const std::vector<cd>& Problem::spectrum_of(const std::vector<double>& record, std::vector<cd>& scratch) {
   const bool zero = std::all_of(record.begin(), record.begin() + static_cast<std::ptrdiff_t>(n_),
                                 [](double v) { return v == 0.0; });
-  if (zero && !zero_bins_.empty()) return zero_bins_;  // (the same FFT of the same samples: the same bins)
-  std::vector<cd>& out = zero ? zero_bins_ : scratch;
-  out.resize(fft_.bins());
-  fft_.forward(record.data(), n_, out.data());
-  return out;
+  if (zero) {  // (the same FFT of the same samples: the same bins, whichever thread makes them)
+    std::call_once(zero_->once, [&] {
+      zero_->bins.resize(fft_.bins());
+      fft_.forward(record.data(), n_, zero_->bins.data());
+    });
+    return zero_->bins;
+  }
+  scratch.resize(fft_.bins());
+  fft_.forward(record.data(), n_, scratch.data());
+  return scratch;
 }
 
 Eigen::VectorXd Problem::deviation(const std::vector<cd>& t, const std::vector<double>& d1,

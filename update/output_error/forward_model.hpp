@@ -357,12 +357,18 @@ class Problem {
   std::vector<Cached> cache_;
   unsigned long clock_ = 0;
   // The forward spectrum of a record deviation() filters: zero (a baseline
-  // column's v1, a single shot's deviation) is transformed once and kept,
-  // any other into `scratch`. (Keeping every record's spectrum by content
-  // was measured slower: the held-out chirp's 1.6 MB spectra cost more in
-  // fresh pages and comparisons than the transforms they saved.)
+  // column's v1, a single shot's deviation) is transformed once and kept —
+  // once for this problem and its forks, by whichever needs it first, so the
+  // FFT count does not depend on the threads — any other into `scratch`.
+  // (Keeping every record's spectrum by content was measured slower: the
+  // held-out chirp's 1.6 MB spectra cost more in fresh pages and comparisons
+  // than the transforms they saved.)
   const std::vector<cd>& spectrum_of(const std::vector<double>& record, std::vector<cd>& scratch);
-  std::vector<cd> zero_bins_;
+  struct ZeroSpectrum {
+    std::once_flag once;
+    std::vector<cd> bins;
+  };
+  std::shared_ptr<ZeroSpectrum> zero_ = std::make_shared<ZeroSpectrum>();
 
  public:
   // What the optimiser leaves behind (the cached models, the tangent): each
