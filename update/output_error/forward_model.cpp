@@ -104,11 +104,11 @@ const std::vector<cd>& Problem::spectrum_of(const std::vector<double>& record, s
   const bool zero = std::all_of(record.begin(), record.begin() + static_cast<std::ptrdiff_t>(n_),
                                 [](double v) { return v == 0.0; });
   if (zero) {  // (the same FFT of the same samples: the same bins, whichever thread makes them)
-    std::call_once(zero_->once, [&] {
-      zero_->bins.resize(fft_.bins());
-      fft_.forward(record.data(), n_, zero_->bins.data());
+    std::call_once(columns_->zero_once, [&] {
+      columns_->zero_bins.resize(fft_.bins());
+      fft_.forward(record.data(), n_, columns_->zero_bins.data());
     });
-    return zero_->bins;
+    return columns_->zero_bins;
   }
   scratch.resize(fft_.bins());
   fft_.forward(record.data(), n_, scratch.data());

@@ -52,6 +52,10 @@ struct OeRecordShare {
     std::shared_ptr<const dsp::DecimatedInverse> dinv;  // (copied: its buffer is per problem)
   };
   std::shared_ptr<const Spectra> spectra;
+  // The spectrum of a zero record (Problem::spectrum_of), made once by
+  // whichever problem sharing the columns needs it first.
+  std::once_flag zero_once;
+  std::vector<std::complex<double>> zero_bins;
 };
 
 }  // namespace piezo::update
@@ -358,17 +362,13 @@ class Problem {
   unsigned long clock_ = 0;
   // The forward spectrum of a record deviation() filters: zero (a baseline
   // column's v1, a single shot's deviation) is transformed once and kept —
-  // once for this problem and its forks, by whichever needs it first, so the
-  // FFT count does not depend on the threads — any other into `scratch`.
+  // once for all the problems that share the columns (this one, its forks,
+  // the held-out predictions of one record), by whichever needs it first, so
+  // the FFT count does not depend on the threads — any other into `scratch`.
   // (Keeping every record's spectrum by content was measured slower: the
   // held-out chirp's 1.6 MB spectra cost more in fresh pages and comparisons
   // than the transforms they saved.)
   const std::vector<cd>& spectrum_of(const std::vector<double>& record, std::vector<cd>& scratch);
-  struct ZeroSpectrum {
-    std::once_flag once;
-    std::vector<cd> bins;
-  };
-  std::shared_ptr<ZeroSpectrum> zero_ = std::make_shared<ZeroSpectrum>();
 
  public:
   // What the optimiser leaves behind (the cached models, the tangent): each

@@ -81,7 +81,7 @@ Problem::Problem(const Problem& o, model::ModalSolver& solver)
       lv1_(o.lv1_), ly_(o.ly_), spec_(o.spec_), buf_(o.buf_), idx_(o.idx_), dinv_(o.dinv_), columns_(o.columns_),
       reduced_(o.reduced_), local_(o.local_), surrogate_(o.surrogate_), exact_since_(o.exact_since_.load()),
       tangent_(o.tangent_),
-      cache_(o.cache_), clock_(o.clock_), zero_(o.zero_) {}
+      cache_(o.cache_), clock_(o.clock_) {}
 
 model::ModalSolver& Problem::second_solver() {
   // (sharing the first solver's upper half: one model build less a fit)
