@@ -27,8 +27,8 @@
 #include "model/reduced_port.hpp"
 #include "update/output_error.hpp"
 #include "update/output_error/common.hpp"
-#include "update/output_error/spare_core.hpp"
 #include "update/output_error/shot_average.hpp"
+#include "update/output_error/spare_core.hpp"
 #include "update/residual_regions.hpp"
 
 namespace piezo::update {
