@@ -11,7 +11,6 @@
 #include <cstdlib>
 #include <exception>
 #include <optional>
-#include <thread>
 
 #include "model/effects.hpp"
 #include "update/output_error/spare_core.hpp"
@@ -362,15 +361,7 @@ GapDiagnosis gap_from_output_error(const OeResult& r, const std::string& fit_des
     if (n > 1 && (options.threads > 1 || oe::may_borrow_core())) {  // (or a core lent: spare_core.hpp)
       model::ModalSolver second(solver.model(), solver.half_model());
       second.set_memo(solver.memo(), solver.memo_reader());  // (the same tube's port models)
-      std::thread t([&] {
-        const oe::TwoThreadScope inside;
-        work(second);
-      });
-      {
-        const oe::TwoThreadScope inside;
-        work(solver);
-      }
-      t.join();
+      oe::on_two_threads([&] { work(second); }, [&] { work(solver); });
     } else {
       work(solver);
     }

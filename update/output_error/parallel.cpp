@@ -4,7 +4,6 @@
 #include <atomic>
 #include <exception>
 #include <mutex>
-#include <thread>
 
 namespace piezo::update::oe {
 
@@ -31,15 +30,7 @@ int in_parallel(Fitter& fitter, const std::vector<std::size_t>& order, const Pro
     Fitter other_fit = fitter.on(other);
     const int threads = prob.threads();
     prob.set_threads(1);  // (the second solver is the other thread's now; nor does either thread borrow a core)
-    std::thread t([&] {
-      const TwoThreadScope inside;
-      work(other, other_fit);
-    });
-    {
-      const TwoThreadScope inside;
-      work(prob, fitter);
-    }
-    t.join();
+    on_two_threads([&] { work(other, other_fit); }, [&] { work(prob, fitter); });
     prob.set_threads(threads);
     models_elsewhere += other.evaluations();
   } else {

@@ -7,7 +7,6 @@
 #include <algorithm>
 #include <cmath>
 #include <exception>
-#include <thread>
 
 namespace piezo::update::oe {
 
@@ -62,13 +61,8 @@ void Problem::prefetch(const std::vector<std::pair<Eigen::VectorXd, double>>& po
   if (todo.size() > 1 && two_threads()) {
     model::ModalSolver& second = second_solver();
     // The second thread takes the odd points (one FE model each, equal work).
-    std::thread other([&] {
-      const TwoThreadScope inside;
-      for (std::size_t i = 1; i < todo.size(); i += 2) built[i] = build(second, todo[i], arm);
-    });
-    const TwoThreadScope inside;
-    for (std::size_t i = 0; i < todo.size(); i += 2) built[i] = build(solver_, todo[i], arm);
-    other.join();
+    on_two_threads([&] { for (std::size_t i = 1; i < todo.size(); i += 2) built[i] = build(second, todo[i], arm); },
+                   [&] { for (std::size_t i = 0; i < todo.size(); i += 2) built[i] = build(solver_, todo[i], arm); });
   } else {
     for (std::size_t i = 0; i < todo.size(); ++i) built[i] = build(solver_, todo[i], arm);
   }
@@ -273,13 +267,7 @@ Problem::Basis Problem::make_basis(const Key& centre, bool mass, bool two_thread
   };
   if (two_threads) {
     model::ModalSolver& second = second_solver();
-    std::thread other([&] {
-      const TwoThreadScope inside;
-      take(second, 1, 2);
-    });
-    const TwoThreadScope inside;
-    take(solver_, 0, 2);
-    other.join();
+    on_two_threads([&] { take(second, 1, 2); }, [&] { take(solver_, 0, 2); });
   } else {
     take(solver, 0, 1);
   }

@@ -16,6 +16,7 @@
 // fit) and `--jobs 2` (one) already show. A step inside a two-thread step
 // never borrows (the second solver is the other thread's then).
 #include <atomic>
+#include <functional>
 
 namespace piezo::update::oe {
 
@@ -25,6 +26,11 @@ void set_spare_cores(const std::atomic<int>* count);
 // Whether a step that can use a second thread may take one now: a core is
 // spare and this thread is not inside a two-thread step.
 bool may_borrow_core();
+
+// A two-thread step: `other` on a second thread, `mine` on this one, each
+// inside the step (no borrowing within), joined before it returns — also
+// when `mine` throws (the exception then passes on).
+void on_two_threads(const std::function<void()>& other, const std::function<void()>& mine);
 
 // Marks the calling thread as inside a two-thread step while it lives.
 class TwoThreadScope {
