@@ -86,7 +86,8 @@ TEST(GaussNewton, UndampedStepsReachAKnownRoot) {
   Eigen::Vector2d x(1.3, 1.6);
   GaussNewtonProblem pb;
   pb.linearise = [&](Eigen::VectorXd& r, Eigen::MatrixXd& j) {
-    r = Eigen::Vector2d(x[0] * x[0] + x[1] * x[1] - 5.0, x[0] - x[1] + 1.0);
+    r.resize(2);  // (not = Vector2d(…): GCC 12 with AVX warns falsely, bug 106247)
+    r << x[0] * x[0] + x[1] * x[1] - 5.0, x[0] - x[1] + 1.0;
     j.resize(2, 2);
     j << 2 * x[0], 2 * x[1], 1.0, -1.0;
   };

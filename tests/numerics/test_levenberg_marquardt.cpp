@@ -6,6 +6,7 @@
 
 #include <gtest/gtest.h>
 
+#include <initializer_list>
 #include <limits>
 #include <random>
 #include <stdexcept>
@@ -13,6 +14,15 @@
 using namespace piezo::numerics;
 
 namespace {
+
+// A VectorXd of these values (not = Vector2d(…): GCC 12 with AVX warns
+// falsely of an out-of-bounds packet load, GCC bug 106247).
+Eigen::VectorXd vec(std::initializer_list<double> v) {
+  Eigen::VectorXd x(static_cast<Eigen::Index>(v.size()));
+  Eigen::Index i = 0;
+  for (double e : v) x[i++] = e;
+  return x;
+}
 
 LmProblem linear_problem(const Eigen::MatrixXd& a, const Eigen::VectorXd& y) {
   LmProblem pb;
@@ -231,21 +241,21 @@ TEST(LevenbergMarquardt, PerCoordinateTrustRegionBindsOnlyItsCoordinate) {
   const auto one_cap = levenberg_marquardt(linear_problem(a, y), Eigen::VectorXd::Zero(2), s);
   ASSERT_TRUE(one_cap.converged);
   EXPECT_GE(one_cap.iterations, 27);
-  s.max_step_each = Eigen::Vector2d(0.3, std::numeric_limits<double>::infinity());
+  s.max_step_each = vec({0.3, std::numeric_limits<double>::infinity()});
   const auto each = levenberg_marquardt(linear_problem(a, y), Eigen::VectorXd::Zero(2), s);
   ASSERT_TRUE(each.converged);
   EXPECT_LE(each.iterations, 3);  // the step to the answer, then the ones that find nothing lower
   EXPECT_NEAR(each.x[0], 0.1, 1e-12);
   EXPECT_NEAR(each.x[1], 8.0, 1e-12);
   // The first coordinate's cap binds: the step is scaled as a whole.
-  s.max_step_each = Eigen::Vector2d(0.01, std::numeric_limits<double>::infinity());
+  s.max_step_each = vec({0.01, std::numeric_limits<double>::infinity()});
   s.max_iterations = 1;
   const auto first = levenberg_marquardt(linear_problem(a, y), Eigen::VectorXd::Zero(2), s);
   EXPECT_NEAR(first.x[0], 0.01, 1e-12);
   EXPECT_NEAR(first.x[1], 0.8, 1e-9);
   // One cap per coordinate, each positive.
-  s.max_step_each = Eigen::Vector3d(0.3, 0.3, 0.3);
+  s.max_step_each = vec({0.3, 0.3, 0.3});
   EXPECT_THROW(levenberg_marquardt(linear_problem(a, y), Eigen::VectorXd::Zero(2), s), std::invalid_argument);
-  s.max_step_each = Eigen::Vector2d(0.3, 0.0);
+  s.max_step_each = vec({0.3, 0.0});
   EXPECT_THROW(levenberg_marquardt(linear_problem(a, y), Eigen::VectorXd::Zero(2), s), std::invalid_argument);
 }
