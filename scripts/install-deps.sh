@@ -17,7 +17,10 @@ PACKAGES=(
   libgtest-dev libgmock-dev libbenchmark-dev
   xvfb xauth libgl1-mesa-dri
   python3-numpy python3-h5py python3-pyvisa python3-pyvisa-py
+  qemu-user
 )
+# (qemu-user: the test that a build for x86-64-v3 refuses an older CPU with a
+# message runs the program on an emulated one: tests/cli/CMakeLists.txt.)
 # `make fuzz` only: clang, its compiler-rt (Debian 12 ships libFuzzer and the
 # sanitizer runtimes for clang 14 in libclang-rt-14-dev) and llvm (for
 # /usr/bin/llvm-symbolizer: symbolized sanitizer reports).
