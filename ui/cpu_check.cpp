@@ -1,6 +1,6 @@
 // The instruction set this program was built for (CMakeLists.txt: PIEZO_MARCH,
 // docs/build-and-test.md), checked before anything else of it runs: a build
-// for x86-64-v3 taken to a CPU without AVX2 or FMA would otherwise die of an
+// for x86-64-v3 (AVX2, FMA, BMI2) taken to an older CPU would otherwise die of an
 // illegal instruction at its first vector loop, with no word of why. This
 // file alone is compiled for the baseline x86-64 (ui/CMakeLists.txt), and its
 // check runs as the first static constructor (priority 101), before Eigen's
@@ -16,7 +16,7 @@ __attribute__((constructor(101))) void check_instruction_set() {
   if (__builtin_cpu_supports(PIEZO_BUILT_FOR_MARCH)) return;
   static const char kMessage[] =
       "piezobench: this program was built for the " PIEZO_BUILT_FOR_MARCH
-      " instruction set (AVX2, FMA, BMI2), which this CPU does not have.\n"
+      " instruction set, which this CPU does not have.\n"
       "  Build it on this machine (make demo / make test choose the CPU's set), or configure with\n"
       "  -DPIEZO_MARCH=baseline for a program that runs on any x86-64 CPU.\n";
   // (write(2): nothing of the C++ runtime is needed, nor initialised yet.)
