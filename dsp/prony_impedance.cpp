@@ -69,8 +69,16 @@ std::complex<double> PronyImpedance::transform(Eigen::Index k, std::complex<doub
     const bool small = std::abs(a) < 1e-3;
     const std::complex<double> hat = small ? 1.0 + a * a / 12.0 : (1.0 / e - 2.0 + e) / (a * a);
     const std::complex<double> half = small ? 0.5 - a / 6.0 + a * a / 24.0 : (a - 1.0 + e) / (a * a);
-    std::complex<double> acc = 0.0;
-    for (Eigen::Index j = n - 1; j >= 1; --j) acc = acc * e + direct_residual(j, k);
+    // acc = acc·e + r_j written out on (re, im): std::complex's product
+    // carries a NaN branch per step; for finite parts its value is this one.
+    double acc_re = 0.0, acc_im = 0.0;
+    const double e_re = e.real(), e_im = e.imag();
+    for (Eigen::Index j = n - 1; j >= 1; --j) {
+      const double re = acc_re * e_re - acc_im * e_im + direct_residual(j, k);
+      acc_im = acc_re * e_im + acc_im * e_re;
+      acc_re = re;
+    }
+    const std::complex<double> acc(acc_re, acc_im);
     l += dt * (direct_residual(0, k) * half + hat * e * acc);
   }
   return l;

@@ -13,6 +13,7 @@
 
 #include "dsp/hankel.hpp"
 #include "dsp/work_counters.hpp"
+#include "numerics/complex_division.hpp"
 #include "numerics/simd_clones.hpp"
 
 namespace piezo::dsp {
@@ -368,9 +369,10 @@ std::vector<PronyOrderFit> prony_ss_orders(const Eigen::Ref<const Eigen::MatrixX
 }
 
 std::complex<double> laplace(const PronyFit& fit, Eigen::Index signal, std::complex<double> s) {
+  // (numerics::divide: libgcc's __divdc3 inlined away, a few ulp — issue 43)
   std::complex<double> acc = 0.0;
   for (Eigen::Index n = 0; n < fit.lambda.size(); ++n)
-    acc += fit.residues(n, signal) / (s - fit.lambda[n]);
+    acc += numerics::divide(fit.residues(n, signal), s - fit.lambda[n]);
   return acc;
 }
 
