@@ -77,6 +77,11 @@ WorkerPool::~WorkerPool() {
 
 void WorkerPool::run() {
   const std::size_t n = std::min(opt_.jobs, std::max<std::size_t>(1, opt_.tasks));
+  // The cores asked for that no worker will have (fewer tasks than jobs): lent
+  // from the start, so that one capture replayed with --jobs 2 is as fast as
+  // with --jobs 1 (which runs the two-thread steps on two threads).
+  const int unused = static_cast<int>(std::min<std::size_t>(opt_.jobs - n, 1024));
+  if (spare_) spare_->store(unused, std::memory_order_relaxed);
   workers_.resize(n);
   for (auto& w : workers_) spawn(w);
   std::size_t next = 0;
@@ -102,7 +107,7 @@ void WorkerPool::run() {
       idle += !w.task;
     }
     if (!busy) break;
-    if (spare_) spare_->store(next < opt_.tasks ? 0 : idle, std::memory_order_relaxed);
+    if (spare_) spare_->store(unused + (next < opt_.tasks ? 0 : idle), std::memory_order_relaxed);
     wait_and_collect();
   }
   if (spare_) spare_->store(0, std::memory_order_relaxed);

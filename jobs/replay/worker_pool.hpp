@@ -61,7 +61,8 @@ class WorkerPool {
   void run();
 
   // How many workers idle with no task left to hand them (0 until the tasks
-  // run out), in memory the workers share with the batch: a worker's fit may
+  // run out), plus the jobs no worker was started for (fewer tasks than
+  // jobs), in memory the workers share with the batch: a worker's fit may
   // borrow a core while it is above zero (update/output_error/spare_core.hpp).
   // nullptr if that memory could not be had (then none is lent).
   const std::atomic<int>* spare_cores() const { return spare_; }

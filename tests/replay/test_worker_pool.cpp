@@ -80,3 +80,29 @@ TEST(WorkerPool, SpareCoresCountTheIdleWorkersOnceNoTaskIsLeft) {
   EXPECT_EQ(done[1], "1");      // the other worker idles with none left: one spare core
   EXPECT_EQ(spare->load(), 0);  // the batch is over: none lent
 }
+
+// Fewer tasks than jobs: the jobs no worker is started for are spare from the
+// first task on (one capture with --jobs 2 borrows the second core at once).
+TEST(WorkerPool, JobsBeyondTheTasksAreSpareFromTheStart) {
+  std::map<std::size_t, std::string> done;
+  const std::atomic<int>* spare = nullptr;
+  WorkerPoolCallbacks cb;
+  cb.work = [&spare](std::size_t, const auto&) -> std::string { return spare ? std::to_string(spare->load()) : "no count"; };
+  cb.done = [&](std::size_t i, const std::string& o) { done.emplace(i, o); };
+  cb.lost = [](const LostTask& t) { ADD_FAILURE() << "task " << t.task << " lost: " << t.kind; };
+  std::atomic<bool> cancel{false};
+  WorkerPool one({1, 2, 60.0}, cb, cancel);
+  spare = one.spare_cores();
+  ASSERT_NE(spare, nullptr);
+  one.run();
+  ASSERT_EQ(done.size(), 1u);
+  EXPECT_EQ(done[0], "1");  // one worker for two jobs: one core lent
+  EXPECT_EQ(spare->load(), 0);
+  done.clear();
+  WorkerPool four({2, 4, 60.0}, cb, cancel);
+  spare = four.spare_cores();
+  four.run();
+  ASSERT_EQ(done.size(), 2u);
+  EXPECT_GE(std::stoi(done[0]), 2);  // two workers for four jobs: at least two spare
+  EXPECT_GE(std::stoi(done[1]), 2);
+}
