@@ -7,6 +7,8 @@
 #include <limits>
 #include <map>
 #include <memory>
+#include <optional>
+#include <utility>
 #include <vector>
 
 #include "dsp/fft.hpp"
@@ -123,16 +125,36 @@ Eigen::MatrixXd baseline_columns(Problem& prob, const Averaged& rec, const std::
   // the columns do not depend on t, and the problem keeps each (the
   // disturbance test, its mains frequencies and the whitening ask for the
   // same ones again).
+  // A harmonic's cosine column is asked for just before its sine: one
+  // sincos per sample makes both functions' values (glibc's sincos runs the
+  // same code as its sin and cos: the same bits), the sine's kept for its
+  // column here.
+  std::optional<std::pair<Problem::ColumnKey, std::vector<double>>> sine_made;
   for (std::size_t c = 0; c < keys.size(); ++c) {
     const auto [kind, order, hz] = keys[c];
     cols.col(static_cast<Eigen::Index>(c)) = prob.kept_column(keys[c], [&, kind = kind, order = order, hz = hz] {
       std::vector<double> neg(n);
-      for (std::size_t i = 0; i < n; ++i) {
-        if (kind == 0) {
-          neg[i] = -legendre(order, n > 1 ? 2.0 * double(i) / double(n - 1) - 1.0 : 0.0);
-        } else {
+      if (kind == 2 && sine_made && sine_made->first == keys[c]) {
+        neg = std::move(sine_made->second);
+        sine_made.reset();
+      } else if (kind == 1) {
+        std::vector<double> neg_sin(n);
+        for (std::size_t i = 0; i < n; ++i) {
           const double ph = kTwoPi * order * hz * double(i) / fs;
-          neg[i] = -(kind == 1 ? std::cos(ph) : std::sin(ph));
+          double sn, cs;
+          ::sincos(ph, &sn, &cs);
+          neg[i] = -cs;
+          neg_sin[i] = -sn;
+        }
+        sine_made.emplace(Problem::ColumnKey{2, order, hz}, std::move(neg_sin));
+      } else {
+        for (std::size_t i = 0; i < n; ++i) {
+          if (kind == 0) {
+            neg[i] = -legendre(order, n > 1 ? 2.0 * double(i) / double(n - 1) - 1.0 : 0.0);
+          } else {
+            const double ph = kTwoPi * order * hz * double(i) / fs;
+            neg[i] = -std::sin(ph);
+          }
         }
       }
       return Eigen::VectorXd(prob.deviation(t, std::vector<double>(n, 0.0), neg));
