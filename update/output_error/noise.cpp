@@ -9,6 +9,12 @@
 
 namespace piezo::update::oe {
 
+namespace {
+// The record's white-noise estimates (of its samples alone, not of θ), kept
+// under this key beside its baseline columns (Problem::kept_column: kinds 0–2).
+const Problem::ColumnKey kRecordWhiteNoise{-1, 0, 0.0};
+}  // namespace
+
 RecordNoise record_noise(Problem& prob, const Averaged& rec, const std::vector<cd>& t) {
   RecordNoise out;
   const std::size_t n = rec.v1.size();
@@ -44,14 +50,20 @@ RecordNoise record_noise(Problem& prob, const Averaged& rec, const std::vector<c
     // it by half again in variance (white noise alone: the two agree within
     // a few percent at these sample counts).
     const auto k_shots = static_cast<double>(rec.shots);
-    double h1 = 0, h2 = 0;
-    for (std::size_t k = 0; k < rec.dev1.size(); ++k) {
-      const Eigen::Map<const Eigen::VectorXd> a(rec.dev1[k].data(), static_cast<Eigen::Index>(n)),
-          b(rec.dev2[k].data(), static_cast<Eigen::Index>(n));
-      const double e1 = dsp::estimate_noise_std(a), e2 = dsp::estimate_noise_std(b);
-      h1 += e1 * e1;
-      h2 += e2 * e2;
-    }
+    // (of the record alone: kept with its columns for the next call — the
+    // fit's answer, the other predictions on one held-out record)
+    const Eigen::VectorXd h = prob.kept_column(kRecordWhiteNoise, [&] {
+      double h1 = 0, h2 = 0;
+      for (std::size_t k = 0; k < rec.dev1.size(); ++k) {
+        const Eigen::Map<const Eigen::VectorXd> a(rec.dev1[k].data(), static_cast<Eigen::Index>(n)),
+            b(rec.dev2[k].data(), static_cast<Eigen::Index>(n));
+        const double e1 = dsp::estimate_noise_std(a), e2 = dsp::estimate_noise_std(b);
+        h1 += e1 * e1;
+        h2 += e2 * e2;
+      }
+      return Eigen::Vector2d(h1, h2).eval();
+    });
+    const double h1 = h[0], h2 = h[1];
     // A deviation from the mean of K holds (K − 1)/K of a shot's variance.
     const double d = double(rec.dev1.size()) * (k_shots - 1.0) / k_shots;
     const double w1 = std::sqrt(h1 / d / k_shots), w2 = std::sqrt(h2 / d / k_shots);  // of the average
@@ -77,10 +89,13 @@ RecordNoise record_noise(Problem& prob, const Averaged& rec, const std::vector<c
     out.source = "pretrigger (" + std::to_string(rec.pretrigger) + " samples)";
     out.dof = double(rec.pretrigger - 1);
   } else {
-    const Eigen::Map<const Eigen::VectorXd> a(rec.v1.data(), static_cast<Eigen::Index>(n)),
-        b(rec.v2.data(), static_cast<Eigen::Index>(n));
-    s1 = dsp::estimate_noise_std(a);
-    s2 = dsp::estimate_noise_std(b);
+    const Eigen::VectorXd e = prob.kept_column(kRecordWhiteNoise, [&] {
+      const Eigen::Map<const Eigen::VectorXd> a(rec.v1.data(), static_cast<Eigen::Index>(n)),
+          b(rec.v2.data(), static_cast<Eigen::Index>(n));
+      return Eigen::Vector2d(dsp::estimate_noise_std(a), dsp::estimate_noise_std(b)).eval();
+    });
+    s1 = e[0];
+    s2 = e[1];
     out.source = "high-pass estimate of each channel";
     // The median of |6th differences| of overlapping windows: about a fifth
     // of the samples' worth of independent information.
