@@ -2,7 +2,10 @@
 #include "update/output_error/noise.hpp"
 
 #include <Eigen/SVD>
+#include <array>
 #include <cmath>
+#include <cstdint>
+#include <cstring>
 #include <memory>
 
 #include "dsp/prony_ss.hpp"
@@ -10,9 +13,32 @@
 namespace piezo::update::oe {
 
 namespace {
-// The record's white-noise estimates (of its samples alone, not of θ), kept
-// under this key beside its baseline columns (Problem::kept_column: kinds 0–2).
-const Problem::ColumnKey kRecordWhiteNoise{-1, 0, 0.0};
+// The record's white-noise estimates (of its samples alone, not of θ) are
+// kept beside its baseline columns (Problem::kept_column: kinds 0–2) under
+// kind −1 and a fingerprint of the samples: problems that share columns may
+// hold other records of the same shape (the columns do not depend on the
+// samples; these estimates do).
+Problem::ColumnKey white_noise_key(const Averaged& rec) {
+  std::array<std::uint64_t, 4> lane{0x9E3779B97F4A7C15ull, 0xC2B2AE3D27D4EB4Full, 0x165667B19E3779F9ull,
+                                    0x27D4EB2F165667C5ull};
+  std::size_t k = 0;
+  auto mix = [&](const std::vector<double>& v) {
+    for (double x : v) {
+      std::uint64_t b;
+      std::memcpy(&b, &x, sizeof b);
+      std::uint64_t& h = lane[k++ & 3];
+      h = (h ^ b) * 0x100000001B3ull;
+      h ^= h >> 29;
+    }
+    lane[0] ^= v.size();
+  };
+  mix(rec.v1);
+  mix(rec.v2);
+  for (const auto& d : rec.dev1) mix(d);
+  for (const auto& d : rec.dev2) mix(d);
+  const std::uint64_t h = (lane[0] * 31 + lane[1]) * 31 + lane[2] * 7 + lane[3];
+  return {-1, static_cast<int>(rec.shots), static_cast<double>(h >> 11)};  // (53 bits: exact, never NaN)
+}
 }  // namespace
 
 RecordNoise record_noise(Problem& prob, const Averaged& rec, const std::vector<cd>& t) {
@@ -52,7 +78,7 @@ RecordNoise record_noise(Problem& prob, const Averaged& rec, const std::vector<c
     const auto k_shots = static_cast<double>(rec.shots);
     // (of the record alone: kept with its columns for the next call — the
     // fit's answer, the other predictions on one held-out record)
-    const Eigen::VectorXd h = prob.kept_column(kRecordWhiteNoise, [&] {
+    const Eigen::VectorXd h = prob.kept_column(white_noise_key(rec), [&] {
       double h1 = 0, h2 = 0;
       for (std::size_t k = 0; k < rec.dev1.size(); ++k) {
         const Eigen::Map<const Eigen::VectorXd> a(rec.dev1[k].data(), static_cast<Eigen::Index>(n)),
@@ -89,7 +115,7 @@ RecordNoise record_noise(Problem& prob, const Averaged& rec, const std::vector<c
     out.source = "pretrigger (" + std::to_string(rec.pretrigger) + " samples)";
     out.dof = double(rec.pretrigger - 1);
   } else {
-    const Eigen::VectorXd e = prob.kept_column(kRecordWhiteNoise, [&] {
+    const Eigen::VectorXd e = prob.kept_column(white_noise_key(rec), [&] {
       const Eigen::Map<const Eigen::VectorXd> a(rec.v1.data(), static_cast<Eigen::Index>(n)),
           b(rec.v2.data(), static_cast<Eigen::Index>(n));
       return Eigen::Vector2d(dsp::estimate_noise_std(a), dsp::estimate_noise_std(b)).eval();
