@@ -330,7 +330,7 @@ GapDiagnosis gap_from_output_error(const OeResult& r, const std::string& fit_des
   auto predict_base = [&](model::ModalSolver& s) {
     try {
       base = predict_output_error(s, cls, r.updated, r.loss(), r.effect_set, heldout.data, r.band_hz, options,
-                                  r.covariance_rel, "", shared);
+                                  r.covariance_rel, "", shared, r.port_tangent);
     } catch (...) {
       base_error = std::current_exception();
     }
@@ -338,8 +338,9 @@ GapDiagnosis gap_from_output_error(const OeResult& r, const std::string& fit_des
   auto predict_with = [&](model::ModalSolver& s, std::size_t i) {
     const OeEffect& e = *candidates[i];
     try {
+      // (a linearised effect sits at the fit's answer: the fit's tangent)
       with[i] = predict_output_error(s, cls, e.material, e.loss(), e.effect_set, heldout.data, r.band_hz, options,
-                                     e.covariance_rel, e.name, shared);
+                                     e.covariance_rel, e.name, shared, e.port_tangent ? e.port_tangent : r.port_tangent);
     } catch (const std::exception& ex) {
       // not simulable with it (an end mass the FE model refuses, a value that
       // makes the divider singular): no held-out number for it

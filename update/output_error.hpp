@@ -35,6 +35,7 @@
 //               3 sigma, is "not identifiable" (with its numbers and what would
 //               pin it).
 #include <Eigen/Core>
+#include <array>
 #include <functional>
 #include <limits>
 #include <memory>
@@ -181,6 +182,21 @@ struct OeOptions {
 // One catalogue effect (model/effects.hpp) fitted as a sixth parameter beside
 // the five, from the five's optimum (issue 18: the gap of any capture, one
 // shot included, in the same output-error model as the estimate).
+// The FE port models' tangent where a fit ended (its last exact Jacobian's
+// models: at x_ref and at x_ref + h·e_c for the four constants, the fit's
+// coordinates about `origin`, the end mass `mass`). A held-out prediction near
+// there takes its Jacobian's material columns from it (the port model at its
+// own point plus the tangent's slopes, checked there: Problem::tangent_near)
+// instead of four new FE models per prediction.
+struct OePortTangent {
+  TubeParams origin;  // the fit's coordinates' constants at x = 0 (the nominal ones)
+  Eigen::Vector4d x_ref = Eigen::Vector4d::Zero();
+  double mass = 0, h = 0;
+  model::ModalPortModel base;
+  std::array<model::ModalPortModel, 4> plus;
+  std::array<double, 4> slope{};  // the largest relative slope of an active mode's ω or |p| per unit x_c
+};
+
 struct OeEffect {
   std::string name, unit;
   double value = 0, sigma = 0;  // SI (daq_input_resistance: ohm, from a fitted conductance)
@@ -220,6 +236,8 @@ struct OeEffect {
   // "constant-phase" (causal, ε' falling with frequency).
   std::string law;
   int fe_models = 0;  // FE port models its scan built (the refit, both laws, the extra starts)
+  // The port models' tangent where its refit ended (null: linearised, or none).
+  std::shared_ptr<const OePortTangent> port_tangent;
 };
 
 struct OeParameter {
@@ -344,6 +362,9 @@ struct OeResult {
   // coordinates at the answer, RELATIVE to it: ln YE11, nu12/nu12 − 1, ln d31,
   // ln εT33, ln β or ln(1/Qm) (what the held-out prediction propagates).
   Eigen::MatrixXd covariance_rel;
+  // The port models' tangent near the answer (the held-out predictions'
+  // Jacobian; null when the fit left none).
+  std::shared_ptr<const OePortTangent> port_tangent;
   std::vector<TubeParams> optima;            // every refined start's optimum (best first)
   std::vector<double> optima_cost;
   double seconds = 0;
@@ -419,6 +440,7 @@ OePrediction predict_output_error(model::ModalSolver& solver, const MaterialClas
                                   double band_hz, const OeOptions& options = {},
                                   const Eigen::MatrixXd& covariance_rel = {},
                                   const std::string& effect = "",
-                                  const std::shared_ptr<OeRecordShare>& shared = nullptr);
+                                  const std::shared_ptr<OeRecordShare>& shared = nullptr,
+                                  const std::shared_ptr<const OePortTangent>& tangent = nullptr);
 
 }  // namespace piezo::update

@@ -257,6 +257,7 @@ Scanned scan_one(const ScanInputs& in, Problem& p, Fitter& f, const std::string&
       fx.dielectric_constant_phase = true;
     };
   fill(in, p, f, e, rf);
+  e.port_tangent = p.export_tangent();
   if (surrogate) p.set_surrogate(true);
   e.fe_models = p.evaluations() - models_before;
   s.e = std::move(e);
@@ -314,6 +315,7 @@ int regrid_effects(const ScanInputs& in, Fitter& fitter, std::vector<Refit>& ref
     if (other.cost < rf->run.cost) {
       rf->run = std::move(other);
       fill(in, p, f, out.effects[rf->index], *rf);  // (each task its own effect)
+      out.effects[rf->index].port_tangent = p.export_tangent();
     }
     out.effects[rf->index].fe_models += p.evaluations() - models_before;
   });

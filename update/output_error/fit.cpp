@@ -298,6 +298,7 @@ OeResult fit_output_error(model::ModalSolver& solver, const MaterialClass& cls,
   out.shot_consistency = shot_consistency(answer, prob, whiten, rec, sigma, nominal.nu12 / out.updated.nu12,
                                           out.parameters);
 
+  out.port_tangent = prob.export_tangent();  // (the scan leaves the problem's state as it found it)
   models_elsewhere += scan_effects(answer, fitter, co, nominal, opt, out);
 
   out.status = best.converged ? UpdateStatus::converged : UpdateStatus::max_iterations;

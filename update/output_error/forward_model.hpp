@@ -197,6 +197,13 @@ class Problem {
   void set_tangent(const Eigen::VectorXd& x, double h) { set_tangent(x, h, effects_at(x).mass_loading); }
   void set_tangent(const Eigen::VectorXd& x, double h, double mass);
   bool tangent_near(const Eigen::VectorXd& x) { return tangent_near(x, effects_at(x).mass_loading); }
+  // The tangent as a fit leaves it (null when there is none), and a fit's
+  // tangent taken into this problem's coordinates (about other constants: the
+  // same models, x_ref moved and the nu12 column — a relative coordinate,
+  // ν/ν0 − 1 — rescaled by the ratio of the origins' ν). The adopted one
+  // serves tangent_near and tangent_transfer as this problem's own would.
+  std::shared_ptr<const OePortTangent> export_tangent() const;
+  void adopt_tangent(const OePortTangent& t);
   // … and it still holds there: x's own port model is its linear prediction
   // from x_ref to within kTangentTolerance in every electrically active mode's
   // frequency and participation. Two modes near a veering (an avoided

@@ -116,6 +116,43 @@ void Problem::set_tangent(const Eigen::VectorXd& x, double h, double mass) {
   tangent_.valid = true;
 }
 
+std::shared_ptr<const OePortTangent> Problem::export_tangent() const {
+  if (!tangent_.valid) return nullptr;
+  auto t = std::make_shared<OePortTangent>();
+  t->origin = co_.p0;
+  t->x_ref = tangent_.x_ref;
+  t->mass = tangent_.mass;
+  t->h = tangent_.h;
+  t->base = tangent_.base;
+  t->plus = tangent_.plus;
+  t->slope = tangent_.slope;
+  return t;
+}
+
+void Problem::adopt_tangent(const OePortTangent& t) {
+  tangent_.valid = false;
+  const TubeParams &a = t.origin, &b = co_.p0;
+  const double r0 = b.y_e11 / a.y_e11, r1 = b.nu12 / a.nu12, r2 = b.d31 / a.d31, r3 = b.eps_t33 / a.eps_t33;
+  if (!(t.h > 0) || !(r0 > 0) || !(r1 > 0) || !(r2 > 0) || !(r3 > 0) || !std::isfinite(r0 * r1 * r2 * r3)) return;
+  for (const auto& p : t.plus)
+    if (!same_structure(p, t.base)) return;
+  // Coordinates5::params: YE11, d31 and εT33 as logs of the ratio to the
+  // origin (so only shifted), nu12 as ν/ν0 − 1 (shifted and scaled: a unit of
+  // this problem's coordinate is ν_b/ν_a of the fit's).
+  tangent_.x_ref << t.x_ref[0] - std::log(r0), (1.0 + t.x_ref[1]) / r1 - 1.0, t.x_ref[2] - std::log(r2),
+      t.x_ref[3] - std::log(r3);
+  tangent_.base = t.base;
+  tangent_.plus = t.plus;
+  tangent_.slope = t.slope;
+  model::ModalPortModel p1 = t.base;
+  shift(p1, t.plus[1], r1);  // base + (ν_b/ν_a)·(plus − base): the slope per unit of this coordinate
+  tangent_.plus[1] = std::move(p1);
+  tangent_.slope[1] = t.slope[1] * r1;
+  tangent_.mass = t.mass;
+  tangent_.h = t.h;
+  tangent_.valid = true;
+}
+
 bool Problem::tangent_near(const Eigen::VectorXd& x, double mass) {
   if (!tangent_.valid || mass != tangent_.mass ||
       (x.head<4>() - tangent_.x_ref).cwiseAbs().maxCoeff() > kTangentReach)

@@ -35,7 +35,8 @@ OePrediction predict_output_error(model::ModalSolver& solver, const MaterialClas
                                   const model::EffectSet& effects, const OeData& data,
                                   double band_hz, const OeOptions& opt,
                                   const Eigen::MatrixXd& covariance_rel,
-                                  const std::string& effect, const std::shared_ptr<OeRecordShare>& shared) {
+                                  const std::string& effect, const std::shared_ptr<OeRecordShare>& shared,
+                                  const std::shared_ptr<const OePortTangent>& tangent) {
   using namespace oe;
   const double fs = data.sample_rate_hz;
   if (!(fs > 0) || !std::isfinite(fs)) fail("sample rate must be positive");
@@ -47,6 +48,10 @@ OePrediction predict_output_error(model::ModalSolver& solver, const MaterialClas
                         loss.model};
   Problem prob(solver, cls, co, rec, data, band_hz, opt.modal, shared);
   prob.share_columns(shared);
+  // The fit's port tangent near these constants: the Gauss–Newton steps below
+  // take the material columns of their Jacobian from it (tangent_near checks
+  // it at the prediction's point) instead of four FE models per prediction.
+  if (tangent) prob.adopt_tangent(*tangent);
   const Eigen::VectorXd x = Eigen::VectorXd::Zero(kParams);
   const auto t = prob.transfer(x, effects);
   if (!t) throw std::runtime_error("predict_output_error: the model cannot be simulated");
