@@ -13,14 +13,11 @@
 #include <cmath>
 #include <complex>
 #include <numbers>
-#include <random>
 #include <vector>
 
 #include "dsp/work_counters.hpp"
-#include "model/material_presets.hpp"
-#include "model/material_spec.hpp"
 #include "model/modal.hpp"
-#include "model/tube_model.hpp"
+#include "tests/support/oe_test_tube.hpp"
 #include "update/output_error/baseline.hpp"
 #include "update/output_error/forward_model.hpp"
 #include "update/output_error/noise.hpp"
@@ -32,19 +29,7 @@ using cd = std::complex<double>;
 constexpr double kFs = 1e6;        // 40 ms records: three hum harmonics fit
 constexpr std::size_t kN = 40000;
 
-update::oe::Averaged record(unsigned seed, double noise = 0.01) {
-  std::mt19937 rng(seed);
-  std::normal_distribution<double> n01;
-  update::oe::Averaged rec;
-  rec.v1.resize(kN);
-  rec.v2.resize(kN);
-  for (std::size_t i = 0; i < kN; ++i) {
-    rec.v1[i] = std::exp(-3000.0 * double(i) / kFs) + noise * n01(rng);
-    rec.v2[i] = 0.5 * rec.v1[i] + noise * n01(rng);
-  }
-  rec.shots = 1;
-  return rec;
-}
+update::oe::Averaged record(unsigned seed, double noise = 0.01) { return test::decaying_record(kN, kFs, seed, noise); }
 
 // P0..P3 on [−1, 1] and cos/sin(2π·h·f·t): the basis the columns filter.
 std::vector<std::vector<double>> basis(double mains_hz) {
@@ -83,19 +68,10 @@ Eigen::MatrixXd direct(update::oe::Problem& prob, const std::vector<cd>& t, doub
   return cols;
 }
 
-class BaselineColumns : public ::testing::Test {
+class BaselineColumns : public test::OeTestTube {
  protected:
-  model::TubeModel tube{model::TubeGeometry{}};
-  model::ModalSolver solver{tube};
-  update::MaterialClass cls = update::MaterialClass::isotropic();
-  update::TubeParams nominal = model::isotropic_params(model::resolve_material({"apc850", true, ""}).d);
-  update::OeData data() const {
-    update::OeData d;
-    d.sample_rate_hz = kFs;
-    d.circuit.r1_ohm = 3140.0;
-    return d;
-  }
-  update::oe::Coordinates5 co() const { return {nominal, 1e-7, update::OeDamping::rayleigh}; }
+  update::OeData data() const { return bench_data(kFs); }
+  update::oe::Coordinates5 co() const { return nominal_coordinates(); }
 };
 
 // The columns against the filter applied directly, to rounding (the

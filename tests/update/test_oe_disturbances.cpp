@@ -34,6 +34,7 @@
 #include "model/modal.hpp"
 #include "model/transient.hpp"
 #include "model/tube_model.hpp"
+#include "tests/support/oe_test_tube.hpp"
 #include "update/gap_diagnosis.hpp"
 #include "update/gap_output_error.hpp"
 #include "update/output_error.hpp"
@@ -151,12 +152,8 @@ double truth_of(const update::TubeParams& t, int i) {
   }
 }
 
-class OeDisturbances : public ::testing::Test {
+class OeDisturbances : public test::OeTestTube {
  protected:
-  model::TubeModel tube{model::TubeGeometry{}};
-  model::ModalSolver solver{tube};
-  update::MaterialClass cls = update::MaterialClass::isotropic();
-  update::TubeParams nominal = model::isotropic_params(model::resolve_material({"apc850", true, ""}).d);
   update::TubeParams truth() const {
     update::TubeParams t = nominal;
     t.y_e11 *= 1.04;

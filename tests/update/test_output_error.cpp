@@ -24,6 +24,7 @@
 #include "model/tube_model.hpp"
 #include "model/work_counters.hpp"
 #include "jobs/pipeline/capture_fit.hpp"
+#include "tests/support/oe_test_tube.hpp"
 #include "update/gap_diagnosis.hpp"
 #include "update/gap_output_error.hpp"
 #include "update/output_error.hpp"
@@ -87,12 +88,8 @@ double truth_of(const update::TubeParams& t, const std::string& name) {
   return t.eps_t33 / model::kEps0;
 }
 
-class OutputErrorSimulated : public ::testing::Test {
+class OutputErrorSimulated : public test::OeTestTube {
  protected:
-  model::TubeModel tube{model::TubeGeometry{}};
-  model::ModalSolver solver{tube};
-  update::MaterialClass cls = update::MaterialClass::isotropic();
-  update::TubeParams nominal = model::isotropic_params(model::resolve_material({"apc850", true, ""}).d);
   update::TubeParams truth() const {
     update::TubeParams t = nominal;
     t.y_e11 *= 1.05;

@@ -10,13 +10,10 @@
 #include <Eigen/Core>
 #include <cmath>
 #include <complex>
-#include <random>
 #include <vector>
 
-#include "model/material_presets.hpp"
-#include "model/material_spec.hpp"
-#include "model/modal.hpp"
-#include "model/tube_model.hpp"
+#include "model/effects.hpp"
+#include "tests/support/oe_test_tube.hpp"
 #include "update/output_error/forward_model.hpp"
 
 namespace {
@@ -26,33 +23,7 @@ using cd = std::complex<double>;
 constexpr double kFs = 1e6;
 constexpr std::size_t kN = 20000;
 
-update::oe::Averaged record() {
-  std::mt19937 rng(5);
-  std::normal_distribution<double> n01;
-  update::oe::Averaged rec;
-  rec.v1.resize(kN);
-  rec.v2.resize(kN);
-  for (std::size_t i = 0; i < kN; ++i) {
-    rec.v1[i] = std::exp(-3000.0 * double(i) / kFs) + 0.01 * n01(rng);
-    rec.v2[i] = 0.5 * rec.v1[i] + 0.01 * n01(rng);
-  }
-  rec.shots = 1;
-  return rec;
-}
-
-class PortTangent : public ::testing::Test {
- protected:
-  model::TubeModel tube{model::TubeGeometry{}};
-  model::ModalSolver solver{tube};
-  update::MaterialClass cls = update::MaterialClass::isotropic();
-  update::TubeParams nominal = model::isotropic_params(model::resolve_material({"apc850", true, ""}).d);
-  update::OeData data() const {
-    update::OeData d;
-    d.sample_rate_hz = kFs;
-    d.circuit.r1_ohm = 3140.0;
-    return d;
-  }
-};
+class PortTangent : public test::OeTestTube {};
 
 // ‖a − b‖/‖b‖ of two transfers.
 double rel(const std::vector<cd>& a, const std::vector<cd>& b) {
@@ -67,9 +38,9 @@ double rel(const std::vector<cd>& a, const std::vector<cd>& b) {
 }  // namespace
 
 TEST_F(PortTangent, AnAdoptedTangentGivesTheColumnsOfTheProblemsOwn) {
-  const auto rec = record();
-  const auto d = data();
-  const update::oe::Coordinates5 fit_co{nominal, 1e-7, update::OeDamping::rayleigh};
+  const auto rec = test::decaying_record(kN, kFs, 5, 0.01);
+  const auto d = bench_data(kFs);
+  const update::oe::Coordinates5 fit_co = nominal_coordinates();
   update::oe::Problem fit(solver, cls, fit_co, rec, d, 100e3, {});
   // The fit's answer away from its origin, nu12 by 8 % (its coordinate's unit
   // then differs by 8 % between the two problems).
