@@ -179,9 +179,6 @@ struct OeOptions {
   double alias_threshold = 0.05;
 };
 
-// One catalogue effect (model/effects.hpp) fitted as a sixth parameter beside
-// the five, from the five's optimum (issue 18: the gap of any capture, one
-// shot included, in the same output-error model as the estimate).
 // The FE port models' tangent where a fit ended (its last exact Jacobian's
 // models: at x_ref and at x_ref + h·e_c for the four constants, the fit's
 // coordinates about `origin`, the end mass `mass`). A held-out prediction near
@@ -197,6 +194,9 @@ struct OePortTangent {
   std::array<double, 4> slope{};  // the largest relative slope of an active mode's ω or |p| per unit x_c
 };
 
+// One catalogue effect (model/effects.hpp) fitted as a sixth parameter beside
+// the five, from the five's optimum (issue 18: the gap of any capture, one
+// shot included, in the same output-error model as the estimate).
 struct OeEffect {
   std::string name, unit;
   double value = 0, sigma = 0;  // SI (daq_input_resistance: ohm, from a fitted conductance)
